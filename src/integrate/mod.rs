@@ -1,0 +1,8 @@
+//! Integration: Owen-scrambled Sobol points and the QMC albedo estimators.
+
+pub mod albedo;
+pub mod estimate;
+pub mod sobol;
+
+pub use albedo::{QmcSettings, albedo, average_albedo};
+pub use estimate::Estimate;
