@@ -1,3 +1,47 @@
-//! kiln: bakes the lookup tables energy-conserving microfacet materials need.
+//! kiln bakes the lookup tables energy-conserving microfacet materials need: the directional
+//! albedo `E(mu, roughness)` and its average `E_avg(roughness)` of GGX and Beckmann BRDFs, for
+//! Kulla and Conty's multiple-scattering compensation.
+//!
+//! The library is what the `kiln` command runs; a build script can use it with
+//! `default-features = false` and pull none of the command line's dependencies.
+//!
+//! ```
+//! use kiln::{BakeOptions, Format, Ndf, Precision};
+//!
+//! // A small, fast GGX table: 8 x 8 texels, 2^12 samples each.
+//! let options = BakeOptions {
+//!     ndfs: vec![Ndf::Ggx],
+//!     size: 8,
+//!     samples: 1 << 12,
+//!     average_samples: 1 << 14,
+//!     ..BakeOptions::default()
+//! };
+//! let tables = options.bake(&|_samples_done| {})?;
+//! let e = &tables[0];
+//! assert_eq!(e.spec.id(), "ggx-height-correlated-E");
+//! assert!(e.value.iter().all(|&v| (0.0..=1.0).contains(&v)));
+//!
+//! let dir = tempfile::tempdir().unwrap();
+//! let written = kiln::format::write_tables(dir.path(), &tables, &[Format::Exr, Format::Json], Precision::F16)?;
+//! assert_eq!(written.len(), 4);
+//! # Ok::<(), kiln::Error>(())
+//! ```
+//!
+//! Conventions, everywhere: `mu = cos(theta)` of the view direction; roughness is either the
+//! perceptual `r` with `alpha = r^2` or `alpha` itself, and every table says which; grids put
+//! samples at texel centres `(i + 0.5) / N` (default) or at nodes `i / (N - 1)`.
+
+pub mod bake;
+pub mod error;
+pub mod format;
 pub mod integrate;
 pub mod model;
+pub mod table;
+
+pub use bake::{BakeOptions, bake_table};
+pub use error::{Error, Result};
+pub use format::{Format, Precision};
+pub use integrate::{Estimate, QmcSettings, albedo, average_albedo};
+pub use model::{Masking, Model, Ndf, RoughnessConvention};
+pub use table::axis::{Axis, Grid, MuMapping};
+pub use table::{Quantity, Table, TableSpec};

@@ -15,10 +15,11 @@
 
 use super::estimate::Estimate;
 use super::sobol::{OwenSobol, mix_seed};
+use crate::model::ndf::BeckmannVisibleNormals;
 use crate::model::{Beckmann, Ggx, Masking, MicrofacetDistribution, Model, Ndf, Vec3};
 
 /// How a QMC estimate is run.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub struct QmcSettings {
     /// Integrand evaluations per estimate, a power of two, split evenly over the scrambles.
     pub samples: u64,
@@ -104,7 +105,10 @@ pub fn albedo(model: Model, alpha: f64, mu: f64, settings: &QmcSettings) -> Esti
                 let ndf = Beckmann { alpha };
                 let o = Vec3::from_mu(mu);
                 let lambda_o = ndf.lambda(o);
-                sum_over_block(seq, log2_n, |u| generic_loss(ndf, masking, o, lambda_o, u))
+                let visible = BeckmannVisibleNormals::new(ndf, o);
+                sum_over_block(seq, log2_n, |u| {
+                    reflection_loss(ndf, masking, o, lambda_o, visible.sample(u))
+                })
             }
         }
     })
@@ -229,7 +233,20 @@ pub fn generic_loss<N: MicrofacetDistribution>(
     lambda_o: f64,
     u: [f64; 2],
 ) -> f64 {
-    let m = ndf.sample_visible_normal(o, u);
+    reflection_loss(ndf, masking, o, lambda_o, ndf.sample_visible_normal(o, u))
+}
+
+/// The loss `1 - w` for the microfacet normal `m`: reflect `o` about it; below the horizon all
+/// is lost, above it [`Masking::loss`].
+#[inline]
+#[must_use]
+pub fn reflection_loss<N: MicrofacetDistribution>(
+    ndf: N,
+    masking: Masking,
+    o: Vec3,
+    lambda_o: f64,
+    m: Vec3,
+) -> f64 {
     let i = o.reflect(m);
     if i.z > 0.0 {
         masking.loss(lambda_o, ndf.lambda(i))

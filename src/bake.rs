@@ -1,0 +1,213 @@
+//! Baking: from options to table specs, and from a spec to a table, texels in parallel.
+//!
+//! Each texel is one QMC estimate ([`crate::integrate::albedo`]), a pure function of the spec and
+//! the texel's coordinates, summed in a fixed order inside one thread. Rayon spreads texels over
+//! cores and collects them in index order, so a table is byte-identical for any thread count.
+
+use crate::error::{Error, Result};
+use crate::integrate::{Estimate, QmcSettings, albedo, average_albedo};
+use crate::model::{Masking, Model, Ndf, RoughnessConvention};
+use crate::table::axis::{Axis, Grid, MuMapping};
+use crate::table::{Quantity, Table, TableSpec};
+use rayon::prelude::*;
+
+/// What `kiln bake` bakes: for each model, an `E` table and an `E_avg` table.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct BakeOptions {
+    pub ndfs: Vec<Ndf>,
+    pub maskings: Vec<Masking>,
+    /// Samples per axis: `E` is `size x size`, `E_avg` has `size` entries.
+    pub size: usize,
+    /// QMC evaluations per `E` texel (a power of two).
+    pub samples: u64,
+    /// QMC evaluations per `E_avg` entry (a power of two); `E_avg` integrates over `mu` as well,
+    /// and 32 entries are cheap, so the default is 16 times `samples`.
+    pub average_samples: u64,
+    /// Independent scrambles per estimate (for the standard error).
+    pub scrambles: u32,
+    pub seed: u64,
+    pub roughness_convention: RoughnessConvention,
+    pub mu_mapping: MuMapping,
+    pub grid: Grid,
+}
+
+impl Default for BakeOptions {
+    fn default() -> Self {
+        Self {
+            ndfs: Ndf::ALL.to_vec(),
+            maskings: vec![Masking::HeightCorrelated],
+            size: Self::DEFAULT_SIZE,
+            samples: QmcSettings::DEFAULT_SAMPLES,
+            average_samples: 16 * QmcSettings::DEFAULT_SAMPLES,
+            scrambles: QmcSettings::DEFAULT_SCRAMBLES,
+            seed: 0,
+            roughness_convention: RoughnessConvention::Perceptual,
+            mu_mapping: MuMapping::Linear,
+            grid: Grid::Centers,
+        }
+    }
+}
+
+impl BakeOptions {
+    /// The default table size, 32 x 32.
+    pub const DEFAULT_SIZE: usize = 32;
+    /// The largest size accepted per axis.
+    pub const MAX_SIZE: usize = 4096;
+
+    /// Checks every option, naming the bad value and the allowed range.
+    pub fn validate(&self) -> Result<()> {
+        if !(2..=Self::MAX_SIZE).contains(&self.size) {
+            return Err(Error::InvalidInput(format!(
+                "size must be between 2 and {} (got {})",
+                Self::MAX_SIZE,
+                self.size
+            )));
+        }
+        if self.ndfs.is_empty() || self.maskings.is_empty() {
+            return Err(Error::InvalidInput(
+                "name at least one ndf and one masking".into(),
+            ));
+        }
+        for (what, samples) in [
+            ("samples", self.samples),
+            ("avg-samples", self.average_samples),
+        ] {
+            QmcSettings {
+                samples,
+                scrambles: self.scrambles,
+                seed: self.seed,
+            }
+            .validate()
+            .map_err(|e| Error::InvalidInput(format!("{what}: {e}")))?;
+        }
+        Ok(())
+    }
+
+    /// The models baked, in a fixed order.
+    #[must_use]
+    pub fn models(&self) -> Vec<Model> {
+        let mut models = Vec::new();
+        for &ndf in &self.ndfs {
+            for &masking in &self.maskings {
+                let model = Model { ndf, masking };
+                if !models.contains(&model) {
+                    models.push(model);
+                }
+            }
+        }
+        models
+    }
+
+    /// The tables to bake: `E` then `E_avg` for each model.
+    #[must_use]
+    pub fn specs(&self) -> Vec<TableSpec> {
+        let roughness = Axis::Roughness {
+            size: self.size,
+            convention: self.roughness_convention,
+            grid: self.grid,
+        };
+        let mu = Axis::Mu {
+            size: self.size,
+            mapping: self.mu_mapping,
+            grid: self.grid,
+        };
+        let qmc = |samples| QmcSettings {
+            samples,
+            scrambles: self.scrambles,
+            seed: self.seed,
+        };
+        self.models()
+            .into_iter()
+            .flat_map(|model| {
+                [
+                    TableSpec {
+                        model,
+                        quantity: Quantity::E,
+                        roughness,
+                        mu: Some(mu),
+                        qmc: qmc(self.samples),
+                    },
+                    TableSpec {
+                        model,
+                        quantity: Quantity::EAvg,
+                        roughness,
+                        mu: None,
+                        qmc: qmc(self.average_samples),
+                    },
+                ]
+            })
+            .collect()
+    }
+
+    /// The `kiln bake` command that reproduces the tables of `model` with these options, with
+    /// every setting spelled out.
+    #[must_use]
+    pub fn command_for(&self, model: Model) -> String {
+        format!(
+            "kiln bake --ndf {} --masking {} --size {} --samples {} --avg-samples {} \
+             --scrambles {} --seed {} --roughness-axis {} --mu-axis {} --grid {}",
+            model.ndf,
+            model.masking,
+            self.size,
+            self.samples,
+            self.average_samples,
+            self.scrambles,
+            self.seed,
+            self.roughness_convention,
+            self.mu_mapping.name(),
+            self.grid.name()
+        )
+    }
+
+    /// Bakes every table of [`BakeOptions::specs`]. `progress` is told how many integrand
+    /// evaluations each finished texel spent (see [`BakeOptions::total_samples`]).
+    pub fn bake(&self, progress: &(dyn Fn(u64) + Sync)) -> Result<Vec<Table>> {
+        self.validate()?;
+        Ok(self
+            .specs()
+            .into_iter()
+            .map(|spec| {
+                let command = self.command_for(spec.model);
+                bake_table(spec, command, progress)
+            })
+            .collect())
+    }
+
+    /// The integrand evaluations [`BakeOptions::bake`] will spend, for a progress bar.
+    #[must_use]
+    pub fn total_samples(&self) -> u64 {
+        self.specs()
+            .iter()
+            .map(|s| s.len() as u64 * s.qmc.samples)
+            .sum()
+    }
+}
+
+/// Bakes one table, texels in parallel (deterministic for any thread count).
+#[must_use]
+pub fn bake_table(spec: TableSpec, command: String, progress: &(dyn Fn(u64) + Sync)) -> Table {
+    let estimates: Vec<Estimate> = (0..spec.len())
+        .into_par_iter()
+        .map(|index| {
+            let estimate = estimate_texel(&spec, index);
+            progress(spec.qmc.samples);
+            estimate
+        })
+        .collect();
+    Table {
+        value: estimates.iter().map(|e| e.value).collect(),
+        one_minus_value: estimates.iter().map(|e| e.one_minus_value).collect(),
+        std_error: estimates.iter().map(|e| e.std_error).collect(),
+        spec,
+        command,
+    }
+}
+
+/// The estimate of one texel (row-major index, slowest axis first).
+#[must_use]
+pub fn estimate_texel(spec: &TableSpec, index: usize) -> Estimate {
+    match spec.texel_coordinates(index) {
+        (alpha, Some(mu)) => albedo(spec.model, alpha, mu, &spec.qmc),
+        (alpha, None) => average_albedo(spec.model, alpha, &spec.qmc),
+    }
+}

@@ -1,0 +1,205 @@
+//! kiln's raw binary table format: a small fixed header, then one little-endian plane per channel.
+//! Easy to `include_bytes!` and to read from C. All integers are little-endian `u32`.
+//!
+//! ```text
+//! offset  size  field
+//!      0     8  magic "KILNTAB\0"
+//!      8     4  format version (1)
+//!     12     4  header size in bytes = offset of the first plane (a multiple of 16)
+//!     16     4  rank: 1 (E_avg) or 2 (E)
+//!     20     4  channel count C
+//!     24     4  dims[0]: size of the slowest-varying axis (roughness)
+//!     28     4  dims[1]: size of the fastest-varying axis (mu), 1 when rank is 1
+//!     32    16  axis 0 descriptor  \  each: u32 quantity (1 = mu, 2 = r with alpha = r^2,
+//!     48    16  axis 1 descriptor  /  3 = alpha), u32 mapping (0 = linear, 1 = sqrt: mu = t^2),
+//!                                     u32 grid (0 = centers (i + 0.5)/N, 1 = nodes i/(N - 1)),
+//!                                     u32 reserved (0); all zero for an absent axis
+//!     64  32*C  channel entries: 24 bytes name (ASCII, NUL-padded), u32 dtype (1 = f32,
+//!               2 = f16), u32 byte offset of the channel's plane from the start of the file
+//!      …        planes, each 16-byte aligned: dims[0] * dims[1] values, row-major
+//!               (index = i0 * dims[1] + i1)
+//! ```
+//!
+//! Channels, in order: `E`, `one_minus_E`, `std_error` (or `E_avg`, `one_minus_E_avg`,
+//! `std_error`). The value channels use the requested precision; `std_error` is always f32.
+
+use super::Precision;
+use crate::model::RoughnessConvention;
+use crate::table::Table;
+use crate::table::axis::{Axis, Grid, MuMapping};
+
+/// The file's first 8 bytes.
+pub const MAGIC: &[u8; 8] = b"KILNTAB\0";
+/// The format version written.
+pub const VERSION: u32 = 1;
+
+const FIXED_HEADER: usize = 64;
+const CHANNEL_ENTRY: usize = 32;
+const NAME_BYTES: usize = 24;
+
+fn align16(n: usize) -> usize {
+    n.div_ceil(16) * 16
+}
+
+fn axis_descriptor(axis: Option<&Axis>) -> [u32; 4] {
+    let grid = |g: Grid| match g {
+        Grid::Centers => 0,
+        Grid::Nodes => 1,
+    };
+    match axis {
+        None => [0; 4],
+        Some(&Axis::Mu {
+            mapping, grid: g, ..
+        }) => {
+            let m = match mapping {
+                MuMapping::Linear => 0,
+                MuMapping::Sqrt => 1,
+            };
+            [1, m, grid(g), 0]
+        }
+        Some(&Axis::Roughness {
+            convention,
+            grid: g,
+            ..
+        }) => {
+            let q = match convention {
+                RoughnessConvention::Perceptual => 2,
+                RoughnessConvention::Alpha => 3,
+            };
+            [q, 0, grid(g), 0]
+        }
+    }
+}
+
+/// Encodes a table in kiln's binary format.
+#[must_use]
+pub fn encode(table: &Table, precision: Precision) -> Vec<u8> {
+    let axes = table.spec.axes();
+    let shape = table.spec.shape();
+    let count = table.spec.len();
+    let names = table.channel_names();
+    let dtypes = [precision, precision, Precision::F32];
+    let header_size = align16(FIXED_HEADER + CHANNEL_ENTRY * names.len());
+    let mut offsets = Vec::with_capacity(names.len());
+    let mut offset = header_size;
+    for dtype in dtypes {
+        offsets.push(offset);
+        offset = align16(offset + count * dtype.bytes());
+    }
+
+    let mut out = Vec::with_capacity(offset);
+    let put = |out: &mut Vec<u8>, v: u32| out.extend_from_slice(&v.to_le_bytes());
+    out.extend_from_slice(MAGIC);
+    put(&mut out, VERSION);
+    put(&mut out, header_size as u32);
+    put(&mut out, axes.len() as u32);
+    put(&mut out, names.len() as u32);
+    put(&mut out, shape[0] as u32);
+    put(&mut out, shape.get(1).copied().unwrap_or(1) as u32);
+    for k in 0..2 {
+        for word in axis_descriptor(axes.get(k)) {
+            put(&mut out, word);
+        }
+    }
+    for ((name, dtype), &plane) in names.iter().zip(dtypes).zip(&offsets) {
+        let mut field = [0u8; NAME_BYTES];
+        field[..name.len()].copy_from_slice(name.as_bytes());
+        out.extend_from_slice(&field);
+        put(&mut out, dtype.code());
+        put(&mut out, plane as u32);
+    }
+    for (values, dtype) in table.channels().into_iter().zip(dtypes) {
+        out.resize(align16(out.len()), 0);
+        for &v in values {
+            match dtype {
+                Precision::F32 => out.extend_from_slice(&(v as f32).to_le_bytes()),
+                Precision::F16 => {
+                    out.extend_from_slice(&half::f16::from_f32(v as f32).to_le_bytes());
+                }
+            }
+        }
+    }
+    out.resize(align16(out.len()), 0);
+    out
+}
+
+/// A decoded binary table: its shape, axis descriptors and channels widened to f64.
+#[derive(Debug, PartialEq)]
+pub struct BinaryContents {
+    pub shape: Vec<usize>,
+    /// The raw axis descriptors (see the module docs), one per axis.
+    pub axes: Vec<[u32; 4]>,
+    pub channels: Vec<(String, Vec<f64>)>,
+}
+
+/// Decodes kiln's binary format, checking every size against the bytes present.
+pub fn decode(bytes: &[u8]) -> std::result::Result<BinaryContents, String> {
+    let word = |offset: usize| -> std::result::Result<u32, String> {
+        bytes
+            .get(offset..offset + 4)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .ok_or_else(|| format!("file ends inside the header (at byte {offset})"))
+    };
+    if bytes.len() < FIXED_HEADER || &bytes[..8] != MAGIC {
+        return Err("not a kiln binary table (bad magic)".into());
+    }
+    let version = word(8)?;
+    if version != VERSION {
+        return Err(format!(
+            "unsupported kiln binary version {version} (this kiln reads {VERSION})"
+        ));
+    }
+    let rank = word(16)? as usize;
+    let channel_count = word(20)? as usize;
+    if !(1..=2).contains(&rank) || channel_count == 0 || channel_count > 64 {
+        return Err(format!("bad header: rank {rank}, {channel_count} channels"));
+    }
+    let shape: Vec<usize> = (0..rank)
+        .map(|k| word(24 + 4 * k).map(|v| v as usize))
+        .collect::<std::result::Result<_, _>>()?;
+    let count: usize = shape.iter().product();
+    let mut axes = Vec::with_capacity(rank);
+    for k in 0..rank {
+        let base = 32 + 16 * k;
+        axes.push([
+            word(base)?,
+            word(base + 4)?,
+            word(base + 8)?,
+            word(base + 12)?,
+        ]);
+    }
+    let mut channels = Vec::with_capacity(channel_count);
+    for c in 0..channel_count {
+        let entry = FIXED_HEADER + CHANNEL_ENTRY * c;
+        let name_bytes = bytes
+            .get(entry..entry + NAME_BYTES)
+            .ok_or("file ends inside the channel list")?;
+        let name_len = name_bytes
+            .iter()
+            .position(|&b| b == 0)
+            .unwrap_or(NAME_BYTES);
+        let name = String::from_utf8_lossy(&name_bytes[..name_len]).into_owned();
+        let dtype = Precision::from_code(word(entry + NAME_BYTES)?)
+            .ok_or_else(|| format!("channel {name}: unknown dtype"))?;
+        let plane = word(entry + NAME_BYTES + 4)? as usize;
+        let data = bytes
+            .get(plane..plane + count * dtype.bytes())
+            .ok_or_else(|| format!("channel {name}: file too short for {count} values"))?;
+        let values = match dtype {
+            Precision::F32 => data
+                .chunks_exact(4)
+                .map(|b| f64::from(f32::from_le_bytes([b[0], b[1], b[2], b[3]])))
+                .collect(),
+            Precision::F16 => data
+                .chunks_exact(2)
+                .map(|b| f64::from(half::f16::from_le_bytes([b[0], b[1]]).to_f32()))
+                .collect(),
+        };
+        channels.push((name, values));
+    }
+    Ok(BinaryContents {
+        shape,
+        axes,
+        channels,
+    })
+}

@@ -1,0 +1,117 @@
+//! OpenEXR output: one layer with channels `E`, `one_minus_E` (f32 or f16) and `std_error` (always
+//! f32: half floats cannot hold errors of 1e-7), the metadata as a JSON text attribute `kiln`.
+//!
+//! Encoding is chosen for byte-reproducible files: ZIP-compressed scan lines in increasing order,
+//! written without parallel compression (the `exr` crate's default tiled RLE with parallel
+//! compression gives different bytes on each run), and a single custom attribute (the crate keeps
+//! custom attributes in a `HashMap`, whose iteration order changes from run to run). f64 values
+//! reach f16 through f32 (`half`'s direct f64 path differs between CPUs).
+
+use super::Precision;
+use super::metadata::{KILN_VERSION, Metadata};
+use crate::table::Table;
+use exr::prelude::*;
+use std::io::Cursor;
+
+/// The name of the header attribute holding the metadata JSON.
+pub const METADATA_ATTRIBUTE: &str = "kiln";
+
+/// Encodes a table as an EXR file in memory. A 2-D table is `mu` wide and `roughness` high; a
+/// 1-D table is one row.
+pub fn encode(table: &Table, precision: Precision) -> std::result::Result<Vec<u8>, String> {
+    let shape = table.spec.shape();
+    let (width, height) = match shape[..] {
+        [rows, columns] => (columns, rows),
+        [n] => (n, 1),
+        _ => {
+            return Err(format!(
+                "cannot store a table of shape {shape:?} as an image"
+            ));
+        }
+    };
+    let names = table.channel_names();
+    let channels = table.channels();
+    let samples = |values: &[f64], precision: Precision| match precision {
+        Precision::F32 => FlatSamples::F32(values.iter().map(|&v| v as f32).collect()),
+        Precision::F16 => {
+            FlatSamples::F16(values.iter().map(|&v| f16::from_f32(v as f32)).collect())
+        }
+    };
+    let list = SmallVec::from_vec(vec![
+        AnyChannel::new(names[0].as_str(), samples(channels[0], precision)),
+        AnyChannel::new(names[1].as_str(), samples(channels[1], precision)),
+        AnyChannel::new(names[2].as_str(), samples(channels[2], Precision::F32)),
+    ]);
+    let metadata = serde_json::to_string(&Metadata::new(table, precision.name()))
+        .map_err(|e| e.to_string())?;
+    let mut attributes = LayerAttributes::named(table.spec.id().as_str());
+    attributes.software_name = Some(Text::from(format!("kiln {KILN_VERSION}").as_str()));
+    attributes.other.insert(
+        Text::from(METADATA_ATTRIBUTE),
+        AttributeValue::Text(Text::new_or_none(metadata.as_str()).ok_or("metadata is not ASCII")?),
+    );
+    let encoding = Encoding {
+        compression: Compression::ZIP16,
+        blocks: Blocks::ScanLines,
+        line_order: LineOrder::Increasing,
+    };
+    let layer = Layer::new(
+        (width, height),
+        attributes,
+        encoding,
+        AnyChannels::sort(list),
+    );
+    let mut bytes = Vec::new();
+    Image::from_layer(layer)
+        .write()
+        .non_parallel()
+        .to_buffered(Cursor::new(&mut bytes))
+        .map_err(|e| e.to_string())?;
+    Ok(bytes)
+}
+
+/// A table's channels as read back from an EXR file: name, values (widened to f64), width, height,
+/// and the metadata JSON if present.
+#[derive(Debug)]
+pub struct ExrContents {
+    pub width: usize,
+    pub height: usize,
+    pub channels: Vec<(String, Vec<f64>)>,
+    pub metadata: Option<String>,
+}
+
+/// Reads the first layer of an EXR file from memory.
+pub fn decode(bytes: &[u8]) -> std::result::Result<ExrContents, String> {
+    let image = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .from_buffered(Cursor::new(bytes))
+        .map_err(|e| e.to_string())?;
+    let layer = image.layer_data;
+    let metadata = layer
+        .attributes
+        .other
+        .get(&Text::from(METADATA_ATTRIBUTE))
+        .and_then(|v| match v {
+            AttributeValue::Text(text) => Some(text.to_string()),
+            _ => None,
+        });
+    let channels = layer
+        .channel_data
+        .list
+        .iter()
+        .map(|c| {
+            let values = c.sample_data.values_as_f32().map(f64::from).collect();
+            (c.name.to_string(), values)
+        })
+        .collect();
+    Ok(ExrContents {
+        width: layer.size.0,
+        height: layer.size.1,
+        channels,
+        metadata,
+    })
+}

@@ -1,0 +1,119 @@
+//! The description every output carries: model, axes, grid, samples, errors, provenance.
+
+use crate::table::Table;
+use crate::table::axis::{Axis, Grid};
+use serde::{Deserialize, Serialize};
+
+/// kiln's version, recorded in every table.
+pub const KILN_VERSION: &str = env!("CARGO_PKG_VERSION");
+
+/// What one axis is, in words and numbers.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AxisMetadata {
+    /// `mu`, `r` or `alpha`.
+    pub name: String,
+    pub size: usize,
+    /// `centers` or `nodes`.
+    pub grid: Grid,
+    /// `linear` or `sqrt` for `mu`; `r` (alpha = r^2) or `alpha` for roughness.
+    pub mapping: String,
+    /// Index to value, e.g. `t_i = (i + 0.5) / N, mu = t`.
+    pub formula: String,
+    /// The coordinate of every sample, in the axis' own unit (`mu`, `r` or `alpha`).
+    pub values: Vec<f64>,
+}
+
+impl AxisMetadata {
+    #[must_use]
+    pub fn new(axis: &Axis) -> Self {
+        let mapping = match *axis {
+            Axis::Mu { mapping, .. } => mapping.name().to_string(),
+            Axis::Roughness { convention, .. } => convention.describe().to_string(),
+        };
+        Self {
+            name: axis.name().to_string(),
+            size: axis.size(),
+            grid: axis.grid(),
+            mapping,
+            formula: axis.formula(),
+            values: axis.values(),
+        }
+    }
+}
+
+/// A table's metadata, as stored in the JSON sidecar, the EXR header and generated sources.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Metadata {
+    pub kiln_version: String,
+    /// `E` or `E_avg`.
+    pub quantity: String,
+    pub description: String,
+    /// `ggx` or `beckmann`.
+    pub ndf: String,
+    /// `height-correlated` or `separable`.
+    pub masking: String,
+    pub fresnel: String,
+    /// `r` (perceptual, alpha = r^2) or `alpha`.
+    pub roughness_convention: String,
+    /// The shape, slowest-varying axis first.
+    pub shape: Vec<usize>,
+    /// How the flat data is laid out.
+    pub layout: String,
+    /// The axes, slowest-varying first.
+    pub axes: Vec<AxisMetadata>,
+    /// The channels, in storage order.
+    pub channels: Vec<String>,
+    /// How the values were computed.
+    pub estimator: String,
+    pub samples_per_texel: u64,
+    pub scrambles: u32,
+    pub seed: u64,
+    /// The largest per-texel standard error (the table's measured error).
+    pub max_std_error: f64,
+    pub rms_std_error: f64,
+    /// `f32` or `f16`: how the value channels are stored in the binary formats.
+    pub precision: String,
+    /// The command that reproduces the values.
+    pub command: String,
+}
+
+impl Metadata {
+    #[must_use]
+    pub fn new(table: &Table, precision: &str) -> Self {
+        let spec = &table.spec;
+        let axes: Vec<AxisMetadata> = spec.axes().iter().map(AxisMetadata::new).collect();
+        let layout = match spec.mu {
+            Some(_) => format!(
+                "row-major, slowest axis first: value[{r}_index * {n} + mu_index]; as an image, \
+                 x (columns) = mu, y (rows, top to bottom) = {r}",
+                r = axes[0].name,
+                n = axes[1].size
+            ),
+            None => format!("value[{}_index]", axes[0].name),
+        };
+        Self {
+            kiln_version: KILN_VERSION.to_string(),
+            quantity: spec.quantity.symbol().to_string(),
+            description: spec.quantity.describe().to_string(),
+            ndf: spec.model.ndf.name().to_string(),
+            masking: spec.model.masking.name().to_string(),
+            fresnel: "none (F = 1)".to_string(),
+            roughness_convention: spec.roughness_convention().name().to_string(),
+            shape: spec.shape(),
+            layout,
+            axes,
+            channels: table.channel_names().to_vec(),
+            estimator: "quasi-Monte Carlo: visible-normal (VNDF) importance sampling driven by \
+                        Owen-scrambled Sobol points (Burley 2020); std_error from independent \
+                        scrambles"
+                .to_string(),
+            samples_per_texel: spec.qmc.samples,
+            scrambles: spec.qmc.scrambles,
+            seed: spec.qmc.seed,
+            max_std_error: table.max_std_error(),
+            rms_std_error: table.rms_std_error(),
+            precision: precision.to_string(),
+            command: table.command.clone(),
+        }
+    }
+}

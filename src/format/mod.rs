@@ -1,0 +1,208 @@
+//! Output formats, and writing them without ever leaving a partial file.
+//!
+//! Every file is encoded in memory first; then each is written to a temporary file in the output
+//! directory and renamed into place only after all of them were written. A failure part-way
+//! removes the temporaries; a reader never sees a half-written table.
+
+pub mod binary;
+pub mod exr;
+pub mod json;
+pub mod metadata;
+pub mod png;
+pub mod rust;
+
+use crate::error::{Error, Result};
+use crate::table::Table;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// An output format.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Format {
+    /// OpenEXR, channels `E`, `one_minus_E`, `std_error`, metadata in the header.
+    Exr,
+    /// kiln's raw binary format ([`binary`]).
+    Bin,
+    /// Rust source with `pub const` arrays.
+    Rs,
+    /// JSON sidecar with metadata and f64 values.
+    Json,
+    /// PNG heat map (2-D tables only).
+    Png,
+}
+
+impl Format {
+    /// Every format, in the order they are written.
+    pub const ALL: [Format; 5] = [
+        Format::Exr,
+        Format::Bin,
+        Format::Rs,
+        Format::Json,
+        Format::Png,
+    ];
+
+    /// The name on the command line, which is also the file extension.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Format::Exr => "exr",
+            Format::Bin => "bin",
+            Format::Rs => "rs",
+            Format::Json => "json",
+            Format::Png => "png",
+        }
+    }
+}
+
+/// How the value channels are stored in EXR and binary files.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Precision {
+    F32,
+    /// Half floats. Store and use `one_minus_E` near `E = 1`: f16 spacing below 1 is 2^-11.
+    F16,
+}
+
+impl Precision {
+    /// `f32` or `f16`.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Precision::F32 => "f32",
+            Precision::F16 => "f16",
+        }
+    }
+
+    /// Bytes per value.
+    #[must_use]
+    pub fn bytes(self) -> usize {
+        match self {
+            Precision::F32 => 4,
+            Precision::F16 => 2,
+        }
+    }
+
+    /// The binary format's dtype code.
+    #[must_use]
+    pub fn code(self) -> u32 {
+        match self {
+            Precision::F32 => 1,
+            Precision::F16 => 2,
+        }
+    }
+
+    /// The precision of a binary dtype code.
+    #[must_use]
+    pub fn from_code(code: u32) -> Option<Self> {
+        match code {
+            1 => Some(Precision::F32),
+            2 => Some(Precision::F16),
+            _ => None,
+        }
+    }
+}
+
+/// Encodes each table in each format: `(file name, bytes)` pairs, file names from
+/// [`crate::table::TableSpec::id`] and the format's extension. PNG is skipped for 1-D tables.
+pub fn encode_all(
+    tables: &[Table],
+    formats: &[Format],
+    precision: Precision,
+) -> Result<Vec<(String, Vec<u8>)>> {
+    let mut files = Vec::new();
+    for table in tables {
+        let id = table.spec.id();
+        let fail = |format: Format, message: String| Error::Format {
+            path: PathBuf::from(format!("{id}.{}", format.name())),
+            message,
+        };
+        let mut written = BTreeMap::new();
+        for &format in formats {
+            let bytes = match format {
+                Format::Exr => exr::encode(table, precision).map_err(|m| fail(format, m))?,
+                Format::Bin => binary::encode(table, precision),
+                Format::Rs => rust::encode(table).into_bytes(),
+                Format::Png => match png::encode(table) {
+                    None => continue,
+                    Some(result) => result.map_err(|m| fail(format, m))?,
+                },
+                Format::Json => continue, // last, once the others are known
+            };
+            let name = format!("{id}.{}", format.name());
+            written.insert(format.name().to_string(), name.clone());
+            files.push((name, bytes));
+        }
+        if formats.contains(&Format::Json) {
+            let sidecar = json::sidecar(table, precision.name(), written);
+            let bytes = json::encode(&sidecar).map_err(|m| fail(Format::Json, m))?;
+            files.push((format!("{id}.json"), bytes));
+        }
+    }
+    Ok(files)
+}
+
+/// Checks that `dir` exists or can be created, and that kiln can create files in it: called
+/// before long work so that a bad `--out` fails at once, not after the bake.
+pub fn check_output_dir(dir: &Path) -> Result<()> {
+    std::fs::create_dir_all(dir).map_err(|source| Error::Io {
+        path: dir.to_path_buf(),
+        action: "create the output directory",
+        source,
+    })?;
+    tempfile::Builder::new()
+        .prefix(".kiln-probe-")
+        .tempfile_in(dir)
+        .map(drop)
+        .map_err(|source| Error::Io {
+            path: dir.to_path_buf(),
+            action: "write to the output directory",
+            source,
+        })
+}
+
+/// Writes `(file name, bytes)` pairs into `dir` all-or-nothing (as far as a file system allows):
+/// each goes to a temporary file first; only when all were written are they renamed into place.
+pub fn write_files(dir: &Path, files: &[(String, Vec<u8>)]) -> Result<Vec<PathBuf>> {
+    check_output_dir(dir)?;
+    let mut staged = Vec::with_capacity(files.len());
+    for (name, bytes) in files {
+        let path = dir.join(name);
+        let io = |action, source| Error::Io {
+            path: path.clone(),
+            action,
+            source,
+        };
+        let mut temp = tempfile::Builder::new()
+            .prefix(&format!(".{name}."))
+            .suffix(".tmp")
+            .tempfile_in(dir)
+            .map_err(|e| io("create a temporary file for", e))?;
+        temp.write_all(bytes).map_err(|e| io("write", e))?;
+        temp.as_file().sync_all().map_err(|e| io("flush", e))?;
+        staged.push((temp, path));
+    }
+    let mut paths = Vec::with_capacity(staged.len());
+    for (temp, path) in staged {
+        temp.persist(&path).map_err(|e| Error::Io {
+            path: path.clone(),
+            action: "rename into place",
+            source: e.error,
+        })?;
+        paths.push(path);
+    }
+    Ok(paths)
+}
+
+/// Encodes and writes tables: [`encode_all`] then [`write_files`].
+pub fn write_tables(
+    dir: &Path,
+    tables: &[Table],
+    formats: &[Format],
+    precision: Precision,
+) -> Result<Vec<PathBuf>> {
+    let files = encode_all(tables, formats, precision)?;
+    write_files(dir, &files)
+}

@@ -1,0 +1,67 @@
+//! PNG heat map of a 2-D table, for a person to look at: each texel drawn as a square of
+//! [`SCALE`] pixels in the viridis colour map, stretched between the table's minimum and maximum.
+//! Rows are roughness (top: smallest), columns `mu` (left: smallest), as in the EXR.
+
+use crate::table::Table;
+
+/// Pixels per texel side.
+pub const SCALE: usize = 8;
+
+/// Viridis (van der Walt and Smith, matplotlib), sampled at 0, 1/8, ..., 1 and interpolated.
+const VIRIDIS: [[f64; 3]; 9] = [
+    [68.0, 1.0, 84.0],
+    [71.0, 44.0, 122.0],
+    [59.0, 81.0, 139.0],
+    [44.0, 113.0, 142.0],
+    [33.0, 144.0, 141.0],
+    [39.0, 173.0, 129.0],
+    [92.0, 200.0, 99.0],
+    [170.0, 220.0, 50.0],
+    [253.0, 231.0, 37.0],
+];
+
+fn colour(t: f64) -> [u8; 3] {
+    let x = t.clamp(0.0, 1.0) * 8.0;
+    let i = (x.floor() as usize).min(7);
+    let f = x - i as f64;
+    std::array::from_fn(|c| (VIRIDIS[i][c] * (1.0 - f) + VIRIDIS[i + 1][c] * f).round() as u8)
+}
+
+/// Encodes the table's value channel as a heat map; `None` for a 1-D table.
+pub fn encode(table: &Table) -> Option<std::result::Result<Vec<u8>, String>> {
+    let [rows, columns] = table.spec.shape()[..] else {
+        return None;
+    };
+    let (lo, hi) = table
+        .value
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+            (lo.min(v), hi.max(v))
+        });
+    let span = if hi > lo { hi - lo } else { 1.0 };
+    let (width, height) = (columns * SCALE, rows * SCALE);
+    let mut pixels = Vec::with_capacity(width * height * 3);
+    for y in 0..height {
+        for x in 0..width {
+            let v = table.value[(y / SCALE) * columns + x / SCALE];
+            pixels.extend_from_slice(&colour((v - lo) / span));
+        }
+    }
+    let mut bytes = Vec::new();
+    let result = (|| {
+        let mut encoder = png::Encoder::new(&mut bytes, width as u32, height as u32);
+        encoder.set_color(png::ColorType::Rgb);
+        encoder.set_depth(png::BitDepth::Eight);
+        encoder.add_text_chunk(
+            "Description".into(),
+            format!(
+                "{} heat map, {lo:.6} (dark) to {hi:.6} (bright)",
+                table.spec.id()
+            ),
+        )?;
+        let mut writer = encoder.write_header()?;
+        writer.write_image_data(&pixels)?;
+        writer.finish()
+    })();
+    Some(result.map(|()| bytes).map_err(|e| e.to_string()))
+}

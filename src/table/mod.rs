@@ -1,0 +1,194 @@
+//! Tables: what was computed (the spec), the values with their errors, and how to look them up.
+
+pub mod axis;
+
+use crate::integrate::QmcSettings;
+use crate::model::{Model, RoughnessConvention};
+use axis::Axis;
+use serde::{Deserialize, Serialize};
+
+/// What a table holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum Quantity {
+    /// Directional albedo `E(mu, roughness)` for F = 1, a 2-D table.
+    #[serde(rename = "E")]
+    E,
+    /// Its cosine-weighted average `E_avg(roughness) = 2 ∫ E(mu) mu dmu`, a 1-D table.
+    #[serde(rename = "E_avg")]
+    EAvg,
+}
+
+impl Quantity {
+    /// The symbol used in channel and file names: `E` or `E_avg`.
+    #[must_use]
+    pub fn symbol(self) -> &'static str {
+        match self {
+            Quantity::E => "E",
+            Quantity::EAvg => "E_avg",
+        }
+    }
+
+    /// The name used on the command line: `e` or `e-avg`.
+    #[must_use]
+    pub fn cli_name(self) -> &'static str {
+        match self {
+            Quantity::E => "e",
+            Quantity::EAvg => "e-avg",
+        }
+    }
+
+    /// A sentence for metadata and generated docs (ASCII: EXR text attributes are Latin-1).
+    #[must_use]
+    pub fn describe(self) -> &'static str {
+        match self {
+            Quantity::E => {
+                "directional albedo E(mu) = integral of f(o, i) mu_i over incoming directions i, F = 1"
+            }
+            Quantity::EAvg => {
+                "average albedo E_avg = 2 * integral of E(mu) mu dmu over [0, 1], F = 1"
+            }
+        }
+    }
+}
+
+/// Everything that determines a table's values.
+#[derive(Clone, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub struct TableSpec {
+    pub model: Model,
+    pub quantity: Quantity,
+    /// The roughness axis (rows of a 2-D table; the only axis of a 1-D table).
+    pub roughness: Axis,
+    /// The `mu` axis (columns, the fastest-varying index) of a 2-D table; `None` for `E_avg`.
+    pub mu: Option<Axis>,
+    /// Sample count, scrambles and seed of each texel's QMC estimate.
+    pub qmc: QmcSettings,
+}
+
+impl TableSpec {
+    /// The axes, slowest-varying first: `[roughness, mu]` or `[roughness]`.
+    #[must_use]
+    pub fn axes(&self) -> Vec<Axis> {
+        std::iter::once(self.roughness).chain(self.mu).collect()
+    }
+
+    /// The shape, slowest-varying first.
+    #[must_use]
+    pub fn shape(&self) -> Vec<usize> {
+        self.axes().iter().map(Axis::size).collect()
+    }
+
+    /// The number of texels.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.shape().iter().product()
+    }
+
+    /// Whether the table has no texels (never, for a validated spec).
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The roughness convention of the roughness axis.
+    #[must_use]
+    pub fn roughness_convention(&self) -> RoughnessConvention {
+        match self.roughness {
+            Axis::Roughness { convention, .. } => convention,
+            Axis::Mu { .. } => unreachable!("the roughness axis is a roughness axis"),
+        }
+    }
+
+    /// A file-name stem naming the table: `ggx-height-correlated-E`.
+    #[must_use]
+    pub fn id(&self) -> String {
+        format!(
+            "{}-{}-{}",
+            self.model.ndf,
+            self.model.masking,
+            self.quantity.symbol()
+        )
+    }
+
+    /// The `(alpha, mu)` at which texel `index` (row-major, slowest axis first) is computed;
+    /// `mu` is `None` for `E_avg`.
+    #[must_use]
+    pub fn texel_coordinates(&self, index: usize) -> (f64, Option<f64>) {
+        match self.mu {
+            Some(mu) => {
+                let n = mu.size();
+                (self.roughness.alpha(index / n), Some(mu.value(index % n)))
+            }
+            None => (self.roughness.alpha(index), None),
+        }
+    }
+}
+
+/// A baked table: its spec, per-texel values and standard errors, and where it came from.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Table {
+    pub spec: TableSpec,
+    /// The quantity's value per texel, row-major with the slowest axis first.
+    pub value: Vec<f64>,
+    /// One minus the value, estimated directly (keeps relative precision near 1).
+    pub one_minus_value: Vec<f64>,
+    /// The standard error of each texel's estimate.
+    pub std_error: Vec<f64>,
+    /// The command that reproduces this table.
+    pub command: String,
+}
+
+impl Table {
+    /// The largest per-texel standard error.
+    #[must_use]
+    pub fn max_std_error(&self) -> f64 {
+        self.std_error.iter().copied().fold(0.0, f64::max)
+    }
+
+    /// The root-mean-square per-texel standard error.
+    #[must_use]
+    pub fn rms_std_error(&self) -> f64 {
+        (self.std_error.iter().map(|e| e * e).sum::<f64>() / self.std_error.len() as f64).sqrt()
+    }
+
+    /// Channel names, in storage order: `E`, `one_minus_E`, `std_error` (or the `E_avg` forms).
+    #[must_use]
+    pub fn channel_names(&self) -> [String; 3] {
+        let q = self.spec.quantity.symbol();
+        [
+            q.to_string(),
+            format!("one_minus_{q}"),
+            "std_error".to_string(),
+        ]
+    }
+
+    /// The channels in storage order, matching [`Table::channel_names`].
+    #[must_use]
+    pub fn channels(&self) -> [&[f64]; 3] {
+        [&self.value, &self.one_minus_value, &self.std_error]
+    }
+
+    /// The value a renderer's bilinear lookup returns at `(mu, roughness)` (roughness in the
+    /// table's convention; `mu` is ignored for a 1-D table), with clamp-to-edge.
+    #[must_use]
+    pub fn lookup(&self, mu: f64, roughness: f64) -> f64 {
+        let lerp_axis = |axis: &Axis, x: f64| {
+            let p = axis.position(x);
+            let i = (p.floor() as usize).min(axis.size().saturating_sub(2));
+            (i, p - i as f64)
+        };
+        let (ri, rf) = lerp_axis(&self.spec.roughness, roughness);
+        let r1 = (ri + 1).min(self.spec.roughness.size() - 1);
+        match self.spec.mu {
+            None => self.value[ri] * (1.0 - rf) + self.value[r1] * rf,
+            Some(mu_axis) => {
+                let n = mu_axis.size();
+                let (mi, mf) = lerp_axis(&mu_axis, mu);
+                let m1 = (mi + 1).min(n - 1);
+                let at = |r: usize, m: usize| self.value[r * n + m];
+                let row0 = at(ri, mi) * (1.0 - mf) + at(ri, m1) * mf;
+                let row1 = at(r1, mi) * (1.0 - mf) + at(r1, m1) * mf;
+                row0 * (1.0 - rf) + row1 * rf
+            }
+        }
+    }
+}
