@@ -9,7 +9,10 @@ use std::hint::black_box;
 
 fn estimators(c: &mut Criterion) {
     let samples = 1u64 << 16;
-    let settings = QmcSettings { samples, ..QmcSettings::default() };
+    let settings = QmcSettings {
+        samples,
+        ..QmcSettings::default()
+    };
     let mut group = c.benchmark_group("vndf");
     group.throughput(Throughput::Elements(samples));
     for ndf in Ndf::ALL {

@@ -31,6 +31,23 @@ const JOE_KUO: [(u32, u32, [u32; 4]); DIMENSIONS - 1] = [
 /// `DIRECTIONS[d][k]` is the direction number XORed in when bit `k` of the index is set.
 pub const DIRECTIONS: [[u32; 32]; DIMENSIONS] = directions();
 
+/// [`DIRECTIONS`] with each number's bits reversed: XORing these yields the bit-reversed Sobol
+/// coordinate, which is the form Burley's hash scrambles, saving one reversal per coordinate.
+pub const DIRECTIONS_REVERSED: [[u32; 32]; DIMENSIONS] = reversed(directions());
+
+const fn reversed(mut table: [[u32; 32]; DIMENSIONS]) -> [[u32; 32]; DIMENSIONS] {
+    let mut d = 0;
+    while d < DIMENSIONS {
+        let mut k = 0;
+        while k < 32 {
+            table[d][k] = table[d][k].reverse_bits();
+            k += 1;
+        }
+        d += 1;
+    }
+    table
+}
+
 const fn directions() -> [[u32; 32]; DIMENSIONS] {
     let mut out = [[0u32; 32]; DIMENSIONS];
     let mut k = 0;
@@ -88,7 +105,15 @@ pub fn sobol(index: u32, dim: usize) -> u32 {
 #[inline]
 #[must_use]
 pub fn nested_uniform_scramble(x: u32, seed: u32) -> u32 {
-    let mut v = x.reverse_bits();
+    scramble_reversed(x.reverse_bits(), seed)
+}
+
+/// [`nested_uniform_scramble`] of the fraction whose bit-reversal is `reversed`: the Laine-Karras
+/// style hash, in which each bit depends only on the bits below it, then the reversal back.
+#[inline(always)]
+#[must_use]
+pub fn scramble_reversed(reversed: u32, seed: u32) -> u32 {
+    let mut v = reversed;
     v ^= v.wrapping_mul(0x3d20_adea);
     v = v.wrapping_add(seed);
     v = v.wrapping_mul((seed >> 16) | 1);
@@ -172,6 +197,13 @@ impl OwenSobol {
         nested_uniform_scramble(raw, self.dim_seeds[dim])
     }
 
+    /// Scrambles a bit-reversed Sobol coordinate (as [`SobolBlock::fill_reversed`] yields).
+    #[inline(always)]
+    #[must_use]
+    pub fn scramble_reversed(&self, reversed: u32, dim: usize) -> u32 {
+        scramble_reversed(reversed, self.dim_seeds[dim])
+    }
+
     /// Turns a scrambled coordinate of dimension `dim` into an f64 (see [`to_unit_f64`]).
     #[inline]
     #[must_use]
@@ -192,6 +224,7 @@ impl OwenSobol {
         let base = nested_uniform_scramble(0, self.shuffle_seed) & !low_mask;
         SobolBlock {
             current: std::array::from_fn(|d| sobol(base, d)),
+            current_reversed: std::array::from_fn(|d| sobol(base, d).reverse_bits()),
             next: 0,
             count: 1u64 << log2_n,
         }
@@ -202,6 +235,7 @@ impl OwenSobol {
 #[derive(Clone, Debug)]
 pub struct SobolBlock<const D: usize> {
     current: [u32; D],
+    current_reversed: [u32; D],
     next: u64,
     count: u64,
 }
@@ -227,6 +261,26 @@ impl<const D: usize> SobolBlock<D> {
             }
             for d in 0..D {
                 out[d][k] = self.current[d];
+            }
+            self.next += 1;
+        }
+    }
+
+    /// As [`SobolBlock::fill`], but writes each coordinate bit-reversed (for
+    /// [`OwenSobol::scramble_reversed`]). Use one of `fill`, `fill_reversed` or the iterator
+    /// per block, not a mix.
+    pub fn fill_reversed(&mut self, out: &mut [&mut [u32]; D]) {
+        let n = out[0].len();
+        assert!(n as u64 <= self.remaining());
+        for k in 0..n {
+            if self.next != 0 {
+                let bit = self.next.trailing_zeros() as usize;
+                for d in 0..D {
+                    self.current_reversed[d] ^= DIRECTIONS_REVERSED[d][bit];
+                }
+            }
+            for d in 0..D {
+                out[d][k] = self.current_reversed[d];
             }
             self.next += 1;
         }
@@ -335,6 +389,16 @@ mod tests {
                 .collect();
             filled.sort_unstable();
             assert_eq!(filled, block);
+            // And so does the bit-reversed form.
+            {
+                let [b0, b1, b2] = &mut bufs;
+                seq.block::<3>(m).fill_reversed(&mut [b0, b1, b2]);
+            }
+            let mut reversed: Vec<[u32; 3]> = (0..1usize << m)
+                .map(|k| std::array::from_fn(|d| seq.scramble_reversed(bufs[d][k], d)))
+                .collect();
+            reversed.sort_unstable();
+            assert_eq!(reversed, block);
         }
     }
 
