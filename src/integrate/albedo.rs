@@ -30,9 +30,9 @@ pub struct QmcSettings {
 }
 
 impl QmcSettings {
-    /// 2^18 evaluations in 8 scrambles: a standard error of about 1e-6 or better at mid-range
-    /// points of `E` (see the README for measured figures).
-    pub const DEFAULT_SAMPLES: u64 = 1 << 18;
+    /// 2^19 evaluations in 8 scrambles: a standard error below 1e-6 at mid-range points of GGX
+    /// `E` (measured: at most 3.4e-7 for mu and alpha in {0.3, 0.5, 0.7}; 2^18 gives up to 1.1e-6).
+    pub const DEFAULT_SAMPLES: u64 = 1 << 19;
     /// Eight scrambles: the standard error then has 7 degrees of freedom.
     pub const DEFAULT_SCRAMBLES: u32 = 8;
 
