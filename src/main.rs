@@ -68,16 +68,16 @@ struct BakeArgs {
     )]
     masking: Vec<MaskingArg>,
     /// Samples per axis: E is SIZE x SIZE, E_avg has SIZE entries. 2 to 4096.
-    #[arg(long, default_value_t = BakeOptions::DEFAULT_SIZE, value_parser = parse_size)]
+    #[arg(long, default_value_t = BakeOptions::DEFAULT_SIZE, value_parser = parse_size, allow_negative_numbers = true)]
     size: usize,
     /// QMC samples per E texel, a power of two (split over the scrambles).
-    #[arg(long, default_value_t = QmcSettings::DEFAULT_SAMPLES, value_parser = parse_samples)]
+    #[arg(long, default_value_t = QmcSettings::DEFAULT_SAMPLES, value_parser = parse_samples, allow_negative_numbers = true)]
     samples: u64,
     /// QMC samples per E_avg entry, a power of two [default: 16 x --samples].
-    #[arg(long, value_parser = parse_samples)]
+    #[arg(long, value_parser = parse_samples, allow_negative_numbers = true)]
     avg_samples: Option<u64>,
     /// Independent scrambles per estimate, for the standard error: a power of two, 2 to 1024.
-    #[arg(long, default_value_t = QmcSettings::DEFAULT_SCRAMBLES)]
+    #[arg(long, default_value_t = QmcSettings::DEFAULT_SCRAMBLES, allow_negative_numbers = true)]
     scrambles: u32,
     /// Base seed of the scrambles.
     #[arg(long, default_value_t = 0)]
@@ -125,22 +125,22 @@ struct EvalArgs {
     #[arg(long, value_enum, default_value = "height-correlated")]
     masking: MaskingArg,
     /// Slope-space roughness alpha, >= 0 (give this or --roughness).
-    #[arg(long, value_parser = parse_roughness, required_unless_present = "roughness", conflicts_with = "roughness")]
+    #[arg(long, value_parser = parse_roughness, required_unless_present = "roughness", conflicts_with = "roughness", allow_negative_numbers = true)]
     alpha: Option<f64>,
     /// Perceptual roughness r >= 0, alpha = r^2 (give this or --alpha).
-    #[arg(long, value_parser = parse_roughness)]
+    #[arg(long, value_parser = parse_roughness, allow_negative_numbers = true)]
     roughness: Option<f64>,
     /// cos(theta) of the view direction, in [0, 1]; required for --quantity e.
-    #[arg(long, value_parser = parse_mu)]
+    #[arg(long, value_parser = parse_mu, allow_negative_numbers = true)]
     mu: Option<f64>,
     /// What to evaluate.
     #[arg(long, value_enum, default_value = "e")]
     quantity: QuantityArg,
     /// QMC samples, a power of two (split over the scrambles).
-    #[arg(long, default_value_t = QmcSettings::DEFAULT_SAMPLES, value_parser = parse_samples)]
+    #[arg(long, default_value_t = QmcSettings::DEFAULT_SAMPLES, value_parser = parse_samples, allow_negative_numbers = true)]
     samples: u64,
     /// Independent scrambles, for the standard error: a power of two, 2 to 1024.
-    #[arg(long, default_value_t = QmcSettings::DEFAULT_SCRAMBLES)]
+    #[arg(long, default_value_t = QmcSettings::DEFAULT_SCRAMBLES, allow_negative_numbers = true)]
     scrambles: u32,
     /// Base seed of the scrambles.
     #[arg(long, default_value_t = 0)]
@@ -248,7 +248,7 @@ fn parse_mu(text: &str) -> Result<f64, String> {
 
 fn parse_roughness(text: &str) -> Result<f64, String> {
     let value = parse_number(text)?;
-    if value >= 0.0 && value <= 1e3 {
+    if (0.0..=1e3).contains(&value) {
         Ok(value)
     } else {
         Err(format!("roughness must be in [0, 1000] (got {text})"))
@@ -275,7 +275,7 @@ fn parse_samples(text: &str) -> Result<u64, String> {
         .trim()
         .parse()
         .map_err(|_| format!("'{text}' is not a whole number"))?;
-    if n >= 2 && n <= 1 << 42 && (n as u64).is_power_of_two() {
+    if (2..=1 << 42).contains(&n) && (n as u64).is_power_of_two() {
         Ok(n as u64)
     } else {
         Err(format!(
@@ -292,13 +292,14 @@ fn main() -> ExitCode {
             if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) {
                 e.exit();
             }
-            // One line: what was wrong, and the allowed values.
+            // One line: what was wrong, and the allowed values (clap's first paragraph, joined).
             let rendered = e.render().to_string();
-            let first = rendered
+            let message: Vec<&str> = rendered
                 .lines()
-                .next()
-                .unwrap_or("error: invalid arguments");
-            eprintln!("kiln: {}", first.trim_start_matches("error: "));
+                .map(str::trim)
+                .take_while(|line| !line.is_empty())
+                .collect();
+            eprintln!("kiln: {}", message.join(" ").trim_start_matches("error: "));
             return ExitCode::from(2);
         }
     };

@@ -181,7 +181,10 @@ fn one_minus_e_keeps_relative_precision_near_a_mirror() {
     // At alpha = 0.01 (r = 0.1), 1 - E_avg is about 5.1e-4 (physics.md); its estimate must be
     // meaningful in relative terms, not a difference of two numbers near 1.
     // At the E_avg sample count `kiln bake` uses by default (16 x the default).
-    let s = QmcSettings { samples: 16 * QmcSettings::DEFAULT_SAMPLES, ..QmcSettings::default() };
+    let s = QmcSettings {
+        samples: 16 * QmcSettings::DEFAULT_SAMPLES,
+        ..QmcSettings::default()
+    };
     let e = average_albedo(model(Ndf::Ggx, HC), 0.01, &s);
     assert!((e.one_minus_value - 5.1e-4).abs() < 0.05e-4, "{e:?}");
     assert!(e.std_error < 0.01 * e.one_minus_value, "{e:?}");

@@ -247,42 +247,50 @@ impl<const D: usize> SobolBlock<D> {
         self.count - self.next
     }
 
-    /// Writes the next `out[0].len()` points' raw coordinates, dimension by dimension.
-    /// Panics if fewer points remain or the slices differ in length.
-    pub fn fill(&mut self, out: &mut [&mut [u32]; D]) {
-        let n = out[0].len();
-        assert!(n as u64 <= self.remaining());
-        for k in 0..n {
-            if self.next != 0 {
-                let bit = self.next.trailing_zeros() as usize;
-                for d in 0..D {
+    /// Moves to the next point (Gray-code order: one direction number XORed in per dimension),
+    /// updating the plain or the bit-reversed coordinates: a block is read one way or the other.
+    #[inline(always)]
+    fn advance<const REVERSED: bool>(&mut self) {
+        if self.next != 0 {
+            let bit = self.next.trailing_zeros() as usize;
+            for d in 0..D {
+                if REVERSED {
+                    self.current_reversed[d] ^= DIRECTIONS_REVERSED[d][bit];
+                } else {
                     self.current[d] ^= DIRECTIONS[d][bit];
                 }
             }
-            for d in 0..D {
-                out[d][k] = self.current[d];
-            }
-            self.next += 1;
         }
+        self.next += 1;
+    }
+
+    /// Writes the next `out[0].len()` points' raw coordinates, dimension by dimension.
+    /// Panics if fewer points remain or the slices differ in length.
+    pub fn fill(&mut self, out: &mut [&mut [u32]; D]) {
+        self.fill_planes::<false>(out);
     }
 
     /// As [`SobolBlock::fill`], but writes each coordinate bit-reversed (for
-    /// [`OwenSobol::scramble_reversed`]). Use one of `fill`, `fill_reversed` or the iterator
-    /// per block, not a mix.
+    /// [`OwenSobol::scramble_reversed`]). Read a block with `fill_reversed` only, or with `fill`
+    /// and the iterator only.
     pub fn fill_reversed(&mut self, out: &mut [&mut [u32]; D]) {
+        self.fill_planes::<true>(out);
+    }
+
+    #[inline(always)]
+    fn fill_planes<const REVERSED: bool>(&mut self, out: &mut [&mut [u32]; D]) {
         let n = out[0].len();
         assert!(n as u64 <= self.remaining());
         for k in 0..n {
-            if self.next != 0 {
-                let bit = self.next.trailing_zeros() as usize;
-                for d in 0..D {
-                    self.current_reversed[d] ^= DIRECTIONS_REVERSED[d][bit];
-                }
+            self.advance::<REVERSED>();
+            let point = if REVERSED {
+                &self.current_reversed
+            } else {
+                &self.current
+            };
+            for (plane, &coordinate) in out.iter_mut().zip(point) {
+                plane[k] = coordinate;
             }
-            for d in 0..D {
-                out[d][k] = self.current_reversed[d];
-            }
-            self.next += 1;
         }
     }
 }
@@ -294,13 +302,7 @@ impl<const D: usize> Iterator for SobolBlock<D> {
         if self.next == self.count {
             return None;
         }
-        if self.next != 0 {
-            let bit = self.next.trailing_zeros() as usize;
-            for d in 0..D {
-                self.current[d] ^= DIRECTIONS[d][bit];
-            }
-        }
-        self.next += 1;
+        self.advance::<false>();
         Some(self.current)
     }
 }

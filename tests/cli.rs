@@ -1,0 +1,399 @@
+//! The `kiln` command: errors for bad input, the eval JSON interface, outputs that round-trip,
+//! and byte-identical results for any thread count.
+
+#![cfg(feature = "cli")]
+
+use kiln::format::{binary, exr, json::Sidecar};
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn kiln(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_kiln"))
+        .args(args)
+        .output()
+        .expect("kiln runs")
+}
+
+fn stderr(output: &Output) -> String {
+    String::from_utf8_lossy(&output.stderr).into_owned()
+}
+
+fn files_in(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .map(|entries| {
+            entries
+                .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+                .collect()
+        })
+        .unwrap_or_default();
+    names.sort();
+    names
+}
+
+/// A small, fast bake into `dir`.
+fn small_bake(dir: &Path, extra: &[&str]) -> Output {
+    let out = dir.to_str().unwrap();
+    let mut args = vec![
+        "bake",
+        "--size",
+        "4",
+        "--samples",
+        "1024",
+        "--avg-samples",
+        "4096",
+        "--out",
+        out,
+    ];
+    args.extend_from_slice(extra);
+    kiln(&args)
+}
+
+#[test]
+fn bad_input_gets_one_line_exit_status_2_and_no_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let out = out.to_str().unwrap();
+    let cases: &[(&[&str], &str)] = &[
+        (&["bake", "--size", "0", "--out", out], "size"),
+        (&["bake", "--size", "-3", "--out", out], "size"),
+        (&["bake", "--size", "nan", "--out", out], "size"),
+        (&["bake", "--samples", "1000", "--out", out], "power of two"),
+        (&["bake", "--samples", "0", "--out", out], "power of two"),
+        (&["bake", "--ndf", "phong", "--out", out], "phong"),
+        (&["bake", "--masking", "v-cavity", "--out", out], "v-cavity"),
+        (&["bake", "--format", "tiff", "--out", out], "tiff"),
+        (&["bake", "--scrambles", "3", "--out", out], "scrambles"),
+        (&["eval", "--alpha", "0.5", "--mu", "1.5"], "[0, 1]"),
+        (&["eval", "--alpha", "0.5", "--mu", "-0.1"], "[0, 1]"),
+        (&["eval", "--alpha", "0.5", "--mu", "nan"], "mu"),
+        (&["eval", "--alpha", "-1", "--mu", "0.5"], "roughness"),
+        (
+            &["eval", "--alpha", "0.5", "--mu", "0.5", "--samples", "-4"],
+            "power of two",
+        ),
+        (&["eval", "--roughness", "inf", "--mu", "0.5"], "finite"),
+        (&["eval", "--alpha", "0.5"], "--mu"),
+        (&["eval", "--mu", "0.5"], "--alpha"),
+        (
+            &[
+                "eval",
+                "--alpha",
+                "0.5",
+                "--roughness",
+                "0.5",
+                "--mu",
+                "0.5",
+            ],
+            "--roughness",
+        ),
+    ];
+    for (args, mentions) in cases {
+        let output = kiln(args);
+        let message = stderr(&output);
+        assert_eq!(output.status.code(), Some(2), "{args:?}: {message}");
+        assert_eq!(
+            message.trim_end().lines().count(),
+            1,
+            "{args:?}: not one line: {message}"
+        );
+        assert!(
+            message.contains(mentions),
+            "{args:?}: '{message}' does not mention {mentions}"
+        );
+        assert!(output.stdout.is_empty(), "{args:?}");
+    }
+    assert!(
+        !Path::new(out).exists(),
+        "a failed run created the output directory"
+    );
+}
+
+#[test]
+fn an_unwritable_output_directory_fails_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    // A regular file where the directory should be.
+    let blocker = dir.path().join("not-a-directory");
+    std::fs::write(&blocker, b"x").unwrap();
+    let output = small_bake(&blocker, &[]);
+    assert_eq!(output.status.code(), Some(2), "{}", stderr(&output));
+    assert!(stderr(&output).contains("not-a-directory"));
+    assert_eq!(std::fs::read(&blocker).unwrap(), b"x");
+    assert_eq!(files_in(dir.path()), ["not-a-directory"]);
+}
+
+#[test]
+fn eval_json_is_one_object_with_the_agreed_fields() {
+    let output = kiln(&[
+        "eval",
+        "--ndf",
+        "ggx",
+        "--alpha",
+        "1",
+        "--mu",
+        "1",
+        "--samples",
+        "65536",
+        "--json",
+    ]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let text = String::from_utf8(output.stdout).unwrap();
+    assert_eq!(text.trim_end().lines().count(), 1);
+    let object: serde_json::Value = serde_json::from_str(&text).unwrap();
+    for field in ["value", "std_error", "method", "samples", "seconds"] {
+        assert!(object.get(field).is_some(), "missing {field} in {text}");
+    }
+    assert_eq!(object["samples"], 65536);
+    let value = object["value"].as_f64().unwrap();
+    let std_error = object["std_error"].as_f64().unwrap();
+    let exact = 1.0 - std::f64::consts::LN_2;
+    assert!(
+        (value - exact).abs() <= 5.0 * std_error,
+        "{value} ± {std_error} vs {exact}"
+    );
+
+    // --roughness is perceptual: r = 0.5 is alpha = 0.25.
+    let by_r = kiln(&[
+        "eval",
+        "--roughness",
+        "0.5",
+        "--mu",
+        "0.3",
+        "--json",
+        "--samples",
+        "1024",
+    ]);
+    let by_alpha = kiln(&[
+        "eval",
+        "--alpha",
+        "0.25",
+        "--mu",
+        "0.3",
+        "--json",
+        "--samples",
+        "1024",
+    ]);
+    let value = |o: &Output| {
+        serde_json::from_slice::<serde_json::Value>(&o.stdout).unwrap()["value"].clone()
+    };
+    assert_eq!(value(&by_r), value(&by_alpha));
+
+    let avg = kiln(&[
+        "eval",
+        "--alpha",
+        "1",
+        "--quantity",
+        "e-avg",
+        "--json",
+        "--samples",
+        "65536",
+    ]);
+    let object: serde_json::Value = serde_json::from_slice(&avg.stdout).unwrap();
+    assert_eq!(object["quantity"], "E_avg");
+    assert!((object["value"].as_f64().unwrap() - 0.409_137_09).abs() < 1e-4);
+}
+
+#[test]
+fn outputs_agree_with_each_other_and_round_trip() {
+    let dir = tempfile::tempdir().unwrap();
+    for precision in ["f32", "f16"] {
+        let out = dir.path().join(precision);
+        let output = small_bake(
+            &out,
+            &[
+                "--precision",
+                precision,
+                "--ndf",
+                "ggx,beckmann",
+                "--masking",
+                "separable",
+            ],
+        );
+        assert!(output.status.success(), "{}", stderr(&output));
+        for id in [
+            "ggx-separable-E",
+            "ggx-separable-E_avg",
+            "beckmann-separable-E",
+            "beckmann-separable-E_avg",
+        ] {
+            let read = |ext: &str| std::fs::read(out.join(format!("{id}.{ext}"))).unwrap();
+            let sidecar: Sidecar = serde_json::from_slice(&read("json")).unwrap();
+            let q = &sidecar.metadata.quantity;
+            let reference = &sidecar.data[q.as_str()];
+            let one_minus = &sidecar.data[&format!("one_minus_{q}")];
+            let std_error = &sidecar.data["std_error"];
+            // What a value becomes in storage: f32, or f16 through f32.
+            let stored = |v: f64| match precision {
+                "f32" => f64::from(v as f32),
+                _ => f64::from(half::f16::from_f32(v as f32).to_f32()),
+            };
+
+            let image = exr::decode(&read("exr")).unwrap();
+            let channel = |name: &str| &image.channels.iter().find(|(n, _)| n == name).unwrap().1;
+            assert_eq!(image.width * image.height, reference.len());
+            assert!(
+                reference
+                    .iter()
+                    .map(|&v| stored(v))
+                    .eq(channel(q).iter().copied()),
+                "{id} exr {q}"
+            );
+            assert!(
+                one_minus
+                    .iter()
+                    .map(|&v| stored(v))
+                    .eq(channel(&format!("one_minus_{q}")).iter().copied())
+            );
+            // std_error stays f32 whatever the precision.
+            assert!(
+                std_error
+                    .iter()
+                    .map(|&v| f64::from(v as f32))
+                    .eq(channel("std_error").iter().copied())
+            );
+            let header: kiln::format::metadata::Metadata =
+                serde_json::from_str(image.metadata.as_deref().unwrap()).unwrap();
+            assert_eq!(header, sidecar.metadata);
+
+            let bin = binary::decode(&read("bin")).unwrap();
+            assert_eq!(bin.shape, sidecar.metadata.shape);
+            assert_eq!(bin.channels[0].0, *q);
+            assert!(
+                reference
+                    .iter()
+                    .map(|&v| stored(v))
+                    .eq(bin.channels[0].1.iter().copied()),
+                "{id} bin"
+            );
+            assert!(
+                std_error
+                    .iter()
+                    .map(|&v| f64::from(v as f32))
+                    .eq(bin.channels[2].1.iter().copied())
+            );
+
+            assert_eq!(
+                sidecar.files.get("exr").map(String::as_str),
+                Some(format!("{id}.exr").as_str())
+            );
+            assert_eq!(sidecar.metadata.precision, precision);
+            assert!(sidecar.metadata.command.contains("--masking separable"));
+        }
+    }
+}
+
+#[test]
+fn results_are_byte_identical_for_any_thread_count_and_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |name: &str, threads: Option<&str>| {
+        let out = dir.path().join(name);
+        let mut command = Command::new(env!("CARGO_BIN_EXE_kiln"));
+        command.args([
+            "bake",
+            "--size",
+            "6",
+            "--samples",
+            "2048",
+            "--avg-samples",
+            "8192",
+            "--ndf",
+            "ggx,beckmann",
+            "-q",
+        ]);
+        command.arg("--out").arg(&out);
+        match threads {
+            Some(n) => command.env("RAYON_NUM_THREADS", n),
+            None => command.env_remove("RAYON_NUM_THREADS"),
+        };
+        let output = command.output().unwrap();
+        assert!(output.status.success(), "{}", stderr(&output));
+        out
+    };
+    let one = run("one", Some("1"));
+    let three = run("three", Some("3"));
+    let default = run("default", None);
+    let again = run("again", None);
+    let names = files_in(&one);
+    assert_eq!(names.len(), 18);
+    for other in [&three, &default, &again] {
+        assert_eq!(files_in(other), names);
+        for name in &names {
+            assert!(
+                std::fs::read(one.join(name)).unwrap() == std::fs::read(other.join(name)).unwrap(),
+                "{name} differs"
+            );
+        }
+    }
+}
+
+#[test]
+fn generated_rust_compiles_for_every_layout() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("tables");
+    let out_arg = out.to_str().unwrap();
+    let output = kiln(&[
+        "bake",
+        "--format",
+        "rs",
+        "--roughness-axis",
+        "alpha",
+        "--mu-axis",
+        "sqrt",
+        "--grid",
+        "nodes",
+        "--size",
+        "5",
+        "--samples",
+        "256",
+        "--avg-samples",
+        "256",
+        "--out",
+        out_arg,
+    ]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    // One crate that includes both files, so that their constant names must not clash either.
+    let lib = dir.path().join("lib.rs");
+    std::fs::write(
+        &lib,
+        "#![deny(warnings)]\ninclude!(\"tables/ggx-height-correlated-E.rs\");\ninclude!(\"tables/ggx-height-correlated-E_avg.rs\");\n\
+         pub fn corner() -> f32 { GGX_HEIGHT_CORRELATED_E[4][0] + GGX_HEIGHT_CORRELATED_E_AVG[0] + GGX_HEIGHT_CORRELATED_E_MU[4] }\n",
+    )
+    .unwrap();
+    let rustc = std::env::var("RUSTC").unwrap_or_else(|_| "rustc".into());
+    let compiled = Command::new(rustc)
+        .args([
+            "--edition",
+            "2024",
+            "--crate-type",
+            "lib",
+            "--crate-name",
+            "tables",
+            "-o",
+        ])
+        .arg(dir.path().join("libtables.rlib"))
+        .arg(&lib)
+        .output()
+        .unwrap();
+    assert!(
+        compiled.status.success(),
+        "{}",
+        String::from_utf8_lossy(&compiled.stderr)
+    );
+}
+
+#[test]
+fn help_explains_the_conventions() {
+    let output = kiln(&["bake", "--help"]);
+    let text = String::from_utf8(output.stdout).unwrap();
+    for phrase in [
+        "alpha = r^2",
+        "(i + 0.5) / N",
+        "i / (N - 1)",
+        "cos(theta)",
+        "one_minus_E",
+    ] {
+        assert!(
+            text.contains(phrase),
+            "bake --help does not explain {phrase}"
+        );
+    }
+}
