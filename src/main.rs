@@ -136,9 +136,10 @@ struct EvalArgs {
     /// What to evaluate.
     #[arg(long, value_enum, default_value = "e")]
     quantity: QuantityArg,
-    /// QMC samples, a power of two (split over the scrambles).
-    #[arg(long, default_value_t = QmcSettings::DEFAULT_SAMPLES, value_parser = parse_samples, allow_negative_numbers = true)]
-    samples: u64,
+    /// QMC samples, a power of two (split over the scrambles) [default: 2^19 for e, 2^23 for
+    /// e-avg, as `kiln bake` uses].
+    #[arg(long, value_parser = parse_samples, allow_negative_numbers = true)]
+    samples: Option<u64>,
     /// Independent scrambles, for the standard error: a power of two, 2 to 1024.
     #[arg(long, default_value_t = QmcSettings::DEFAULT_SCRAMBLES, allow_negative_numbers = true)]
     scrambles: u32,
@@ -417,8 +418,12 @@ fn eval(args: EvalArgs) -> kiln::Result<()> {
         (None, Some(r)) => RoughnessConvention::Perceptual.to_alpha(r),
         (None, None) => unreachable!("clap requires one of them"),
     };
+    let samples = args.samples.unwrap_or(match args.quantity {
+        QuantityArg::E => QmcSettings::DEFAULT_SAMPLES,
+        QuantityArg::EAvg => 16 * QmcSettings::DEFAULT_SAMPLES,
+    });
     let settings = QmcSettings {
-        samples: args.samples,
+        samples,
         scrambles: args.scrambles,
         seed: args.seed,
     };

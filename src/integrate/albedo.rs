@@ -105,7 +105,7 @@ pub fn albedo(model: Model, alpha: f64, mu: f64, settings: &QmcSettings) -> Esti
                 let ndf = Beckmann { alpha };
                 let o = Vec3::from_mu(mu);
                 let lambda_o = ndf.lambda(o);
-                let visible = BeckmannVisibleNormals::new(ndf, o);
+                let visible = BeckmannVisibleNormals::tabulated(ndf, o);
                 sum_over_block(seq, log2_n, |u| {
                     reflection_loss(ndf, masking, o, lambda_o, visible.sample(u))
                 })
