@@ -14,7 +14,7 @@ use rayon::prelude::*;
 /// What `kiln bake` bakes: for each model, an `E` table and an `E_avg` table.
 ///
 /// The default is GGX with height-correlated masking; Beckmann's visible-normal sampling needs a
-/// numerical inversion per sample and runs about 25 times slower, so it is baked on request.
+/// numerical inversion per sample and runs about 20 times slower, so it is baked on request.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct BakeOptions {
     pub ndfs: Vec<Ndf>,

@@ -56,7 +56,7 @@ enum Command {
 #[derive(Args, Debug)]
 struct BakeArgs {
     /// Normal distributions to bake, comma-separated: ggx,beckmann for both (Beckmann's
-    /// sampling is about 25 times slower than GGX's).
+    /// sampling is about 20 times slower than GGX's).
     #[arg(long, value_enum, value_delimiter = ',', default_value = "ggx")]
     ndf: Vec<NdfArg>,
     /// Smith G2 forms to bake, comma-separated.

@@ -192,3 +192,69 @@ impl Table {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::integrate::QmcSettings;
+    use crate::model::{Masking, Ndf};
+    use axis::{Grid, MuMapping};
+
+    fn synthetic(grid: Grid, mapping: MuMapping) -> Table {
+        let spec = TableSpec {
+            model: Model {
+                ndf: Ndf::Ggx,
+                masking: Masking::HeightCorrelated,
+            },
+            quantity: Quantity::E,
+            roughness: Axis::Roughness {
+                size: 5,
+                convention: RoughnessConvention::Perceptual,
+                grid,
+            },
+            mu: Some(Axis::Mu {
+                size: 4,
+                mapping,
+                grid,
+            }),
+            qmc: QmcSettings::default(),
+        };
+        // value = 10 * row + column, so that interpolation is easy to predict.
+        let value: Vec<f64> = (0..20).map(|k| (10 * (k / 4) + k % 4) as f64).collect();
+        Table {
+            one_minus_value: value.iter().map(|v| 1.0 - v).collect(),
+            std_error: vec![0.0; 20],
+            value,
+            spec,
+            command: String::new(),
+        }
+    }
+
+    #[test]
+    fn lookup_returns_stored_values_at_sample_coordinates_and_lerps_between() {
+        for grid in [Grid::Centers, Grid::Nodes] {
+            for mapping in [MuMapping::Linear, MuMapping::Sqrt] {
+                let t = synthetic(grid, mapping);
+                let (r_axis, mu_axis) = (t.spec.roughness, t.spec.mu.unwrap());
+                for row in 0..5 {
+                    for col in 0..4 {
+                        let got = t.lookup(mu_axis.value(col), r_axis.value(row));
+                        assert!(
+                            (got - t.value[row * 4 + col]).abs() < 1e-12,
+                            "{grid:?} {mapping:?}"
+                        );
+                    }
+                }
+                // Halfway between two rows and two columns (in texture coordinates).
+                let r = (r_axis.value(1) + r_axis.value(2)) / 2.0;
+                let mu = mapping.mu((mapping.coordinate(mu_axis.value(2))
+                    + mapping.coordinate(mu_axis.value(3)))
+                    / 2.0);
+                assert!((t.lookup(mu, r) - 17.5).abs() < 1e-12);
+                // Clamp to edge beyond the outermost samples.
+                assert_eq!(t.lookup(0.0, 0.0), t.value[0]);
+                assert_eq!(t.lookup(1.0, 1.0), t.value[19]);
+            }
+        }
+    }
+}
