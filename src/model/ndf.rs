@@ -31,6 +31,15 @@ pub trait MicrofacetDistribution: Copy + Send + Sync {
         self.lambda_from_tan2(v.tan2_theta())
     }
 
+    /// `D(m)` given `tan^2(theta_m)`, with `cos^4 = 1 / (1 + tan^2)^2`: no cancellation near the
+    /// normal, where `1 - cos^2` would lose the digits that a small `alpha` needs.
+    fn d_from_tan2(&self, tan2_theta_m: f64) -> f64;
+
+    /// The projected area of the microsurface seen from a direction with `cos(theta) = mu`,
+    /// `mu (1 + Lambda) = ∫ (v.m)+ D(m) dω_m` (Heitz 2014, eq. 11), in a form that stays exact as
+    /// `mu -> 0` (where `mu` goes to 0 and `Lambda` to infinity).
+    fn projected_area(&self, mu: f64) -> f64;
+
     /// Smith masking `G1(v) = 1 / (1 + Lambda(v))` (Heitz 2014, eq. 43).
     fn g1(&self, v: Vec3) -> f64 {
         1.0 / (1.0 + self.lambda(v))
@@ -58,6 +67,19 @@ impl MicrofacetDistribution for Ggx {
         let c2 = cos_theta_m * cos_theta_m;
         let t = 1.0 + (a2 - 1.0) * c2;
         a2 / (PI * t * t)
+    }
+
+    /// `D = alpha^2 (1 + t^2)^2 / (pi (alpha^2 + t^2)^2)`, `t^2 = tan^2(theta_m)`.
+    fn d_from_tan2(&self, tan2: f64) -> f64 {
+        let a2 = self.alpha * self.alpha;
+        let ratio = (1.0 + tan2) / (a2 + tan2);
+        a2 * ratio * ratio / PI
+    }
+
+    /// `mu (1 + Lambda) = (mu + sqrt(mu^2 + alpha^2 (1 - mu^2))) / 2`.
+    fn projected_area(&self, mu: f64) -> f64 {
+        let so2 = (1.0 - mu) * (1.0 + mu);
+        0.5 * (mu + (mu * mu + self.alpha * self.alpha * so2).sqrt())
     }
 
     /// `Lambda = (sqrt(1 + x) - 1) / 2` with `x = alpha^2 tan^2(theta)` (Heitz 2014, eq. 72),
@@ -110,6 +132,24 @@ impl MicrofacetDistribution for Beckmann {
         let c2 = cos_theta_m * cos_theta_m;
         let tan2 = (1.0 - c2) / c2;
         (-tan2 / a2).exp() / (PI * a2 * c2 * c2)
+    }
+
+    /// `D = exp(-t^2 / alpha^2) (1 + t^2)^2 / (pi alpha^2)`, `t^2 = tan^2(theta_m)`.
+    fn d_from_tan2(&self, tan2: f64) -> f64 {
+        let a2 = self.alpha * self.alpha;
+        (-tan2 / a2).exp() * (1.0 + tan2) * (1.0 + tan2) / (PI * a2)
+    }
+
+    /// `mu (1 + Lambda) = mu (1 + erf(a)) / 2 + alpha sqrt(1 - mu^2) exp(-a^2) / (2 sqrt(pi))` with
+    /// `a = mu / (alpha sqrt(1 - mu^2))`: the exact Lambda multiplied out, finite at `a = 0`.
+    fn projected_area(&self, mu: f64) -> f64 {
+        let so = ((1.0 - mu) * (1.0 + mu)).max(0.0).sqrt();
+        if self.alpha == 0.0 || so == 0.0 {
+            return mu;
+        }
+        let a = mu / (self.alpha * so);
+        0.5 * mu * (1.0 + super::special::erf(a))
+            + self.alpha * so * (-a * a).exp() * 0.5 * FRAC_1_SQRT_PI
     }
 
     /// Exact Smith Lambda, `a = 1 / (alpha tan(theta))` (Walter 2007, eq. 27 before the rational
@@ -448,6 +488,29 @@ mod tests {
                 check("Beckmann", &|c| beckmann.d(c), beckmann.lambda(o));
             }
         }
+    }
+
+    #[test]
+    fn tan2_forms_and_projected_areas_agree_with_the_plain_forms() {
+        for &alpha in &[1e-3, 0.2, 1.0, 2.5] {
+            for &mu in &[1e-3, 0.3, 0.8, 1.0] {
+                let o = Vec3::from_mu(mu);
+                let check = |name: &str, area: f64, lambda: f64, d_tan: f64, d: f64| {
+                    let plain = mu * (1.0 + lambda);
+                    assert!((area - plain).abs() <= 1e-13 * plain, "{name} {alpha} {mu}: {area} {plain}");
+                    assert!((d_tan - d).abs() <= 1e-9 * d.max(1e-300), "{name} D {alpha} {mu}: {d_tan} {d}");
+                };
+                let tan2 = (1.0 - mu * mu) / (mu * mu);
+                let g = Ggx { alpha };
+                check("GGX", g.projected_area(mu), g.lambda(o), g.d_from_tan2(tan2), g.d(mu));
+                let b = Beckmann { alpha };
+                check("Beckmann", b.projected_area(mu), b.lambda(o), b.d_from_tan2(tan2), b.d(mu));
+            }
+        }
+        // At grazing the projected area is finite: the shadow of a rough surface.
+        assert!((Ggx { alpha: 0.5 }.projected_area(0.0) - 0.25).abs() < 1e-16);
+        let b = Beckmann { alpha: 0.5 }.projected_area(0.0);
+        assert!((b - 0.25 * FRAC_1_SQRT_PI).abs() < 1e-16);
     }
 
     #[test]
