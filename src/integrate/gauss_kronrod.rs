@@ -40,6 +40,9 @@ const WG: [f64; 4] = [
     0.417_959_183_673_469_4,
 ];
 
+/// Relative size of an error estimate below which it is f64 rounding, not truncation.
+const ROUNDOFF: f64 = 50.0 * f64::EPSILON;
+
 /// The result of an adaptive integration.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Quadrature<const N: usize> {
@@ -87,6 +90,8 @@ fn kronrod<const N: usize>(f: &mut impl FnMut(f64) -> [f64; N], a: f64, b: f64) 
 /// Integrates `f` over `[a, b]` until the summed error estimate is at most `tolerance`, using at
 /// most `max_intervals` intervals. If the budget runs out, the result carries `converged: false`
 /// and the error estimate reached: the best available, never silently passed off as converged.
+/// A tolerance below f64 rounding of the integral is met as far as rounding allows (the
+/// estimate then reports that level).
 pub fn integrate<const N: usize>(
     mut f: impl FnMut(f64) -> [f64; N],
     a: f64,
@@ -124,12 +129,23 @@ pub fn integrate_pieces<const N: usize>(
     let total_error = |intervals: &[Interval<N>]| intervals.iter().map(|i| i.error).sum::<f64>();
     let mut converged = total_error(&intervals) <= tolerance;
     while !converged && intervals.len() < max_intervals {
-        let worst = intervals
+        let (worst, worst_error) = intervals
             .iter()
             .enumerate()
             .max_by(|x, y| x.1.error.total_cmp(&y.1.error))
-            .map(|(k, _)| k)
+            .map(|(k, i)| (k, i.error))
             .expect("at least one interval");
+        // Roundoff floor: when even the worst interval's estimate is at the level of f64
+        // rounding of the values summed, splitting cannot lower the total any further.
+        let scale: f64 = intervals
+            .iter()
+            .map(|i| i.value.iter().map(|v| v.abs()).fold(0.0, f64::max))
+            .sum();
+        if worst_error <= ROUNDOFF * scale {
+            converged =
+                total_error(&intervals) <= tolerance.max(ROUNDOFF * scale * intervals.len() as f64);
+            break;
+        }
         let Interval { a, b, .. } = intervals.swap_remove(worst);
         let mid = 0.5 * (a + b);
         if !(mid > a && mid < b) {
@@ -137,7 +153,12 @@ pub fn integrate_pieces<const N: usize>(
         }
         for (lo, hi) in [(a, mid), (mid, b)] {
             let (value, error) = kronrod(f, lo, hi);
-            intervals.push(Interval { a: lo, b: hi, value, error });
+            intervals.push(Interval {
+                a: lo,
+                b: hi,
+                value,
+                error,
+            });
         }
         evaluations += 30;
         converged = total_error(&intervals) <= tolerance;
@@ -150,7 +171,12 @@ pub fn integrate_pieces<const N: usize>(
             value[c] += interval.value[c];
         }
     }
-    Quadrature { value, error: total_error(&intervals), evaluations, converged }
+    Quadrature {
+        value,
+        error: total_error(&intervals),
+        evaluations,
+        converged,
+    }
 }
 
 #[cfg(test)]
@@ -161,9 +187,17 @@ mod tests {
     fn rules_integrate_polynomials_exactly() {
         // K15 is exact to degree 22, G7 to degree 13: a single interval must reproduce ∫ x^k.
         for k in 0..=22 {
-            let exact = if k % 2 == 1 { 0.0 } else { 2.0 / (k as f64 + 1.0) };
+            let exact = if k % 2 == 1 {
+                0.0
+            } else {
+                2.0 / (k as f64 + 1.0)
+            };
             let (value, error) = kronrod(&mut |x: f64| [x.powi(k)], -1.0, 1.0);
-            assert!((value[0] - exact).abs() < 1e-14, "x^{k}: {} vs {exact}", value[0]);
+            assert!(
+                (value[0] - exact).abs() < 1e-14,
+                "x^{k}: {} vs {exact}",
+                value[0]
+            );
             if k <= 13 {
                 assert!(error < 1e-14, "G7 should be exact for x^{k}: {error}");
             }
@@ -175,10 +209,19 @@ mod tests {
     #[test]
     fn adaptive_integration_meets_its_tolerance_on_hard_integrands() {
         // A kink, a narrow peak and an integrable endpoint singularity.
-        let q = integrate(|x: f64| [x.abs(), (-1e4 * x * x).exp()], -1.0, 2.0, 1e-12, 1000);
+        let q = integrate(
+            |x: f64| [x.abs(), (-1e4 * x * x).exp()],
+            -1.0,
+            2.0,
+            1e-12,
+            1000,
+        );
         let peak = (std::f64::consts::PI / 1e4).sqrt();
         assert!(q.converged);
-        assert!((q.value[0] - 2.5).abs() < 1e-12 && (q.value[1] - peak).abs() < 1e-12, "{q:?}");
+        assert!(
+            (q.value[0] - 2.5).abs() < 1e-12 && (q.value[1] - peak).abs() < 1e-12,
+            "{q:?}"
+        );
         let q = integrate(|x: f64| [1.0 / x.sqrt()], 0.0, 1.0, 1e-10, 1000);
         assert!((q.value[0] - 2.0).abs() < 1e-9, "{q:?}");
         // A budget too small says so.

@@ -3,6 +3,7 @@
 pub mod albedo;
 pub mod estimate;
 pub mod gauss_kronrod;
+pub mod reference;
 pub mod sobol;
 
 pub use albedo::{QmcSettings, albedo, average_albedo};

@@ -497,14 +497,32 @@ mod tests {
                 let o = Vec3::from_mu(mu);
                 let check = |name: &str, area: f64, lambda: f64, d_tan: f64, d: f64| {
                     let plain = mu * (1.0 + lambda);
-                    assert!((area - plain).abs() <= 1e-13 * plain, "{name} {alpha} {mu}: {area} {plain}");
-                    assert!((d_tan - d).abs() <= 1e-9 * d.max(1e-300), "{name} D {alpha} {mu}: {d_tan} {d}");
+                    assert!(
+                        (area - plain).abs() <= 1e-13 * plain,
+                        "{name} {alpha} {mu}: {area} {plain}"
+                    );
+                    assert!(
+                        (d_tan - d).abs() <= 1e-9 * d.max(1e-300),
+                        "{name} D {alpha} {mu}: {d_tan} {d}"
+                    );
                 };
                 let tan2 = (1.0 - mu * mu) / (mu * mu);
                 let g = Ggx { alpha };
-                check("GGX", g.projected_area(mu), g.lambda(o), g.d_from_tan2(tan2), g.d(mu));
+                check(
+                    "GGX",
+                    g.projected_area(mu),
+                    g.lambda(o),
+                    g.d_from_tan2(tan2),
+                    g.d(mu),
+                );
                 let b = Beckmann { alpha };
-                check("Beckmann", b.projected_area(mu), b.lambda(o), b.d_from_tan2(tan2), b.d(mu));
+                check(
+                    "Beckmann",
+                    b.projected_area(mu),
+                    b.lambda(o),
+                    b.d_from_tan2(tan2),
+                    b.d(mu),
+                );
             }
         }
         // At grazing the projected area is finite: the shadow of a rough surface.
