@@ -20,6 +20,7 @@ use std::path::{Path, PathBuf};
 
 /// An output format.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum Format {
     /// OpenEXR, channels `E`, `one_minus_E`, `std_error`, metadata in the header.
@@ -59,6 +60,7 @@ impl Format {
 
 /// How the value channels are stored in EXR and binary files.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum Precision {
     F32,

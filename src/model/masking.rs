@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 /// Which Smith `G2` a table is computed for. Part of a table's identity: a table is only right for
 /// the BRDF the renderer evaluates.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum Masking {
     /// `G2 = 1 / (1 + Lambda(o) + Lambda(i))` (pbrt, Cycles, Filament, Unity, Bevy). The default.

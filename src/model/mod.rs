@@ -16,6 +16,7 @@ pub use vector::Vec3;
 
 /// Which normal distribution a table is computed for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum Ndf {
     Ggx,
@@ -55,10 +56,12 @@ pub struct Model {
 /// Imageworks). `Alpha` takes the slope-space width directly (Mitsuba). pbrt-v4's
 /// `alpha = sqrt(r)` is not offered: convert to `alpha` first.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum RoughnessConvention {
     /// Perceptual roughness `r`, `alpha = r^2`.
     #[serde(rename = "r")]
+    #[cfg_attr(feature = "cli", value(name = "r"))]
     Perceptual,
     /// `alpha` itself.
     Alpha,

@@ -20,6 +20,7 @@ use serde::{Deserialize, Serialize};
 
 /// Where the samples of an axis sit.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum Grid {
     /// `t_i = (i + 0.5) / N`: texel centres.
@@ -60,6 +61,7 @@ impl Grid {
 
 /// How the `mu` axis is spaced.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum MuMapping {
     /// `mu = t`.

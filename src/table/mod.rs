@@ -9,12 +9,15 @@ use serde::{Deserialize, Serialize};
 
 /// What a table holds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum Quantity {
     /// Directional albedo `E(mu, roughness)` for F = 1, a 2-D table.
     #[serde(rename = "E")]
+    #[cfg_attr(feature = "cli", value(name = "e"))]
     E,
     /// Its cosine-weighted average `E_avg(roughness) = 2 ∫ E(mu) mu dmu`, a 1-D table.
     #[serde(rename = "E_avg")]
+    #[cfg_attr(feature = "cli", value(name = "e-avg"))]
     EAvg,
 }
 
