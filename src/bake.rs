@@ -5,10 +5,12 @@
 //! cores and collects them in index order, so a table is byte-identical for any thread count.
 
 use crate::error::{Error, Result};
+use crate::integrate::reference::ReferenceSettings;
 use crate::integrate::{Estimate, QmcSettings, albedo, average_albedo};
 use crate::model::{Masking, Model, Ndf, RoughnessConvention};
 use crate::table::axis::{Axis, Grid, MuMapping};
 use crate::table::{Quantity, Table, TableSpec};
+use crate::verify::node_errors;
 use rayon::prelude::*;
 
 /// What `kiln bake` bakes: for each model, an `E` table and an `E_avg` table.
@@ -32,6 +34,8 @@ pub struct BakeOptions {
     pub roughness_convention: RoughnessConvention,
     pub mu_mapping: MuMapping,
     pub grid: Grid,
+    /// Measure each table's node error against the deterministic reference after baking.
+    pub check_against_reference: bool,
 }
 
 impl Default for BakeOptions {
@@ -47,6 +51,7 @@ impl Default for BakeOptions {
             roughness_convention: RoughnessConvention::Perceptual,
             mu_mapping: MuMapping::Linear,
             grid: Grid::Centers,
+            check_against_reference: true,
         }
     }
 }
@@ -164,6 +169,10 @@ impl BakeOptions {
 
     /// Bakes every table of [`BakeOptions::specs`]. `progress` is told how many integrand
     /// evaluations each finished texel spent (see [`BakeOptions::total_samples`]).
+    ///
+    /// Each table then has its node error measured against the deterministic reference
+    /// ([`crate::verify::node_errors`]: every `E` texel, a few `E_avg` entries) and recorded in
+    /// [`Table::node_errors`], unless `check_against_reference` is off.
     pub fn bake(&self, progress: &(dyn Fn(u64) + Sync)) -> Result<Vec<Table>> {
         self.validate()?;
         Ok(self
@@ -171,7 +180,11 @@ impl BakeOptions {
             .into_iter()
             .map(|spec| {
                 let command = self.command_for(spec.model);
-                bake_table(spec, command, progress)
+                let mut table = bake_table(spec, command, progress);
+                if self.check_against_reference {
+                    table.node_errors = Some(node_errors(&table, &ReferenceSettings::default()));
+                }
+                table
             })
             .collect())
     }
@@ -203,6 +216,7 @@ pub fn bake_table(spec: TableSpec, command: String, progress: &(dyn Fn(u64) + Sy
         std_error: estimates.iter().map(|e| e.std_error).collect(),
         spec,
         command,
+        node_errors: None,
     }
 }
 

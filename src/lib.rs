@@ -37,6 +37,7 @@ pub mod format;
 pub mod integrate;
 pub mod model;
 pub mod table;
+pub mod verify;
 
 pub use bake::{BakeOptions, bake_table};
 pub use error::{Error, Result};

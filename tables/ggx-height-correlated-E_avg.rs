@@ -6,6 +6,7 @@
 /// - Indexing: `GGX_HEIGHT_CORRELATED_E_AVG[r_index]`.
 /// - Axis `r` (32 samples, centers grid): t_i = (i + 0.5) / N, r = t_i, alpha = r^2; values in `GGX_HEIGHT_CORRELATED_E_AVG_R`.
 /// - Measured error: max standard error 1.81e-6, rms 7.42e-7, from 8388608 samples per texel in 8 scrambles.
+/// - Against kiln's deterministic reference: max error 1.24e-6 over 5 texels.
 /// - Estimator: quasi-Monte Carlo: visible-normal (VNDF) importance sampling driven by Owen-scrambled Sobol points (Burley 2020); std_error from independent scrambles.
 pub const GGX_HEIGHT_CORRELATED_E_AVG: [f32; 32] = [
     0.99999917, 0.9999678, 0.9997926, 0.99929875, 0.9982739, 0.99649835, 0.9937409, 0.9897614,

@@ -1,7 +1,7 @@
 //! The description every output carries: model, axes, grid, samples, errors, provenance.
 
-use crate::table::Table;
 use crate::table::axis::{Axis, Grid};
+use crate::table::{Table, TableSpec};
 use serde::{Deserialize, Serialize};
 
 /// kiln's version, recorded in every table.
@@ -71,10 +71,18 @@ pub struct Metadata {
     /// The largest per-texel standard error (the table's measured error).
     pub max_std_error: f64,
     pub rms_std_error: f64,
+    /// The error of the stored values against the deterministic reference (in `1 - E`), as
+    /// measured by `kiln bake`: largest, RMS, and over how many texels (all of an `E` table; a
+    /// few evenly spaced entries of an `E_avg` table, each of which costs the reference ~0.5 s).
+    pub node_max_error: Option<f64>,
+    pub node_rms_error: Option<f64>,
+    pub node_error_texels: Option<usize>,
     /// `f32` or `f16`: how the value channels are stored in the binary formats.
     pub precision: String,
     /// The command that reproduces the values.
     pub command: String,
+    /// The same facts in machine form, for reading a table back ([`crate::TableSpec`]).
+    pub spec: TableSpec,
 }
 
 impl Metadata {
@@ -112,8 +120,12 @@ impl Metadata {
             seed: spec.qmc.seed,
             max_std_error: table.max_std_error(),
             rms_std_error: table.rms_std_error(),
+            node_max_error: table.node_errors.map(|e| e.max),
+            node_rms_error: table.node_errors.map(|e| e.rms),
+            node_error_texels: table.node_errors.map(|e| e.texels),
             precision: precision.to_string(),
             command: table.command.clone(),
+            spec: table.spec.clone(),
         }
     }
 }

@@ -116,6 +116,12 @@ pub fn encode(table: &Table) -> String {
          {} scrambles.",
         meta.max_std_error, meta.rms_std_error, meta.samples_per_texel, meta.scrambles
     );
+    if let (Some(max), Some(texels)) = (meta.node_max_error, meta.node_error_texels) {
+        let _ = writeln!(
+            out,
+            "/// - Against kiln's deterministic reference: max error {max:.2e} over {texels} texels."
+        );
+    }
     let _ = writeln!(out, "/// - Estimator: {}.", meta.estimator);
     let _ = write!(out, "pub const {prefix}: {ty} = ");
     write_array(&mut out, &table.value, &shape);

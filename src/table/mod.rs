@@ -138,6 +138,8 @@ pub struct Table {
     pub std_error: Vec<f64>,
     /// The command that reproduces this table.
     pub command: String,
+    /// The error of the stored values against the deterministic reference, where measured.
+    pub node_errors: Option<crate::verify::NodeErrors>,
 }
 
 impl Table {
@@ -230,6 +232,7 @@ mod tests {
             value,
             spec,
             command: String::new(),
+            node_errors: None,
         }
     }
 

@@ -3,6 +3,7 @@
 mod args;
 mod bake;
 mod eval;
+mod verify;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -21,6 +22,8 @@ enum Command {
     Bake(bake::BakeArgs),
     /// Evaluate E or E_avg at one point, by QMC or by the deterministic reference.
     Eval(eval::EvalArgs),
+    /// Audit a table (kiln's or an engine's) against the deterministic reference.
+    Verify(verify::VerifyArgs),
 }
 
 /// A progress bar on stderr, drawn only when stderr is a terminal; hidden with `quiet`.
@@ -59,11 +62,14 @@ fn main() -> ExitCode {
         }
     };
     let result = match cli.command {
-        Command::Bake(args) => bake::run(args),
-        Command::Eval(args) => eval::run(args),
+        Command::Bake(args) => bake::run(args).map(|()| true),
+        Command::Eval(args) => eval::run(args).map(|()| true),
+        Command::Verify(args) => verify::run(args),
     };
     match result {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(true) => ExitCode::SUCCESS,
+        // A check that ran and failed (verify --max-error).
+        Ok(false) => ExitCode::from(1),
         Err(e) => {
             eprintln!("kiln: {e}");
             // Bad input and unusable output directories are the caller's to fix: status 2.

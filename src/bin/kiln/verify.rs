@@ -1,0 +1,256 @@
+//! `kiln verify`.
+
+use crate::args::{CONVENTIONS, parse_error_bound, parse_number};
+use clap::Args;
+use kiln::format::Precision;
+use kiln::integrate::reference::ReferenceSettings;
+use kiln::verify::input::{AxisName, Encoding, Layout, read_external, read_kiln};
+use kiln::verify::{Against, AuditSettings, Point, audit, audit_points};
+use kiln::{Grid, Masking, Model, MuMapping, Ndf, Quantity, RoughnessConvention, Table};
+use std::path::{Path, PathBuf};
+
+/// Audit a table against the deterministic reference (or another table).
+#[derive(Args, Debug)]
+#[command(
+    long_about = "Audit a table, kiln's or an engine's. Reports the error of the stored values at \
+                  the coordinates the table says it was computed at (node_max_error, \
+                  node_rms_error) and of its bilinear lookup, with its own grid convention, on a \
+                  dense set of points between the nodes including the axis ends \
+                  (lookup_max_error, lookup_rms_error, lookup_p99_error), each with the worst \
+                  point. kiln's own files (.json sidecar, .exr, .bin beside its sidecar) carry \
+                  their layout; for any other table give it with --shape, --order, --grid, \
+                  --roughness-axis, --mu-axis, --clamp-min and the model flags.",
+    after_help = CONVENTIONS
+)]
+pub struct VerifyArgs {
+    /// The table to audit: a kiln output, a text file of numbers (whitespace or commas, '#'
+    /// comments), raw little-endian floats (--dtype) or an EXR channel (--channel).
+    file: PathBuf,
+    /// What to compare with: 'reference' (the deterministic quadrature) or another table's file.
+    #[arg(long, default_value = "reference")]
+    against: String,
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    json: bool,
+    /// Exit with status 1 when node_max_error exceeds this.
+    #[arg(long, value_parser = parse_error_bound, allow_negative_numbers = true)]
+    max_error: Option<f64>,
+    /// Lookup points per texel along each axis.
+    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=64))]
+    density: u32,
+    /// The smallest coordinate the table was actually computed at, on both axes (Cycles: 1e-4).
+    #[arg(long, default_value_t = 0.0, value_parser = parse_clamp, allow_negative_numbers = true)]
+    clamp_min: f64,
+    /// External tables: raw little-endian floats of this type (otherwise text is expected).
+    #[arg(long, value_enum)]
+    dtype: Option<Precision>,
+    /// External tables: read this channel of an EXR file.
+    #[arg(long, conflicts_with = "dtype")]
+    channel: Option<String>,
+    /// External tables: sizes, slowest-varying axis first: 32x32 for E, 32 for E_avg.
+    #[arg(long, value_parser = parse_shape)]
+    shape: Option<Shape>,
+    /// External tables: the axes, slowest-varying first [default: r,mu for E; r for E_avg].
+    #[arg(long, value_enum, value_delimiter = ',')]
+    order: Option<Vec<AxisName>>,
+    /// External tables: where samples sit.
+    #[arg(long, value_enum, default_value = "centers")]
+    grid: Grid,
+    /// External tables: the roughness axis, r (alpha = r^2) or alpha.
+    #[arg(long, value_enum, default_value = "r")]
+    roughness_axis: RoughnessConvention,
+    /// External tables: the mu axis spacing.
+    #[arg(long, value_enum, default_value = "linear")]
+    mu_axis: MuMapping,
+    /// External tables: the normal distribution.
+    #[arg(long, value_enum, default_value = "ggx")]
+    ndf: Ndf,
+    /// External tables: the Smith G2 form.
+    #[arg(long, value_enum, default_value = "height-correlated")]
+    masking: Masking,
+    /// External tables: what the numbers are.
+    #[arg(long, value_enum, default_value = "e")]
+    quantity: Quantity,
+    /// No progress bar.
+    #[arg(long, short)]
+    quiet: bool,
+}
+
+fn parse_clamp(text: &str) -> Result<f64, String> {
+    let value = parse_number(text)?;
+    if (0.0..1.0).contains(&value) {
+        Ok(value)
+    } else {
+        Err(format!("clamp-min must be in [0, 1) (got {text})"))
+    }
+}
+
+/// Table sizes, slowest-varying axis first.
+#[derive(Clone, Debug)]
+struct Shape(Vec<usize>);
+
+fn parse_shape(text: &str) -> Result<Shape, String> {
+    let sizes: Result<Vec<usize>, _> = text
+        .split(['x', 'X'])
+        .map(|s| s.trim().parse::<usize>())
+        .collect();
+    match sizes {
+        Ok(sizes)
+            if (1..=2).contains(&sizes.len())
+                && sizes.iter().all(|&n| (2..=65536).contains(&n)) =>
+        {
+            Ok(Shape(sizes))
+        }
+        _ => Err(format!(
+            "shape must be like 32x32 or 32, each size 2 to 65536 (got {text})"
+        )),
+    }
+}
+
+impl VerifyArgs {
+    fn layout(&self) -> kiln::Result<Layout> {
+        let Shape(shape) = self.shape.clone().ok_or_else(|| {
+            kiln::Error::InvalidInput(format!(
+                "{} is not a kiln table: give its layout, at least --shape (e.g. --shape 32x32 --order mu,r)",
+                self.file.display()
+            ))
+        })?;
+        let order = self.order.clone().unwrap_or(match self.quantity {
+            Quantity::E => vec![AxisName::R, AxisName::Mu],
+            Quantity::EAvg => vec![AxisName::R],
+        });
+        Ok(Layout {
+            model: Model {
+                ndf: self.ndf,
+                masking: self.masking,
+            },
+            quantity: self.quantity,
+            shape,
+            order,
+            grid: self.grid,
+            roughness: self.roughness_axis,
+            mu_mapping: self.mu_axis,
+        })
+    }
+
+    fn load(&self, path: &Path) -> kiln::Result<Table> {
+        if self.channel.is_none() && self.dtype.is_none() {
+            if let Some(table) = read_kiln(path)? {
+                return Ok(table);
+            }
+        }
+        let encoding = match (&self.channel, self.dtype) {
+            (Some(name), _) => Encoding::ExrChannel(name.clone()),
+            (None, Some(dtype)) => Encoding::Raw(dtype),
+            (None, None) => Encoding::Text,
+        };
+        read_external(path, &encoding, &self.layout()?)
+    }
+}
+
+fn describe(point: &Point, convention: &str) -> String {
+    let at = match point.mu {
+        Some(mu) => format!("mu = {mu:.6}, "),
+        None => String::new(),
+    };
+    format!(
+        "{at}{convention} = {:.6} (alpha {:.3e}): table {:.7}, reference {:.7}",
+        point.roughness, point.alpha, point.table, point.reference
+    )
+}
+
+/// Returns whether the table passed `--max-error` (always true without it).
+pub fn run(args: VerifyArgs) -> kiln::Result<bool> {
+    let table = args.load(&args.file)?;
+    let other;
+    let against = if args.against == "reference" {
+        Against::Reference(ReferenceSettings::default())
+    } else {
+        other = args.load(Path::new(&args.against))?;
+        if other.spec.quantity != table.spec.quantity {
+            return Err(kiln::Error::InvalidInput(format!(
+                "{} holds {} but {} holds {}",
+                args.file.display(),
+                table.spec.quantity.symbol(),
+                args.against,
+                other.spec.quantity.symbol()
+            )));
+        }
+        Against::Table(&other)
+    };
+    let settings = AuditSettings {
+        clamp_min: args.clamp_min,
+        density: args.density as usize,
+    };
+    let bar = crate::progress_bar(
+        args.quiet || args.json,
+        audit_points(&table, &settings),
+        "verifying",
+    );
+    let report = audit(&table, &against, &settings, &|| bar.inc(1));
+    bar.finish_and_clear();
+    let passed = args
+        .max_error
+        .is_none_or(|bound| report.node_max_error <= bound);
+    if args.json {
+        let mut object = serde_json::to_value(&report).expect("a report serialises");
+        object["file"] = args.file.display().to_string().into();
+        if let Some(bound) = args.max_error {
+            object["max_error"] = bound.into();
+            object["passed"] = passed.into();
+        }
+        println!("{object}");
+    } else {
+        let shape: Vec<String> = report.shape.iter().map(|n| n.to_string()).collect();
+        println!(
+            "{}: {} {} {}, {} ({} grid, roughness axis {}{}{}) against {}",
+            args.file.display(),
+            report.ndf,
+            report.masking,
+            report.quantity,
+            shape.join("x"),
+            report.grid,
+            report.roughness_axis,
+            report
+                .mu_axis
+                .as_ref()
+                .map(|m| format!(", mu axis {m}"))
+                .unwrap_or_default(),
+            if report.clamp_min > 0.0 {
+                format!(", clamped to >= {}", report.clamp_min)
+            } else {
+                String::new()
+            },
+            report.against
+        );
+        println!(
+            "  nodes   {:>6}: max error {:.2e}, rms {:.2e}; worst at {}",
+            report.nodes,
+            report.node_max_error,
+            report.node_rms_error,
+            describe(&report.worst_node, &report.roughness_axis)
+        );
+        println!(
+            "  lookups {:>6}: max error {:.2e}, rms {:.2e}, p99 {:.2e}; worst at {}",
+            report.lookup_points,
+            report.lookup_max_error,
+            report.lookup_rms_error,
+            report.lookup_p99_error,
+            describe(&report.worst_lookup, &report.roughness_axis)
+        );
+        if !report.reference_converged {
+            println!(
+                "  note: some reference values did not reach their tolerance (estimate {:.1e})",
+                report.reference_error_estimate
+            );
+        }
+        if let Some(bound) = args.max_error {
+            let verdict = if passed { "passes" } else { "FAILS" };
+            println!(
+                "  {verdict} --max-error {bound:e} (node max error {:.2e})",
+                report.node_max_error
+            );
+        }
+    }
+    Ok(passed)
+}

@@ -1,0 +1,340 @@
+//! Reading tables to audit: kiln's own files (JSON sidecar, EXR, binary) with their metadata, and
+//! external tables (text, raw f32/f16, one EXR channel) whose layout the caller describes.
+
+use crate::error::{Error, Result};
+use crate::format::json::{KIND, Sidecar};
+use crate::format::metadata::Metadata;
+use crate::format::{Precision, binary, exr};
+use crate::integrate::QmcSettings;
+use crate::model::{Model, RoughnessConvention};
+use crate::table::axis::{Axis, Grid, MuMapping};
+use crate::table::{Quantity, Table, TableSpec};
+use std::path::Path;
+
+/// The two kinds of axis a table can have.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
+pub enum AxisName {
+    /// `mu = cos(theta)`.
+    Mu,
+    /// Roughness, in the layout's convention.
+    R,
+}
+
+/// How an external table is laid out: everything a file of bare numbers does not say.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Layout {
+    pub model: Model,
+    pub quantity: Quantity,
+    /// Sizes, slowest-varying axis first (one size for `E_avg`).
+    pub shape: Vec<usize>,
+    /// The axes in the same order as `shape` (`[Mu, R]` when mu varies slowest).
+    pub order: Vec<AxisName>,
+    pub grid: Grid,
+    pub roughness: RoughnessConvention,
+    pub mu_mapping: MuMapping,
+}
+
+/// How to read the numbers of an external table.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Encoding {
+    /// Numbers separated by whitespace or commas; `#` starts a comment.
+    Text,
+    /// Little-endian floats and nothing else.
+    Raw(Precision),
+    /// One channel of an EXR image, rows top to bottom.
+    ExrChannel(String),
+}
+
+fn invalid(path: &Path, message: impl std::fmt::Display) -> Error {
+    Error::InvalidInput(format!("{}: {message}", path.display()))
+}
+
+fn read(path: &Path) -> Result<Vec<u8>> {
+    std::fs::read(path).map_err(|source| Error::Io {
+        path: path.to_path_buf(),
+        action: "read",
+        source,
+    })
+}
+
+/// Checks that no value is NaN or infinite, naming the first one that is.
+fn check_finite(path: &Path, values: &[f64]) -> Result<()> {
+    match values.iter().position(|v| !v.is_finite()) {
+        Some(k) => Err(invalid(
+            path,
+            format!("value {k} is {}, not a finite number", values[k]),
+        )),
+        None => Ok(()),
+    }
+}
+
+fn table_from_channel(spec: TableSpec, values: Vec<f64>, command: String) -> Table {
+    Table {
+        one_minus_value: values.iter().map(|v| 1.0 - v).collect(),
+        std_error: vec![0.0; values.len()],
+        value: values,
+        spec,
+        command,
+        node_errors: None,
+    }
+}
+
+fn channel(path: &Path, channels: &[(String, Vec<f64>)], name: &str) -> Result<Vec<f64>> {
+    channels
+        .iter()
+        .find(|(n, _)| n == name)
+        .map(|(_, v)| v.clone())
+        .ok_or_else(|| {
+            let names: Vec<&str> = channels.iter().map(|(n, _)| n.as_str()).collect();
+            invalid(
+                path,
+                format!("no channel '{name}' (it has {})", names.join(", ")),
+            )
+        })
+}
+
+/// Reads one of kiln's own files, if it is one: a JSON sidecar, an EXR with kiln's metadata, or a
+/// kiln binary (whose model comes from its sidecar beside it). `Ok(None)` for anything else.
+pub fn read_kiln(path: &Path) -> Result<Option<Table>> {
+    let bytes = read(path)?;
+    let extension = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
+    let from_metadata = |metadata: Metadata, channels: &[(String, Vec<f64>)]| -> Result<Table> {
+        let values = channel(path, channels, &metadata.quantity)?;
+        check_finite(path, &values)?;
+        if values.len() != metadata.spec.len() {
+            return Err(invalid(
+                path,
+                format!(
+                    "{} values for shape {:?}",
+                    values.len(),
+                    metadata.spec.shape()
+                ),
+            ));
+        }
+        let mut table = table_from_channel(metadata.spec, values, metadata.command);
+        if let Ok(one_minus) = channel(path, channels, &format!("one_minus_{}", metadata.quantity))
+        {
+            table.one_minus_value = one_minus;
+        }
+        if let Ok(std_error) = channel(path, channels, "std_error") {
+            table.std_error = std_error;
+        }
+        Ok(table)
+    };
+    match extension.as_str() {
+        "json" => {
+            let sidecar = match serde_json::from_slice::<Sidecar>(&bytes) {
+                Ok(sidecar) => sidecar,
+                Err(e) => {
+                    // A kiln sidecar this kiln cannot read is an error, not an external table.
+                    let value: Option<serde_json::Value> = serde_json::from_slice(&bytes).ok();
+                    if value
+                        .as_ref()
+                        .and_then(|v| v.get("kind"))
+                        .and_then(|k| k.as_str())
+                        == Some(KIND)
+                    {
+                        return Err(invalid(
+                            path,
+                            format!(
+                                "unreadable kiln sidecar ({e}); was it written by another kiln version?"
+                            ),
+                        ));
+                    }
+                    return Ok(None);
+                }
+            };
+            if sidecar.kind != KIND {
+                return Ok(None);
+            }
+            let channels: Vec<(String, Vec<f64>)> = sidecar.data.into_iter().collect();
+            from_metadata(sidecar.metadata, &channels).map(Some)
+        }
+        "exr" => {
+            let image = exr::decode(&bytes).map_err(|e| invalid(path, e))?;
+            let Some(text) = image.metadata else {
+                return Ok(None);
+            };
+            let metadata: Metadata = serde_json::from_str(&text)
+                .map_err(|e| invalid(path, format!("bad kiln metadata: {e}")))?;
+            from_metadata(metadata, &image.channels).map(Some)
+        }
+        _ if bytes.starts_with(binary::MAGIC) => {
+            let contents = binary::decode(&bytes).map_err(|e| invalid(path, e))?;
+            let sidecar_path = path.with_extension("json");
+            let sidecar = read_kiln(&sidecar_path).ok().flatten().ok_or_else(|| {
+                invalid(
+                    path,
+                    format!(
+                        "a kiln binary holds no model; its sidecar {} is missing or unreadable",
+                        sidecar_path.display()
+                    ),
+                )
+            })?;
+            let metadata = Metadata::new(&sidecar, "f32");
+            if contents.shape != metadata.spec.shape() {
+                return Err(invalid(path, "shape differs from its sidecar's"));
+            }
+            from_metadata(metadata, &contents.channels).map(Some)
+        }
+        _ => Ok(None),
+    }
+}
+
+/// Reads an external table of bare numbers laid out as `layout` says.
+pub fn read_external(path: &Path, encoding: &Encoding, layout: &Layout) -> Result<Table> {
+    let bytes = read(path)?;
+    let values: Vec<f64> = match encoding {
+        Encoding::Text => {
+            let text = String::from_utf8(bytes)
+                .map_err(|_| invalid(path, "not text (use --dtype for raw floats)"))?;
+            let mut values = Vec::new();
+            for (line_number, line) in text.lines().enumerate() {
+                let line = line.split('#').next().unwrap_or("");
+                for token in line
+                    .split(|c: char| c.is_whitespace() || c == ',')
+                    .filter(|t| !t.is_empty())
+                {
+                    let value: f64 = token.parse().map_err(|_| {
+                        invalid(
+                            path,
+                            format!("line {}: '{token}' is not a number", line_number + 1),
+                        )
+                    })?;
+                    values.push(value);
+                }
+            }
+            values
+        }
+        Encoding::Raw(precision) => {
+            let size = precision.bytes();
+            if bytes.len() % size != 0 {
+                return Err(invalid(
+                    path,
+                    format!(
+                        "{} bytes is not a whole number of {}-byte floats",
+                        bytes.len(),
+                        size
+                    ),
+                ));
+            }
+            bytes
+                .chunks_exact(size)
+                .map(|b| match precision {
+                    Precision::F32 => f64::from(f32::from_le_bytes([b[0], b[1], b[2], b[3]])),
+                    Precision::F16 => f64::from(half::f16::from_le_bytes([b[0], b[1]]).to_f32()),
+                })
+                .collect()
+        }
+        Encoding::ExrChannel(name) => {
+            let image = exr::decode(&bytes).map_err(|e| invalid(path, e))?;
+            channel(path, &image.channels, name)?
+        }
+    };
+    let expected: usize = layout.shape.iter().product();
+    if values.len() != expected {
+        return Err(invalid(
+            path,
+            format!(
+                "holds {} values but the layout {:?} needs {expected}",
+                values.len(),
+                layout.shape
+            ),
+        ));
+    }
+    check_finite(path, &values)?;
+    let (spec, values) = spec_and_values(layout, values).map_err(|m| invalid(path, m))?;
+    Ok(table_from_channel(
+        spec,
+        values,
+        format!("external table {}", path.display()),
+    ))
+}
+
+/// Builds kiln's spec for a layout and reorders the values into kiln's order (roughness slowest).
+fn spec_and_values(
+    layout: &Layout,
+    values: Vec<f64>,
+) -> std::result::Result<(TableSpec, Vec<f64>), String> {
+    let roughness_axis = |size| Axis::Roughness {
+        size,
+        convention: layout.roughness,
+        grid: layout.grid,
+    };
+    let mu_axis = |size| Axis::Mu {
+        size,
+        mapping: layout.mu_mapping,
+        grid: layout.grid,
+    };
+    let spec = |roughness, mu| TableSpec {
+        model: layout.model,
+        quantity: layout.quantity,
+        roughness,
+        mu,
+        qmc: QmcSettings::default(),
+    };
+    if layout.shape.len() != layout.order.len() {
+        return Err(format!(
+            "--shape has {} sizes but --order names {} axes",
+            layout.shape.len(),
+            layout.order.len()
+        ));
+    }
+    if layout.shape.iter().any(|&n| n < 2) {
+        return Err(format!(
+            "every axis needs at least 2 samples (shape {:?})",
+            layout.shape
+        ));
+    }
+    match (layout.quantity, &layout.order[..], &layout.shape[..]) {
+        (Quantity::EAvg, [AxisName::R], &[n]) => Ok((spec(roughness_axis(n), None), values)),
+        (Quantity::E, [AxisName::R, AxisName::Mu], &[rows, columns]) => {
+            Ok((spec(roughness_axis(rows), Some(mu_axis(columns))), values))
+        }
+        (Quantity::E, [AxisName::Mu, AxisName::R], &[n_mu, n_r]) => {
+            // Transpose into roughness-major order.
+            let transposed = (0..n_r * n_mu)
+                .map(|k| values[(k % n_mu) * n_r + k / n_mu])
+                .collect();
+            Ok((spec(roughness_axis(n_r), Some(mu_axis(n_mu))), transposed))
+        }
+        (Quantity::E, _, _) => {
+            Err("an E table needs two axes, e.g. --shape 32x32 --order mu,r".into())
+        }
+        (Quantity::EAvg, _, _) => {
+            Err("an E_avg table has one roughness axis, e.g. --shape 32 --order r".into())
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::{Masking, Ndf};
+
+    #[test]
+    fn mu_major_tables_are_transposed_into_roughness_major_order() {
+        let layout = Layout {
+            model: Model {
+                ndf: Ndf::Ggx,
+                masking: Masking::HeightCorrelated,
+            },
+            quantity: Quantity::E,
+            shape: vec![3, 2],
+            order: vec![AxisName::Mu, AxisName::R],
+            grid: Grid::Nodes,
+            roughness: RoughnessConvention::Perceptual,
+            mu_mapping: MuMapping::Linear,
+        };
+        // value = 10 * mu_index + r_index, stored mu-major.
+        let values = vec![0.0, 1.0, 10.0, 11.0, 20.0, 21.0];
+        let (spec, reordered) = spec_and_values(&layout, values).unwrap();
+        assert_eq!(spec.shape(), [2, 3]);
+        assert_eq!(reordered, [0.0, 10.0, 20.0, 1.0, 11.0, 21.0]);
+    }
+}

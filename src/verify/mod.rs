@@ -1,0 +1,285 @@
+//! Auditing a table: its stored values against the deterministic reference (or another table) at
+//! the coordinates it says it was computed at, and what a renderer's bilinear lookup of it returns
+//! between those coordinates.
+
+pub mod input;
+
+use crate::integrate::reference::{ReferenceSettings, reference_albedo, reference_average_albedo};
+use crate::model::RoughnessConvention;
+use crate::table::{Quantity, Table};
+use rayon::prelude::*;
+use serde::Serialize;
+
+/// What the table is compared with.
+#[derive(Clone, Copy, Debug)]
+pub enum Against<'a> {
+    /// The deterministic reference quadrature ([`crate::integrate::reference`]).
+    Reference(ReferenceSettings),
+    /// Another table, through its own bilinear lookup.
+    Table(&'a Table),
+}
+
+/// How to audit.
+#[derive(Clone, Copy, Debug)]
+pub struct AuditSettings {
+    /// The smallest coordinate the table's author actually computed at, on either axis (Cycles
+    /// clamps `r` and `mu` to 1e-4): nodes below it are compared with the truth at this value.
+    pub clamp_min: f64,
+    /// Lookup points per texel along each axis (the axis ends are always included).
+    pub density: usize,
+}
+
+impl Default for AuditSettings {
+    fn default() -> Self {
+        Self {
+            clamp_min: 0.0,
+            density: 2,
+        }
+    }
+}
+
+/// One compared point.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Point {
+    /// `mu` (absent for `E_avg`).
+    pub mu: Option<f64>,
+    /// Roughness in the table's own convention (`r` or `alpha`).
+    pub roughness: f64,
+    pub alpha: f64,
+    /// What the table gives there.
+    pub table: f64,
+    /// What the truth is.
+    pub reference: f64,
+    /// `|table - reference|`.
+    pub error: f64,
+}
+
+/// The audit's findings.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Report {
+    pub quantity: String,
+    pub ndf: String,
+    pub masking: String,
+    pub roughness_axis: String,
+    pub mu_axis: Option<String>,
+    pub grid: String,
+    pub shape: Vec<usize>,
+    pub clamp_min: f64,
+    /// `reference` or the other table's description.
+    pub against: String,
+    /// Stored values against the truth at their own coordinates.
+    pub nodes: usize,
+    pub node_max_error: f64,
+    pub node_rms_error: f64,
+    pub worst_node: Point,
+    /// The bilinear lookup against the truth on a dense grid that includes the axis ends.
+    pub lookup_points: usize,
+    pub lookup_max_error: f64,
+    pub lookup_rms_error: f64,
+    pub lookup_p99_error: f64,
+    pub worst_lookup: Point,
+    /// The largest error estimate of the reference values used (0 against a table).
+    pub reference_error_estimate: f64,
+    /// Whether every reference quadrature met its tolerance.
+    pub reference_converged: bool,
+}
+
+/// The truth at `(mu, roughness)` (roughness in `table`'s convention): value, error estimate and
+/// whether it converged.
+fn truth(table: &Table, against: &Against, mu: Option<f64>, roughness: f64) -> (f64, f64, bool) {
+    let alpha = table.spec.roughness_convention().to_alpha(roughness);
+    match against {
+        Against::Reference(settings) => {
+            let r = match mu {
+                Some(mu) => reference_albedo(table.spec.model, alpha, mu, settings),
+                None => reference_average_albedo(table.spec.model, alpha, settings),
+            };
+            (r.value, r.error, r.converged)
+        }
+        Against::Table(other) => {
+            let theirs = match other.spec.roughness_convention() {
+                RoughnessConvention::Perceptual => alpha.sqrt(),
+                RoughnessConvention::Alpha => alpha,
+            };
+            (other.lookup(mu.unwrap_or(1.0), theirs), 0.0, true)
+        }
+    }
+}
+
+/// Compares the stored values with the truth at the nodes ([`node_errors`]) and the table's
+/// lookup with the truth on a dense grid. Reference evaluations run in parallel (deterministic:
+/// each point is a pure function of its coordinates).
+/// `progress` is called once per compared point (see [`audit_points`] for the count).
+#[must_use]
+pub fn audit(
+    table: &Table,
+    against: &Against,
+    settings: &AuditSettings,
+    progress: &(dyn Fn() + Sync),
+) -> Report {
+    let spec = &table.spec;
+    let convention = spec.roughness_convention();
+    let clamp = |x: f64| x.max(settings.clamp_min);
+
+    // Nodes: each stored value against the truth where the table says it was computed.
+    let n_mu = spec.mu.map_or(1, |axis| axis.size());
+    let nodes: Vec<(Point, f64, bool)> = (0..spec.len())
+        .into_par_iter()
+        .map(|k| {
+            let roughness = clamp(spec.roughness.value(k / n_mu));
+            let mu = spec.mu.map(|axis| clamp(axis.value(k % n_mu)));
+            let (reference, error_estimate, converged) = truth(table, against, mu, roughness);
+            progress();
+            let value = table.value[k];
+            let point = Point {
+                mu,
+                roughness,
+                alpha: convention.to_alpha(roughness),
+                table: value,
+                reference,
+                error: (value - reference).abs(),
+            };
+            (point, error_estimate, converged)
+        })
+        .collect();
+
+    // Lookups: the texture coordinate t runs over [0, 1] in steps of 1 / (density * N).
+    let ladder = |n: usize| -> Vec<f64> {
+        let steps = settings.density.max(1) * n;
+        (0..=steps).map(|j| j as f64 / steps as f64).collect()
+    };
+    let r_points = ladder(spec.roughness.size());
+    let mu_points: Vec<Option<f64>> = match spec.mu {
+        Some(crate::table::axis::Axis::Mu { size, mapping, .. }) => ladder(size)
+            .into_iter()
+            .map(|t| Some(mapping.mu(t)))
+            .collect(),
+        _ => vec![None],
+    };
+    let coordinates: Vec<(f64, Option<f64>)> = r_points
+        .iter()
+        .flat_map(|&r| mu_points.iter().map(move |&mu| (r, mu)))
+        .collect();
+    let lookups: Vec<(Point, f64, bool)> = coordinates
+        .into_par_iter()
+        .map(|(roughness, mu)| {
+            let (reference, error_estimate, converged) = truth(table, against, mu, roughness);
+            progress();
+            let value = table.lookup(mu.unwrap_or(1.0), roughness);
+            let point = Point {
+                mu,
+                roughness,
+                alpha: convention.to_alpha(roughness),
+                table: value,
+                reference,
+                error: (value - reference).abs(),
+            };
+            (point, error_estimate, converged)
+        })
+        .collect();
+
+    let worst = |points: &[(Point, f64, bool)]| {
+        points
+            .iter()
+            .map(|p| p.0)
+            .max_by(|a, b| a.error.total_cmp(&b.error))
+            .expect("points")
+    };
+    let rms = |points: &[(Point, f64, bool)]| {
+        (points.iter().map(|p| p.0.error * p.0.error).sum::<f64>() / points.len() as f64).sqrt()
+    };
+    let mut lookup_errors: Vec<f64> = lookups.iter().map(|p| p.0.error).collect();
+    lookup_errors.sort_by(f64::total_cmp);
+    let p99 = lookup_errors
+        [((0.99 * lookup_errors.len() as f64).ceil() as usize).clamp(1, lookup_errors.len()) - 1];
+    let all = nodes.iter().chain(&lookups);
+    let reference_error_estimate = all.clone().map(|p| p.1).fold(0.0, f64::max);
+    let reference_converged = all.clone().all(|p| p.2);
+    let (worst_node, worst_lookup) = (worst(&nodes), worst(&lookups));
+    Report {
+        quantity: spec.quantity.symbol().to_string(),
+        ndf: spec.model.ndf.name().to_string(),
+        masking: spec.model.masking.name().to_string(),
+        roughness_axis: convention.name().to_string(),
+        mu_axis: spec.mu.map(|axis| match axis {
+            crate::table::axis::Axis::Mu { mapping, .. } => mapping.name().to_string(),
+            _ => unreachable!(),
+        }),
+        grid: spec.roughness.grid().name().to_string(),
+        shape: spec.shape(),
+        clamp_min: settings.clamp_min,
+        against: match against {
+            Against::Reference(_) => "reference".to_string(),
+            Against::Table(other) => format!("table {}", other.spec.id()),
+        },
+        nodes: nodes.len(),
+        node_max_error: worst_node.error,
+        node_rms_error: rms(&nodes),
+        worst_node,
+        lookup_points: lookups.len(),
+        lookup_max_error: worst_lookup.error,
+        lookup_rms_error: rms(&lookups),
+        lookup_p99_error: p99,
+        worst_lookup,
+        reference_error_estimate,
+        reference_converged,
+    }
+}
+
+/// How many points [`audit`] compares: every node, and `(density N + 1)` lookups per axis.
+#[must_use]
+pub fn audit_points(table: &Table, settings: &AuditSettings) -> u64 {
+    let lookups: usize = table
+        .spec
+        .shape()
+        .iter()
+        .map(|&n| settings.density.max(1) * n + 1)
+        .product();
+    (table.spec.len() + lookups) as u64
+}
+
+/// The largest number of `E_avg` entries [`node_errors`] checks: each costs the reference about
+/// half a second (a nested three-level quadrature).
+pub const MAX_AVERAGE_ENTRIES_CHECKED: usize = 5;
+
+/// Node errors of a freshly baked table against the reference, in `1 - E` (which both carry
+/// directly): on every texel of an `E` table, and on at most [`MAX_AVERAGE_ENTRIES_CHECKED`]
+/// evenly spaced entries of an `E_avg` table, first and last included. What `kiln bake` records.
+#[must_use]
+pub fn node_errors(table: &Table, settings: &ReferenceSettings) -> NodeErrors {
+    let spec = &table.spec;
+    let n = spec.len();
+    let indices: Vec<usize> = if spec.quantity == Quantity::E || n <= MAX_AVERAGE_ENTRIES_CHECKED {
+        (0..n).collect()
+    } else {
+        let last = MAX_AVERAGE_ENTRIES_CHECKED - 1;
+        (0..=last)
+            .map(|j| (j * (n - 1) + last / 2) / last)
+            .collect()
+    };
+    let errors: Vec<f64> = indices
+        .par_iter()
+        .map(|&k| {
+            let (alpha, mu) = spec.texel_coordinates(k);
+            let reference = match mu {
+                Some(mu) => reference_albedo(spec.model, alpha, mu, settings),
+                None => reference_average_albedo(spec.model, alpha, settings),
+            };
+            (table.one_minus_value[k] - reference.one_minus_value).abs()
+        })
+        .collect();
+    NodeErrors {
+        max: errors.iter().copied().fold(0.0, f64::max),
+        rms: (errors.iter().map(|e| e * e).sum::<f64>() / errors.len() as f64).sqrt(),
+        texels: errors.len(),
+    }
+}
+
+/// The node errors `kiln bake` measures and records.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, serde::Deserialize)]
+pub struct NodeErrors {
+    pub max: f64,
+    pub rms: f64,
+    /// How many texels were checked.
+    pub texels: usize,
+}
