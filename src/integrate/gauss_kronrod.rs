@@ -167,8 +167,8 @@ pub fn integrate_pieces<const N: usize>(
     intervals.sort_by(|x, y| x.a.total_cmp(&y.a));
     let mut value = [0.0; N];
     for interval in &intervals {
-        for c in 0..N {
-            value[c] += interval.value[c];
+        for (total, part) in value.iter_mut().zip(interval.value) {
+            *total += part;
         }
     }
     Quadrature {

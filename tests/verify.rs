@@ -1,0 +1,427 @@
+//! `kiln verify`: kiln's own tables, external tables in every format and layout, bad input, the
+//! `--max-error` gate, and an audit of Blender Cycles' shipped GGX table.
+
+#![cfg(feature = "cli")]
+
+use kiln::integrate::reference::{ReferenceSettings, reference_albedo};
+use kiln::verify::{Against, AuditSettings, audit};
+use kiln::{BakeOptions, Masking, Model, Ndf, RoughnessConvention};
+use serde_json::Value;
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn kiln(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_kiln"))
+        .args(args)
+        .output()
+        .expect("kiln runs")
+}
+
+/// Runs `kiln verify ... --json` and returns its exit status and report.
+fn verify(args: &[&str]) -> (Option<i32>, Value) {
+    let mut all = vec!["verify", "--json"];
+    all.extend_from_slice(args);
+    let output = kiln(&all);
+    let report = serde_json::from_slice(&output.stdout).unwrap_or(Value::Null);
+    assert!(
+        report != Value::Null || output.status.code() == Some(2),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    (output.status.code(), report)
+}
+
+fn number(report: &Value, field: &str) -> f64 {
+    report[field]
+        .as_f64()
+        .unwrap_or_else(|| panic!("no {field} in {report}"))
+}
+
+fn bake(dir: &Path, extra: &[&str]) {
+    let mut args = vec![
+        "bake",
+        "--size",
+        "6",
+        "--samples",
+        "16384",
+        "--avg-samples",
+        "16384",
+        "--no-reference-check",
+        "--format",
+        "exr,bin,json",
+        "-q",
+        "--out",
+        dir.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    let output = kiln(&args);
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+}
+
+fn sidecar_values(path: &Path) -> Vec<f64> {
+    let sidecar: Value = serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap();
+    sidecar["data"]["E"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect()
+}
+
+/// Where QMC is not dominated by rare events (alpha >= 0.06 here), every node's error against the
+/// reference is within five of its standard errors (plus the reference's own 1e-10).
+#[test]
+fn node_errors_of_a_kiln_table_are_consistent_with_its_standard_errors() {
+    let options = BakeOptions {
+        size: 8,
+        samples: 1 << 16,
+        average_samples: 1 << 16,
+        roughness_convention: RoughnessConvention::Alpha,
+        check_against_reference: false,
+        ..BakeOptions::default()
+    };
+    let tables = options.bake(&|_| {}).unwrap();
+    let e = &tables[0];
+    let report = audit(
+        e,
+        &Against::Reference(ReferenceSettings::default()),
+        &AuditSettings::default(),
+        &|| {},
+    );
+    let mut largest_ratio: f64 = 0.0;
+    for k in 0..e.spec.len() {
+        let (alpha, mu) = e.spec.texel_coordinates(k);
+        let r = reference_albedo(
+            e.spec.model,
+            alpha,
+            mu.unwrap(),
+            &ReferenceSettings::default(),
+        );
+        let error = (e.value[k] - r.value).abs();
+        assert!(
+            error <= 5.0 * e.std_error[k] + 1e-10,
+            "texel {k}: error {error:.2e}, std error {:.2e}",
+            e.std_error[k]
+        );
+        largest_ratio = largest_ratio.max(error / e.std_error[k]);
+    }
+    assert!(report.node_max_error <= 5.0 * e.max_std_error());
+    // A sanity check of the other side: errors are not all far below their standard errors.
+    assert!(largest_ratio > 0.5, "{largest_ratio}");
+}
+
+#[test]
+fn every_input_format_and_layout_gives_the_same_audit() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    bake(d, &[]);
+    let (status, from_json) = verify(&[d.join("ggx-height-correlated-E.json").to_str().unwrap()]);
+    assert_eq!(status, Some(0));
+    let node = number(&from_json, "node_max_error");
+    let lookup = number(&from_json, "lookup_max_error");
+    assert_eq!(from_json["nodes"], 36);
+    assert_eq!(from_json["lookup_points"], 13 * 13);
+
+    // kiln's EXR and binary hold f32: the same audit to within f32 rounding.
+    let (_, from_exr) = verify(&[d.join("ggx-height-correlated-E.exr").to_str().unwrap()]);
+    let (_, from_bin) = verify(&[d.join("ggx-height-correlated-E.bin").to_str().unwrap()]);
+    for report in [&from_exr, &from_bin] {
+        assert!(
+            (number(report, "node_max_error") - node).abs() < 1e-7,
+            "{report}"
+        );
+        assert!(
+            (number(report, "lookup_max_error") - lookup).abs() < 1e-7,
+            "{report}"
+        );
+    }
+
+    // External text, roughness-major and whitespace-separated: identical to the sidecar.
+    let values = sidecar_values(&d.join("ggx-height-correlated-E.json"));
+    let text: Vec<String> = values.iter().map(|v| format!("{v:?}")).collect();
+    std::fs::write(
+        d.join("r-major.txt"),
+        format!("# kiln E, r rows\n{}\n", text.join(" ")),
+    )
+    .unwrap();
+    let (_, from_text) = verify(&[d.join("r-major.txt").to_str().unwrap(), "--shape", "6x6"]);
+    assert_eq!(number(&from_text, "node_max_error"), node);
+    assert_eq!(number(&from_text, "lookup_max_error"), lookup);
+
+    // Transposed (mu-major), comma-separated, with --order mu,r: identical again.
+    let transposed: Vec<String> = (0..36)
+        .map(|k| format!("{:?}", values[(k % 6) * 6 + k / 6]))
+        .collect();
+    std::fs::write(d.join("mu-major.csv"), transposed.join(",")).unwrap();
+    let (_, from_csv) = verify(&[
+        d.join("mu-major.csv").to_str().unwrap(),
+        "--shape",
+        "6x6",
+        "--order",
+        "mu,r",
+    ]);
+    assert_eq!(number(&from_csv, "node_max_error"), node);
+    assert_eq!(number(&from_csv, "lookup_max_error"), lookup);
+
+    // Raw f32 equals kiln's f32 files; raw f16 is within half-float rounding (2^-11 below 1).
+    let f32_bytes: Vec<u8> = values
+        .iter()
+        .flat_map(|&v| (v as f32).to_le_bytes())
+        .collect();
+    std::fs::write(d.join("e.f32"), f32_bytes).unwrap();
+    let (_, raw32) = verify(&[
+        d.join("e.f32").to_str().unwrap(),
+        "--shape",
+        "6x6",
+        "--dtype",
+        "f32",
+    ]);
+    assert_eq!(
+        number(&raw32, "node_max_error"),
+        number(&from_exr, "node_max_error")
+    );
+    let f16_bytes: Vec<u8> = values
+        .iter()
+        .flat_map(|&v| half::f16::from_f32(v as f32).to_le_bytes())
+        .collect();
+    std::fs::write(d.join("e.f16"), f16_bytes).unwrap();
+    let (_, raw16) = verify(&[
+        d.join("e.f16").to_str().unwrap(),
+        "--shape",
+        "6x6",
+        "--dtype",
+        "f16",
+    ]);
+    assert!(
+        (number(&raw16, "node_max_error") - node).abs() <= 2f64.powi(-11),
+        "{raw16}"
+    );
+
+    // One EXR channel, read as an external table.
+    let (_, channel) = verify(&[
+        d.join("ggx-height-correlated-E.exr").to_str().unwrap(),
+        "--channel",
+        "E",
+        "--shape",
+        "6x6",
+    ]);
+    assert_eq!(
+        number(&channel, "node_max_error"),
+        number(&from_exr, "node_max_error")
+    );
+}
+
+#[test]
+fn layout_flags_match_the_tables_they_describe() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    bake(
+        d,
+        &[
+            "--grid",
+            "nodes",
+            "--mu-axis",
+            "sqrt",
+            "--roughness-axis",
+            "alpha",
+            "--masking",
+            "separable",
+        ],
+    );
+    let json = d.join("ggx-separable-E.json");
+    let (_, own) = verify(&[json.to_str().unwrap()]);
+    let text: Vec<String> = sidecar_values(&json)
+        .iter()
+        .map(|v| format!("{v:?}"))
+        .collect();
+    std::fs::write(d.join("e.txt"), text.join("\n")).unwrap();
+    let flags = [
+        "--shape",
+        "6x6",
+        "--grid",
+        "nodes",
+        "--mu-axis",
+        "sqrt",
+        "--roughness-axis",
+        "alpha",
+        "--masking",
+        "separable",
+    ];
+    let mut args = vec![d.join("e.txt").to_str().unwrap().to_string()];
+    args.extend(flags.iter().map(|s| s.to_string()));
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let (_, external) = verify(&args);
+    for field in [
+        "node_max_error",
+        "node_rms_error",
+        "lookup_max_error",
+        "lookup_p99_error",
+    ] {
+        assert_eq!(number(&external, field), number(&own, field), "{field}");
+    }
+    // A wrong flag is visible: the same numbers read as height-correlated are far off.
+    let mut wrong = args.clone();
+    wrong.truncate(wrong.len() - 2);
+    let (_, misread) = verify(&wrong);
+    assert!(number(&misread, "node_max_error") > 100.0 * number(&own, "node_max_error"));
+}
+
+#[test]
+fn clamp_min_says_where_the_first_nodes_were_computed() {
+    // A 3 x 3 node table computed Cycles' way: coordinates below 1e-4 moved up to 1e-4.
+    let model = Model {
+        ndf: Ndf::Ggx,
+        masking: Masking::HeightCorrelated,
+    };
+    let s = ReferenceSettings::default();
+    let axis = [0.0f64, 0.5, 1.0];
+    let mut values = Vec::new();
+    for &mu in &axis {
+        for &r in &axis {
+            let (mu, r) = (mu.max(1e-4), r.max(1e-4));
+            values.push(format!(
+                "{:?}",
+                reference_albedo(model, r * r, mu, &s).value
+            ));
+        }
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("clamped.txt");
+    std::fs::write(&path, values.join(" ")).unwrap();
+    let p = path.to_str().unwrap();
+    let layout = ["--shape", "3x3", "--order", "mu,r", "--grid", "nodes"];
+    let (_, clamped) = verify(&[&[p, "--clamp-min", "1e-4"][..], &layout].concat());
+    let (_, unclamped) = verify(&[&[p][..], &layout].concat());
+    assert!(number(&clamped, "node_max_error") < 1e-9, "{clamped}");
+    // Without the flag the mu = 0 row is compared with E(mu = 0) = 1, which it is not: the largest gap
+    // is at r = 1, 1 - E(mu = 1e-4, alpha = 1).
+    let gap = 1.0 - reference_albedo(model, 1.0, 1e-4, &s).value;
+    assert!(
+        (number(&unclamped, "node_max_error") - gap).abs() < 1e-9,
+        "{unclamped} vs {gap}"
+    );
+}
+
+#[test]
+fn bad_tables_get_a_clear_error_and_status_2() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("short.txt"), "0.5 0.6 0.7").unwrap();
+    std::fs::write(d.join("nan.txt"), "0.5 NaN 0.7 0.8").unwrap();
+    std::fs::write(d.join("word.txt"), "0.5 half 0.7 0.8").unwrap();
+    std::fs::write(d.join("odd.f32"), [0u8; 10]).unwrap();
+    let cases: &[(&[&str], &str)] = &[
+        (&["short.txt", "--shape", "2x2"], "holds 3 values"),
+        (&["nan.txt", "--shape", "2x2"], "not a finite number"),
+        (&["word.txt", "--shape", "2x2"], "'half' is not a number"),
+        (
+            &["odd.f32", "--shape", "2x2", "--dtype", "f32"],
+            "whole number",
+        ),
+        (&["short.txt"], "--shape"),
+        (
+            &["short.txt", "--shape", "3", "--quantity", "e"],
+            "--order names 2 axes",
+        ),
+        (&["short.txt", "--shape", "0x3"], "shape"),
+        (&["missing.txt", "--shape", "2x2"], "missing.txt"),
+        (
+            &[
+                "short.txt",
+                "--shape",
+                "3",
+                "--quantity",
+                "e-avg",
+                "--max-error",
+                "-1",
+            ],
+            "positive",
+        ),
+    ];
+    for (args, mentions) in cases {
+        let mut full = vec!["verify".to_string()];
+        full.push(d.join(args[0]).to_string_lossy().into_owned());
+        full.extend(args[1..].iter().map(|s| s.to_string()));
+        let full: Vec<&str> = full.iter().map(String::as_str).collect();
+        let output = kiln(&full);
+        let message = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(2), "{args:?}: {message}");
+        assert_eq!(message.trim_end().lines().count(), 1, "{args:?}: {message}");
+        assert!(
+            message.contains(mentions),
+            "{args:?}: '{message}' should mention {mentions}"
+        );
+    }
+}
+
+#[test]
+fn max_error_gates_a_build_and_tables_compare_with_each_other() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    bake(d, &[]);
+    let json = d.join("ggx-height-correlated-E.json");
+    let (status, report) = verify(&[json.to_str().unwrap(), "--max-error", "1e-12"]);
+    assert_eq!(status, Some(1));
+    assert_eq!(report["passed"], false);
+    let (status, report) = verify(&[json.to_str().unwrap(), "--max-error", "0.01"]);
+    assert_eq!(status, Some(0));
+    assert_eq!(report["passed"], true);
+    // Against its own f32 copy: only f32 rounding apart.
+    let exr = d.join("ggx-height-correlated-E.exr");
+    let (_, report) = verify(&[json.to_str().unwrap(), "--against", exr.to_str().unwrap()]);
+    assert!(number(&report, "node_max_error") < 1e-7, "{report}");
+    assert!(report["against"].as_str().unwrap().starts_with("table"));
+}
+
+/// Blender Cycles' shipped GGX table (../shared/anchors, read at run time, never committed):
+/// its nodes are right to the level of its 6-decimal printing; its linear-mu lookup is worst
+/// near grazing at low roughness.
+#[test]
+fn audit_of_cycles_ggx_table() {
+    let anchor = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/anchors/cycles-ggx.json");
+    let text = std::fs::read(&anchor).unwrap_or_else(|e| {
+        panic!(
+            "{}: {e} (the shared anchors sit beside the repository)",
+            anchor.display()
+        )
+    });
+    let anchor: Value = serde_json::from_slice(&text).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("cycles_ggx_E.txt");
+    let numbers: Vec<String> = anchor["ggx_E"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.to_string())
+        .collect();
+    std::fs::write(&path, numbers.join("\n")).unwrap();
+    let (status, report) = verify(&[
+        path.to_str().unwrap(),
+        "--shape",
+        "32x32",
+        "--order",
+        "mu,r",
+        "--grid",
+        "nodes",
+        "--clamp-min",
+        "1e-4",
+    ]);
+    assert_eq!(status, Some(0));
+    // 6 decimals round by up to 5e-7; Cycles' own QMC (2^23 samples) adds about as much.
+    let node = number(&report, "node_max_error");
+    assert!(
+        node < 2e-6 && number(&report, "node_rms_error") < 5e-7,
+        "{report}"
+    );
+    // Between the nodes a linear mu axis misses the grazing boundary layer at mu ~ alpha.
+    assert!(number(&report, "lookup_max_error") > 1e-2, "{report}");
+    let worst = &report["worst_lookup"];
+    assert!(
+        worst["mu"].as_f64().unwrap() < 1.0 / 31.0 && worst["roughness"].as_f64().unwrap() < 0.25,
+        "{worst}"
+    );
+}
