@@ -268,6 +268,40 @@ fn layout_flags_match_the_tables_they_describe() {
     wrong.truncate(wrong.len() - 2);
     let (_, misread) = verify(&wrong);
     assert!(number(&misread, "node_max_error") > 100.0 * number(&own, "node_max_error"));
+    // So are the numbers read as Beckmann's.
+    let mut beckmann = args.clone();
+    beckmann.extend(["--ndf", "beckmann"]);
+    let (_, misread) = verify(&beckmann);
+    assert!(number(&misread, "node_max_error") > 100.0 * number(&own, "node_max_error"));
+
+    // An E_avg table, external text with --quantity e-avg, against kiln's own reading of it.
+    let avg = d.join("ggx-separable-E_avg.json");
+    let (_, own) = verify(&[avg.to_str().unwrap()]);
+    let sidecar: Value = serde_json::from_slice(&std::fs::read(&avg).unwrap()).unwrap();
+    let numbers: Vec<String> = sidecar["data"]["E_avg"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.to_string())
+        .collect();
+    std::fs::write(d.join("avg.txt"), numbers.join(" ")).unwrap();
+    let (_, external) = verify(&[
+        d.join("avg.txt").to_str().unwrap(),
+        "--quantity",
+        "e-avg",
+        "--shape",
+        "6",
+        "--grid",
+        "nodes",
+        "--roughness-axis",
+        "alpha",
+        "--masking",
+        "separable",
+    ]);
+    assert_eq!(own["quantity"], "E_avg");
+    for field in ["node_max_error", "lookup_max_error", "lookup_p99_error"] {
+        assert_eq!(number(&external, field), number(&own, field), "{field}");
+    }
 }
 
 #[test]
