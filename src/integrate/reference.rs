@@ -83,19 +83,31 @@ pub fn reference_albedo(
 ) -> ReferenceValue {
     assert!((0.0..=1.0).contains(&mu) && alpha >= 0.0 && alpha.is_finite());
     if alpha == 0.0 {
-        return ReferenceValue {
-            value: 1.0,
-            one_minus_value: 0.0,
-            error: 0.0,
-            evaluations: 0,
-            converged: true,
-        };
+        return MIRROR;
     }
-    let q = match model.ndf {
+    finish(quadrature_for(model, alpha, mu, settings))
+}
+
+/// A mirror (`alpha = 0`) reflects everything: `E = 1` exactly.
+const MIRROR: ReferenceValue = ReferenceValue {
+    value: 1.0,
+    one_minus_value: 0.0,
+    error: 0.0,
+    evaluations: 0,
+    converged: true,
+};
+
+/// `[E, 1 - E]` for the model's distribution at `alpha`.
+fn quadrature_for(
+    model: Model,
+    alpha: f64,
+    mu: f64,
+    settings: &ReferenceSettings,
+) -> Quadrature<2> {
+    match model.ndf {
         Ndf::Ggx => albedo_quadrature(Ggx { alpha }, model.masking, mu, settings),
         Ndf::Beckmann => albedo_quadrature(Beckmann { alpha }, model.masking, mu, settings),
-    };
-    finish(q)
+    }
 }
 
 /// `E_avg = 2 ∫ E(mu) mu dmu` by nested quadrature.
@@ -107,13 +119,7 @@ pub fn reference_average_albedo(
 ) -> ReferenceValue {
     assert!(alpha >= 0.0 && alpha.is_finite());
     if alpha == 0.0 {
-        return ReferenceValue {
-            value: 1.0,
-            one_minus_value: 0.0,
-            error: 0.0,
-            evaluations: 0,
-            converged: true,
-        };
+        return MIRROR;
     }
     // The inner E(mu) integrals get a tenth of the budget each: their errors add up under the
     // outer integral, whose weight 2 mu integrates to 1.
@@ -124,10 +130,7 @@ pub fn reference_average_albedo(
     let mut evaluations = 0;
     let mut converged = true;
     let mut integrand = |mu: f64| {
-        let q = match model.ndf {
-            Ndf::Ggx => albedo_quadrature(Ggx { alpha }, model.masking, mu, &inner),
-            Ndf::Beckmann => albedo_quadrature(Beckmann { alpha }, model.masking, mu, &inner),
-        };
+        let q = quadrature_for(model, alpha, mu, &inner);
         evaluations += q.evaluations;
         converged &= q.converged;
         let w = 2.0 * mu;

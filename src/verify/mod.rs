@@ -121,6 +121,26 @@ pub fn audit(
     let convention = spec.roughness_convention();
     let clamp = |x: f64| x.max(settings.clamp_min);
 
+    // One table value against the truth at (mu, roughness), with the truth's error estimate.
+    let compare = |mu: Option<f64>, roughness: f64, value: f64| {
+        let (reference, error_estimate, converged) = truth(table, against, mu, roughness);
+        progress();
+        let error = (value - reference).abs();
+        let alpha = convention.to_alpha(roughness);
+        (
+            Point {
+                mu,
+                roughness,
+                alpha,
+                table: value,
+                reference,
+                error,
+            },
+            error_estimate,
+            converged,
+        )
+    };
+
     // Nodes: each stored value against the truth where the table says it was computed.
     let n_mu = spec.mu.map_or(1, |axis| axis.size());
     let nodes: Vec<(Point, f64, bool)> = (0..spec.len())
@@ -128,18 +148,7 @@ pub fn audit(
         .map(|k| {
             let roughness = clamp(spec.roughness.value(k / n_mu));
             let mu = spec.mu.map(|axis| clamp(axis.value(k % n_mu)));
-            let (reference, error_estimate, converged) = truth(table, against, mu, roughness);
-            progress();
-            let value = table.value[k];
-            let point = Point {
-                mu,
-                roughness,
-                alpha: convention.to_alpha(roughness),
-                table: value,
-                reference,
-                error: (value - reference).abs(),
-            };
-            (point, error_estimate, converged)
+            compare(mu, roughness, table.value[k])
         })
         .collect();
 
@@ -162,20 +171,7 @@ pub fn audit(
         .collect();
     let lookups: Vec<(Point, f64, bool)> = coordinates
         .into_par_iter()
-        .map(|(roughness, mu)| {
-            let (reference, error_estimate, converged) = truth(table, against, mu, roughness);
-            progress();
-            let value = table.lookup(mu.unwrap_or(1.0), roughness);
-            let point = Point {
-                mu,
-                roughness,
-                alpha: convention.to_alpha(roughness),
-                table: value,
-                reference,
-                error: (value - reference).abs(),
-            };
-            (point, error_estimate, converged)
-        })
+        .map(|(roughness, mu)| compare(mu, roughness, table.lookup(mu.unwrap_or(1.0), roughness)))
         .collect();
 
     let worst = |points: &[(Point, f64, bool)]| {
