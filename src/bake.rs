@@ -5,11 +5,11 @@
 //! cores and collects them in index order, so a table is byte-identical for any thread count.
 
 use crate::error::{Error, Result};
-use crate::integrate::reference::ReferenceSettings;
+use crate::integrate::reference::{ReferenceSettings, reference_albedo, reference_average_albedo};
 use crate::integrate::{Estimate, QmcSettings, albedo, average_albedo};
 use crate::model::{Masking, Model, Ndf, RoughnessConvention};
 use crate::table::axis::{Axis, Grid, MuMapping};
-use crate::table::{Quantity, Table, TableSpec};
+use crate::table::{Method, Quantity, Table, TableSpec};
 use crate::verify::node_errors;
 use rayon::prelude::*;
 
@@ -34,8 +34,11 @@ pub struct BakeOptions {
     pub roughness_convention: RoughnessConvention,
     pub mu_mapping: MuMapping,
     pub grid: Grid,
-    /// Measure each table's node error against the deterministic reference after baking.
+    /// Measure each table's node error against the deterministic reference after baking (only
+    /// meaningful for [`Method::Qmc`]).
     pub check_against_reference: bool,
+    /// How to compute the values.
+    pub method: Method,
 }
 
 impl Default for BakeOptions {
@@ -52,6 +55,7 @@ impl Default for BakeOptions {
             mu_mapping: MuMapping::Linear,
             grid: Grid::Centers,
             check_against_reference: true,
+            method: Method::Qmc,
         }
     }
 }
@@ -133,6 +137,7 @@ impl BakeOptions {
                         quantity: Quantity::E,
                         roughness,
                         mu: Some(mu),
+                        method: self.method,
                         qmc: qmc(self.samples),
                     },
                     TableSpec {
@@ -140,6 +145,7 @@ impl BakeOptions {
                         quantity: Quantity::EAvg,
                         roughness,
                         mu: None,
+                        method: self.method,
                         qmc: qmc(self.average_samples),
                     },
                 ]
@@ -151,6 +157,18 @@ impl BakeOptions {
     /// every setting spelled out.
     #[must_use]
     pub fn command_for(&self, model: Model) -> String {
+        if self.method == Method::Reference {
+            return format!(
+                "kiln bake --method reference --ndf {} --masking {} --size {} --roughness-axis {} \
+                 --mu-axis {} --grid {}",
+                model.ndf,
+                model.masking,
+                self.size,
+                self.roughness_convention,
+                self.mu_mapping.name(),
+                self.grid.name()
+            );
+        }
         format!(
             "kiln bake --ndf {} --masking {} --size {} --samples {} --avg-samples {} \
              --scrambles {} --seed {} --roughness-axis {} --mu-axis {} --grid {}",
@@ -181,7 +199,7 @@ impl BakeOptions {
             .map(|spec| {
                 let command = self.command_for(spec.model);
                 let mut table = bake_table(spec, command, progress);
-                if self.check_against_reference {
+                if self.check_against_reference && self.method == Method::Qmc {
                     table.node_errors = Some(node_errors(&table, &ReferenceSettings::default()));
                 }
                 table
@@ -223,8 +241,24 @@ pub fn bake_table(spec: TableSpec, command: String, progress: &(dyn Fn(u64) + Sy
 /// The estimate of one texel (row-major index, slowest axis first).
 #[must_use]
 pub fn estimate_texel(spec: &TableSpec, index: usize) -> Estimate {
-    match spec.texel_coordinates(index) {
-        (alpha, Some(mu)) => albedo(spec.model, alpha, mu, &spec.qmc),
-        (alpha, None) => average_albedo(spec.model, alpha, &spec.qmc),
+    let (alpha, mu) = spec.texel_coordinates(index);
+    match spec.method {
+        Method::Qmc => match mu {
+            Some(mu) => albedo(spec.model, alpha, mu, &spec.qmc),
+            None => average_albedo(spec.model, alpha, &spec.qmc),
+        },
+        Method::Reference => {
+            let settings = ReferenceSettings::default();
+            let r = match mu {
+                Some(mu) => reference_albedo(spec.model, alpha, mu, &settings),
+                None => reference_average_albedo(spec.model, alpha, &settings),
+            };
+            Estimate {
+                value: r.value,
+                one_minus_value: r.one_minus_value,
+                std_error: r.error,
+                samples: r.evaluations,
+            }
+        }
     }
 }

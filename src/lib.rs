@@ -45,4 +45,4 @@ pub use format::{Format, Precision};
 pub use integrate::{Estimate, QmcSettings, albedo, average_albedo};
 pub use model::{Masking, Model, Ndf, RoughnessConvention};
 pub use table::axis::{Axis, Grid, MuMapping};
-pub use table::{Quantity, Table, TableSpec};
+pub use table::{Method, Quantity, Table, TableSpec};

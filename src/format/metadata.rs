@@ -65,6 +65,7 @@ pub struct Metadata {
     pub channels: Vec<String>,
     /// How the values were computed.
     pub estimator: String,
+    /// QMC evaluations per texel (0 for the reference quadrature, which adapts per texel).
     pub samples_per_texel: u64,
     pub scrambles: u32,
     pub seed: u64,
@@ -111,11 +112,11 @@ impl Metadata {
             layout,
             axes,
             channels: table.channel_names().to_vec(),
-            estimator: "quasi-Monte Carlo: visible-normal (VNDF) importance sampling driven by \
-                        Owen-scrambled Sobol points (Burley 2020); std_error from independent \
-                        scrambles"
-                .to_string(),
-            samples_per_texel: spec.qmc.samples,
+            estimator: spec.method.describe().to_string(),
+            samples_per_texel: match spec.method {
+                crate::table::Method::Qmc => spec.qmc.samples,
+                crate::table::Method::Reference => 0,
+            },
             scrambles: spec.qmc.scrambles,
             seed: spec.qmc.seed,
             max_std_error: table.max_std_error(),

@@ -110,12 +110,19 @@ pub fn encode(table: &Table) -> String {
             axis.name.to_uppercase()
         );
     }
-    let _ = writeln!(
-        out,
-        "/// - Measured error: max standard error {:.2e}, rms {:.2e}, from {} samples per texel in \
-         {} scrambles.",
-        meta.max_std_error, meta.rms_std_error, meta.samples_per_texel, meta.scrambles
-    );
+    let _ = match meta.spec.method {
+        crate::table::Method::Qmc => writeln!(
+            out,
+            "/// - Measured error: max standard error {:.2e}, rms {:.2e}, from {} samples per \
+             texel in {} scrambles.",
+            meta.max_std_error, meta.rms_std_error, meta.samples_per_texel, meta.scrambles
+        ),
+        crate::table::Method::Reference => writeln!(
+            out,
+            "/// - Error: at most {:.2e} (the quadrature's own estimate, largest over texels).",
+            meta.max_std_error
+        ),
+    };
     if let (Some(max), Some(texels)) = (meta.node_max_error, meta.node_error_texels) {
         let _ = writeln!(
             out,

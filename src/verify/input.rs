@@ -276,6 +276,7 @@ fn spec_and_values(
         quantity: layout.quantity,
         roughness,
         mu,
+        method: crate::table::Method::Qmc,
         qmc: QmcSettings::default(),
     };
     if layout.shape.len() != layout.order.len() {
