@@ -62,9 +62,10 @@ fn bake(dir: &Path, extra: &[&str]) {
     );
 }
 
-fn sidecar_values(path: &Path) -> Vec<f64> {
+/// One channel of a kiln sidecar, in f64.
+fn sidecar_values(path: &Path, channel: &str) -> Vec<f64> {
     let sidecar: Value = serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap();
-    sidecar["data"]["E"]
+    sidecar["data"][channel]
         .as_array()
         .unwrap()
         .iter()
@@ -141,7 +142,7 @@ fn every_input_format_and_layout_gives_the_same_audit() {
     }
 
     // External text, roughness-major and whitespace-separated: identical to the sidecar.
-    let values = sidecar_values(&d.join("ggx-height-correlated-E.json"));
+    let values = sidecar_values(&d.join("ggx-height-correlated-E.json"), "E");
     let text: Vec<String> = values.iter().map(|v| format!("{v:?}")).collect();
     std::fs::write(
         d.join("r-major.txt"),
@@ -234,7 +235,7 @@ fn layout_flags_match_the_tables_they_describe() {
     );
     let json = d.join("ggx-separable-E.json");
     let (_, own) = verify(&[json.to_str().unwrap()]);
-    let text: Vec<String> = sidecar_values(&json)
+    let text: Vec<String> = sidecar_values(&json, "E")
         .iter()
         .map(|v| format!("{v:?}"))
         .collect();
@@ -277,12 +278,9 @@ fn layout_flags_match_the_tables_they_describe() {
     // An E_avg table, external text with --quantity e-avg, against kiln's own reading of it.
     let avg = d.join("ggx-separable-E_avg.json");
     let (_, own) = verify(&[avg.to_str().unwrap()]);
-    let sidecar: Value = serde_json::from_slice(&std::fs::read(&avg).unwrap()).unwrap();
-    let numbers: Vec<String> = sidecar["data"]["E_avg"]
-        .as_array()
-        .unwrap()
+    let numbers: Vec<String> = sidecar_values(&avg, "E_avg")
         .iter()
-        .map(|v| v.to_string())
+        .map(|v| format!("{v:?}"))
         .collect();
     std::fs::write(d.join("avg.txt"), numbers.join(" ")).unwrap();
     let (_, external) = verify(&[
