@@ -139,6 +139,16 @@ impl VerifyArgs {
                 return Ok(table);
             }
         }
+        let is_exr = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+        if is_exr && self.channel.is_none() {
+            return Err(kiln::Error::InvalidInput(format!(
+                "{} is an EXR without kiln's metadata: name the channel to read with --channel \
+                 and give the layout (--shape, --order, ...)",
+                path.display()
+            )));
+        }
         let encoding = match (&self.channel, self.dtype) {
             (Some(name), _) => Encoding::ExrChannel(name.clone()),
             (None, Some(dtype)) => Encoding::Raw(dtype),
