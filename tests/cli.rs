@@ -7,12 +7,9 @@ use kiln::format::{binary, exr, json::Sidecar};
 use std::path::Path;
 use std::process::{Command, Output};
 
-fn kiln(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_kiln"))
-        .args(args)
-        .output()
-        .expect("kiln runs")
-}
+#[path = "common/command.rs"]
+mod command;
+use command::kiln;
 
 fn stderr(output: &Output) -> String {
     String::from_utf8_lossy(&output.stderr).into_owned()

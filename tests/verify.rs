@@ -8,14 +8,10 @@ use kiln::verify::{Against, AuditSettings, audit};
 use kiln::{BakeOptions, Masking, Model, Ndf, RoughnessConvention};
 use serde_json::Value;
 use std::path::Path;
-use std::process::{Command, Output};
 
-fn kiln(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_kiln"))
-        .args(args)
-        .output()
-        .expect("kiln runs")
-}
+#[path = "common/command.rs"]
+mod command;
+use command::kiln;
 
 /// Runs `kiln verify ... --json` and returns its exit status and report.
 fn verify(args: &[&str]) -> (Option<i32>, Value) {

@@ -94,6 +94,32 @@ fn channel(path: &Path, channels: &[(String, Vec<f64>)], name: &str) -> Result<V
         })
 }
 
+/// Parses a kiln JSON sidecar; `Ok(None)` for JSON that is not one. A kiln sidecar this kiln
+/// cannot read is an error, not an external table.
+fn parse_sidecar(path: &Path, bytes: &[u8]) -> Result<Option<Sidecar>> {
+    match serde_json::from_slice::<Sidecar>(bytes) {
+        Ok(sidecar) if sidecar.kind == KIND => Ok(Some(sidecar)),
+        Ok(_) => Ok(None),
+        Err(e) => {
+            let value: Option<serde_json::Value> = serde_json::from_slice(bytes).ok();
+            if value
+                .as_ref()
+                .and_then(|v| v.get("kind"))
+                .and_then(|k| k.as_str())
+                == Some(KIND)
+            {
+                return Err(invalid(
+                    path,
+                    format!(
+                        "unreadable kiln sidecar ({e}); was it written by another kiln version?"
+                    ),
+                ));
+            }
+            Ok(None)
+        }
+    }
+}
+
 /// Reads one of kiln's own files, if it is one: a JSON sidecar, an EXR with kiln's metadata, or a
 /// kiln binary (whose model comes from its sidecar beside it). `Ok(None)` for anything else.
 pub fn read_kiln(path: &Path) -> Result<Option<Table>> {
@@ -127,34 +153,13 @@ pub fn read_kiln(path: &Path) -> Result<Option<Table>> {
         Ok(table)
     };
     match extension.as_str() {
-        "json" => {
-            let sidecar = match serde_json::from_slice::<Sidecar>(&bytes) {
-                Ok(sidecar) => sidecar,
-                Err(e) => {
-                    // A kiln sidecar this kiln cannot read is an error, not an external table.
-                    let value: Option<serde_json::Value> = serde_json::from_slice(&bytes).ok();
-                    if value
-                        .as_ref()
-                        .and_then(|v| v.get("kind"))
-                        .and_then(|k| k.as_str())
-                        == Some(KIND)
-                    {
-                        return Err(invalid(
-                            path,
-                            format!(
-                                "unreadable kiln sidecar ({e}); was it written by another kiln version?"
-                            ),
-                        ));
-                    }
-                    return Ok(None);
-                }
-            };
-            if sidecar.kind != KIND {
-                return Ok(None);
+        "json" => match parse_sidecar(path, &bytes)? {
+            Some(sidecar) => {
+                let channels: Vec<(String, Vec<f64>)> = sidecar.data.into_iter().collect();
+                from_metadata(sidecar.metadata, &channels).map(Some)
             }
-            let channels: Vec<(String, Vec<f64>)> = sidecar.data.into_iter().collect();
-            from_metadata(sidecar.metadata, &channels).map(Some)
-        }
+            None => Ok(None),
+        },
         "exr" => {
             let image = exr::decode(&bytes).map_err(|e| invalid(path, e))?;
             let Some(text) = image.metadata else {
@@ -167,7 +172,7 @@ pub fn read_kiln(path: &Path) -> Result<Option<Table>> {
         _ if bytes.starts_with(binary::MAGIC) => {
             let contents = binary::decode(&bytes).map_err(|e| invalid(path, e))?;
             let sidecar_path = path.with_extension("json");
-            let sidecar = read_kiln(&sidecar_path).ok().flatten().ok_or_else(|| {
+            let missing = || {
                 invalid(
                     path,
                     format!(
@@ -175,8 +180,11 @@ pub fn read_kiln(path: &Path) -> Result<Option<Table>> {
                         sidecar_path.display()
                     ),
                 )
-            })?;
-            let metadata = Metadata::new(&sidecar, "f32");
+            };
+            let sidecar_bytes = std::fs::read(&sidecar_path).map_err(|_| missing())?;
+            let metadata = parse_sidecar(&sidecar_path, &sidecar_bytes)?
+                .ok_or_else(missing)?
+                .metadata;
             if contents.shape != metadata.spec.shape() {
                 return Err(invalid(path, "shape differs from its sidecar's"));
             }
