@@ -52,8 +52,8 @@ impl Default for BakeOptions {
             scrambles: QmcSettings::DEFAULT_SCRAMBLES,
             seed: 0,
             roughness_convention: RoughnessConvention::Perceptual,
-            mu_mapping: MuMapping::Linear,
-            grid: Grid::Centers,
+            mu_mapping: MuMapping::Adaptive,
+            grid: Grid::Nodes,
             check_against_reference: true,
             method: Method::Qmc,
         }

@@ -221,8 +221,29 @@ fn outputs_agree_with_each_other_and_round_trip() {
             // What a value becomes in storage: f32, or f16 through f32.
             let stored = |v: f64| match precision {
                 "f32" => f64::from(v as f32),
-                _ => f64::from(half::f16::from_f32(v as f32).to_f32()),
+                _ => f64::from(kiln::format::f16::encode(v).0.to_f32()),
             };
+            // f16: nothing non-zero is stored as zero, and the metadata counts what was clamped
+            // (recounted here independently: values that plain rounding would flush to zero).
+            if precision == "f16" {
+                let storage = sidecar.metadata.f16_storage.as_ref().expect("f16 counts");
+                for (name, values) in [
+                    (q.clone(), reference),
+                    (format!("one_minus_{q}"), one_minus),
+                ] {
+                    let flushed = values
+                        .iter()
+                        .filter(|&&v| v != 0.0 && half::f16::from_f32(v as f32).to_f32() == 0.0)
+                        .count();
+                    assert_eq!(storage[&name].clamped, flushed, "{id} {name}");
+                    assert!(
+                        values.iter().all(|&v| v == 0.0 || stored(v) != 0.0),
+                        "{id} {name}"
+                    );
+                }
+            } else {
+                assert!(sidecar.metadata.f16_storage.is_none());
+            }
 
             let image = exr::decode(&read("exr")).unwrap();
             let channel = |name: &str| &image.channels.iter().find(|(n, _)| n == name).unwrap().1;

@@ -6,6 +6,8 @@ mod ggx {
 }
 
 use kiln::format::json::Sidecar;
+use kiln::verify::input::read_kiln;
+use kiln::verify::{AuditSettings, lookup_coordinates};
 
 fn sidecar(name: &str) -> Sidecar {
     let path = format!("{}/tables/{name}.json", env!("CARGO_MANIFEST_DIR"));
@@ -53,5 +55,42 @@ fn included_constants_match_the_sidecar() {
     }
     for (k, &v) in avg.metadata.axes[0].values.iter().enumerate() {
         assert_eq!(ggx::GGX_HEIGHT_CORRELATED_E_AVG_R[k], v as f32);
+    }
+}
+
+/// The generated lookup functions give what the library's `Table::lookup` gives (in f32), at
+/// every point `verify` audits: the same axis mapping, grid and clamping.
+#[test]
+fn generated_lookups_match_the_library_lookup() {
+    let read = |name: &str| {
+        let path = format!("{}/tables/{name}.json", env!("CARGO_MANIFEST_DIR"));
+        read_kiln(std::path::Path::new(&path)).unwrap().unwrap()
+    };
+    let e = read("ggx-height-correlated-E");
+    // f32 positions err by ~31 * 6e-8 of a texel; texel steps are below 0.1.
+    let close = |got: f32, want: f64| (f64::from(got) - want).abs() < 2e-6;
+    let points = lookup_coordinates(&e, &AuditSettings::default());
+    assert!(points.len() > 4000);
+    for (alpha, mu) in points {
+        let (r, mu) = (alpha.sqrt(), mu.unwrap());
+        let got =
+            ggx::ggx_height_correlated_e_lookup(&ggx::GGX_HEIGHT_CORRELATED_E, mu as f32, r as f32);
+        assert!(close(got, e.lookup(mu, r)), "E at mu {mu}, r {r}: {got}");
+        let got = ggx::ggx_height_correlated_e_lookup(
+            &ggx::GGX_HEIGHT_CORRELATED_ONE_MINUS_E,
+            mu as f32,
+            r as f32,
+        );
+        assert!(
+            close(got, e.lookup_one_minus(mu, r)),
+            "1 - E at mu {mu}, r {r}"
+        );
+    }
+    let avg = read("ggx-height-correlated-E_avg");
+    for (alpha, _) in lookup_coordinates(&avg, &AuditSettings::default()) {
+        let r = alpha.sqrt();
+        let got =
+            ggx::ggx_height_correlated_e_avg_lookup(&ggx::GGX_HEIGHT_CORRELATED_E_AVG, r as f32);
+        assert!(close(got, avg.lookup(1.0, r)), "E_avg at r {r}");
     }
 }

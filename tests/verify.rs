@@ -121,7 +121,8 @@ fn every_input_format_and_layout_gives_the_same_audit() {
     let node = number(&from_json, "node_max_error");
     let lookup = number(&from_json, "lookup_max_error");
     assert_eq!(from_json["nodes"], 36);
-    assert_eq!(from_json["lookup_points"], 13 * 13);
+    // A 13 x 13 ladder, and 27 grazing probes on each of its 13 roughness rungs.
+    assert_eq!(from_json["lookup_points"], 13 * (13 + 27));
 
     // kiln's EXR and binary hold f32: the same audit to within f32 rounding.
     let (_, from_exr) = verify(&[d.join("ggx-height-correlated-E.exr").to_str().unwrap()]);
@@ -145,7 +146,15 @@ fn every_input_format_and_layout_gives_the_same_audit() {
         format!("# kiln E, r rows\n{}\n", text.join(" ")),
     )
     .unwrap();
-    let (_, from_text) = verify(&[d.join("r-major.txt").to_str().unwrap(), "--shape", "6x6"]);
+    let (_, from_text) = verify(&[
+        d.join("r-major.txt").to_str().unwrap(),
+        "--shape",
+        "6x6",
+        "--grid",
+        "nodes",
+        "--mu-axis",
+        "adaptive",
+    ]);
     assert_eq!(number(&from_text, "node_max_error"), node);
     assert_eq!(number(&from_text, "lookup_max_error"), lookup);
 
@@ -158,6 +167,10 @@ fn every_input_format_and_layout_gives_the_same_audit() {
         d.join("mu-major.csv").to_str().unwrap(),
         "--shape",
         "6x6",
+        "--grid",
+        "nodes",
+        "--mu-axis",
+        "adaptive",
         "--order",
         "mu,r",
     ]);
@@ -174,6 +187,10 @@ fn every_input_format_and_layout_gives_the_same_audit() {
         d.join("e.f32").to_str().unwrap(),
         "--shape",
         "6x6",
+        "--grid",
+        "nodes",
+        "--mu-axis",
+        "adaptive",
         "--dtype",
         "f32",
     ]);
@@ -190,6 +207,10 @@ fn every_input_format_and_layout_gives_the_same_audit() {
         d.join("e.f16").to_str().unwrap(),
         "--shape",
         "6x6",
+        "--grid",
+        "nodes",
+        "--mu-axis",
+        "adaptive",
         "--dtype",
         "f16",
     ]);
@@ -205,6 +226,10 @@ fn every_input_format_and_layout_gives_the_same_audit() {
         "E",
         "--shape",
         "6x6",
+        "--grid",
+        "nodes",
+        "--mu-axis",
+        "adaptive",
     ]);
     assert_eq!(
         number(&channel, "node_max_error"),

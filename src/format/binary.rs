@@ -11,7 +11,8 @@
 //!     24     4  dims[0]: size of the slowest-varying axis (roughness)
 //!     28     4  dims[1]: size of the fastest-varying axis (mu), 1 when rank is 1
 //!     32    16  axis 0 descriptor  \  each: u32 quantity (1 = mu, 2 = r with alpha = r^2,
-//!     48    16  axis 1 descriptor  /  3 = alpha), u32 mapping (0 = linear, 1 = sqrt: mu = t^2),
+//!     48    16  axis 1 descriptor  /  3 = alpha), u32 mapping (0 = linear, 1 = sqrt: mu = t^2,
+//!                                     2 = adaptive: t = (mu (1 + 4a) / (mu + 4a))^0.4),
 //!                                     u32 grid (0 = centers (i + 0.5)/N, 1 = nodes i/(N - 1)),
 //!                                     u32 reserved (0); all zero for an absent axis
 //!     64  32*C  channel entries: 24 bytes name (ASCII, NUL-padded), u32 dtype (1 = f32,
@@ -54,6 +55,7 @@ fn axis_descriptor(axis: Option<&Axis>) -> [u32; 4] {
             let m = match mapping {
                 MuMapping::Linear => 0,
                 MuMapping::Sqrt => 1,
+                MuMapping::Adaptive => 2,
             };
             [1, m, grid(g), 0]
         }
@@ -114,7 +116,7 @@ pub fn encode(table: &Table, precision: Precision) -> Vec<u8> {
             match dtype {
                 Precision::F32 => out.extend_from_slice(&(v as f32).to_le_bytes()),
                 Precision::F16 => {
-                    out.extend_from_slice(&half::f16::from_f32(v as f32).to_le_bytes());
+                    out.extend_from_slice(&super::f16::encode(v).0.to_le_bytes());
                 }
             }
         }

@@ -34,7 +34,7 @@ pub fn encode(table: &Table, precision: Precision) -> std::result::Result<Vec<u8
     let samples = |values: &[f64], precision: Precision| match precision {
         Precision::F32 => FlatSamples::F32(values.iter().map(|&v| v as f32).collect()),
         Precision::F16 => {
-            FlatSamples::F16(values.iter().map(|&v| f16::from_f32(v as f32)).collect())
+            FlatSamples::F16(values.iter().map(|&v| super::f16::encode(v).0).collect())
         }
     };
     let list = SmallVec::from_vec(vec![

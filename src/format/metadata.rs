@@ -15,11 +15,13 @@ pub struct AxisMetadata {
     pub size: usize,
     /// `centers` or `nodes`.
     pub grid: Grid,
-    /// `linear` or `sqrt` for `mu`; `r` (alpha = r^2) or `alpha` for roughness.
+    /// `linear`, `sqrt` or `adaptive` for `mu`; `r` (alpha = r^2) or `alpha` for roughness.
     pub mapping: String,
     /// Index to value, e.g. `t_i = (i + 0.5) / N, mu = t`.
     pub formula: String,
-    /// The coordinate of every sample, in the axis' own unit (`mu`, `r` or `alpha`).
+    /// The coordinate of every sample, in the axis' own unit (`mu`, `r` or `alpha`); for the
+    /// `adaptive` mu mapping, whose `mu` depends on the row's roughness, the lookup coordinate
+    /// `t` (the formula gives `mu` from `t` and `alpha`).
     pub values: Vec<f64>,
 }
 
@@ -36,7 +38,7 @@ impl AxisMetadata {
             grid: axis.grid(),
             mapping,
             formula: axis.formula(),
-            values: axis.values(),
+            values: axis.listed_values(),
         }
     }
 }
@@ -80,6 +82,11 @@ pub struct Metadata {
     pub node_error_texels: Option<usize>,
     /// `f32` or `f16`: how the value channels are stored in the binary formats.
     pub precision: String,
+    /// With `f16` precision: per value channel, how many values were clamped into f16's range
+    /// (never stored as infinity or zero) and how many are subnormals (below 6.1e-5, absolute
+    /// spacing 6e-8). See [`crate::format::f16`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub f16_storage: Option<std::collections::BTreeMap<String, super::f16::Counts>>,
     /// The command that reproduces the values.
     pub command: String,
     /// The same facts in machine form, for reading a table back ([`crate::TableSpec`]).
@@ -125,6 +132,13 @@ impl Metadata {
             node_rms_error: table.node_errors.map(|e| e.rms),
             node_error_texels: table.node_errors.map(|e| e.texels),
             precision: precision.to_string(),
+            f16_storage: (precision == "f16").then(|| {
+                let names = table.channel_names();
+                let channels = table.channels();
+                (0..2)
+                    .map(|c| (names[c].clone(), super::f16::counts(channels[c])))
+                    .collect()
+            }),
             command: table.command.clone(),
             spec: table.spec.clone(),
         }

@@ -6,6 +6,7 @@
 
 pub mod binary;
 pub mod exr;
+pub mod f16;
 pub mod json;
 pub mod metadata;
 pub mod png;

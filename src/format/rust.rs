@@ -5,8 +5,14 @@
 //! says: Rust has no stable f16 type for constants.
 
 use super::metadata::{KILN_VERSION, Metadata};
+use crate::model::RoughnessConvention;
 use crate::table::Table;
+use crate::table::axis::{ADAPTIVE_POWER, ADAPTIVE_SCALE, Axis, Grid, MuMapping};
 use std::fmt::Write as _;
+
+/// On every generated array: a measured value may happen to print like a mathematical constant
+/// (`1 - E(1, alpha = 1) = ln 2`), which clippy would flag in the including crate.
+const ALLOW: &str = "#[allow(clippy::approx_constant)]";
 
 /// The constant name of a table's values: `GGX_HEIGHT_CORRELATED_E`.
 #[must_use]
@@ -57,6 +63,115 @@ fn write_array(out: &mut String, values: &[f64], shape: &[usize]) {
             out.push_str("\n]");
         }
         _ => unreachable!("tables are 1-D or 2-D"),
+    }
+}
+
+/// The generated lookup function's name: `ggx_height_correlated_e_lookup`.
+#[must_use]
+pub fn lookup_name(table: &Table) -> String {
+    format!("{}_lookup", const_prefix(table).to_lowercase())
+}
+
+/// Rust for the texture coordinate `t` of one axis, from `mu` or the roughness (`alpha` bound).
+fn coordinate_code(axis: &Axis) -> String {
+    match *axis {
+        Axis::Mu { mapping, .. } => match mapping {
+            MuMapping::Linear => "mu".to_string(),
+            MuMapping::Sqrt => "mu.max(0.0).sqrt()".to_string(),
+            MuMapping::Adaptive => format!(
+                "if mu <= 0.0 {{\n        0.0\n    }} else {{\n        let k = {ADAPTIVE_SCALE:?} * alpha;\n        \
+                 (mu * (1.0 + k) / (mu + k)).min(1.0).powf({ADAPTIVE_POWER:?})\n    }}"
+            ),
+        },
+        Axis::Roughness { .. } => "roughness".to_string(),
+    }
+}
+
+/// Rust for the continuous sample position of texture coordinate `t` on an axis of `n` samples.
+fn position_code(grid: Grid, t: &str, n: usize) -> String {
+    let last = n - 1;
+    match grid {
+        Grid::Nodes => format!("({t} * {last}.0_f32).clamp(0.0, {last}.0)"),
+        Grid::Centers => format!("({t} * {n}.0_f32 - 0.5).clamp(0.0, {last}.0)"),
+    }
+}
+
+/// The generated lookup: the table's axis mapping and grid, bilinear, clamp to edge; the same
+/// arithmetic as [`Table::lookup`] in f32.
+fn write_lookup(out: &mut String, table: &Table, prefix: &str, ty: &str) {
+    let spec = &table.spec;
+    let name = lookup_name(table);
+    let roughness_name = spec.roughness_convention().name();
+    let alpha = match spec.roughness_convention() {
+        RoughnessConvention::Perceptual => "roughness * roughness",
+        RoughnessConvention::Alpha => "roughness",
+    };
+    let n_r = spec.roughness.size();
+    let _ = writeln!(out);
+    let _ = writeln!(
+        out,
+        "/// Bilinear lookup of [`{prefix}`] (or a table laid out like it: its `ONE_MINUS` and \
+         `STD_ERROR`\n/// twins) the way kiln's `Table::lookup` does it, in f32: {}.",
+        spec.axes()
+            .iter()
+            .map(|a| format!("`{}` axis {}", a.name(), a.formula()))
+            .collect::<Vec<_>>()
+            .join("; ")
+    );
+    let _ = writeln!(
+        out,
+        "/// `roughness` is `{roughness_name}`{}; out-of-range coordinates clamp to the edge.",
+        if spec.mu.is_some() {
+            ", `mu = cos(theta_o)`"
+        } else {
+            ""
+        }
+    );
+    let _ = writeln!(out, "#[allow(clippy::all)]");
+    let t_r = position_code(spec.roughness.grid(), "roughness", n_r);
+    match spec.mu {
+        None => {
+            let _ = writeln!(out, "pub fn {name}(table: &{ty}, roughness: f32) -> f32 {{");
+            let _ = writeln!(out, "    let p = {t_r};");
+            let _ = writeln!(out, "    let i = (p as usize).min({});", n_r - 2);
+            let _ = writeln!(out, "    let f = p - i as f32;");
+            let _ = writeln!(out, "    table[i] * (1.0 - f) + table[i + 1] * f");
+            let _ = writeln!(out, "}}");
+        }
+        Some(mu_axis) => {
+            let n_mu = mu_axis.size();
+            let _ = writeln!(
+                out,
+                "pub fn {name}(table: &{ty}, mu: f32, roughness: f32) -> f32 {{"
+            );
+            if matches!(mu_axis, Axis::Mu { mapping, .. } if mapping.depends_on_roughness()) {
+                let _ = writeln!(out, "    let alpha = {alpha};");
+            }
+            let _ = writeln!(out, "    let t_mu = {};", coordinate_code(&mu_axis));
+            let _ = writeln!(out, "    let p_r = {t_r};");
+            let _ = writeln!(
+                out,
+                "    let p_mu = {};",
+                position_code(mu_axis.grid(), "t_mu", n_mu)
+            );
+            let _ = writeln!(
+                out,
+                "    let (i, j) = ((p_r as usize).min({}), (p_mu as usize).min({}));",
+                n_r - 2,
+                n_mu - 2
+            );
+            let _ = writeln!(out, "    let (f, g) = (p_r - i as f32, p_mu - j as f32);");
+            let _ = writeln!(
+                out,
+                "    let row0 = table[i][j] * (1.0 - g) + table[i][j + 1] * g;"
+            );
+            let _ = writeln!(
+                out,
+                "    let row1 = table[i + 1][j] * (1.0 - g) + table[i + 1][j + 1] * g;"
+            );
+            let _ = writeln!(out, "    row0 * (1.0 - f) + row1 * f");
+            let _ = writeln!(out, "}}");
+        }
     }
 }
 
@@ -130,6 +245,7 @@ pub fn encode(table: &Table) -> String {
         );
     }
     let _ = writeln!(out, "/// - Estimator: {}.", meta.estimator);
+    let _ = writeln!(out, "{ALLOW}");
     let _ = write!(out, "pub const {prefix}: {ty} = ");
     write_array(&mut out, &table.value, &shape);
     let _ = writeln!(out, ";\n");
@@ -139,20 +255,25 @@ pub fn encode(table: &Table) -> String {
     );
     let _ = writeln!(out, "/// is close to 1 (`1.0 - {q}` in f32 would not).");
     let one_minus = one_minus_name(table);
+    let _ = writeln!(out, "{ALLOW}");
     let _ = write!(out, "pub const {one_minus}: {ty} = ");
     write_array(&mut out, &table.one_minus_value, &shape);
     let _ = writeln!(out, ";\n");
     let _ = writeln!(out, "/// The standard error of each texel of [`{prefix}`].");
+    let _ = writeln!(out, "{ALLOW}");
     let _ = write!(out, "pub const {prefix}_STD_ERROR: {ty} = ");
     write_array(&mut out, &table.std_error, &shape);
     let _ = writeln!(out, ";");
-    for axis in &meta.axes {
+    for (axis, spec_axis) in meta.axes.iter().zip(table.spec.axes()) {
         let _ = writeln!(out);
-        let _ = writeln!(
-            out,
-            "/// The `{}` coordinate of each sample of [`{prefix}`] ({}).",
-            axis.name, axis.formula
-        );
+        let what = match spec_axis {
+            Axis::Mu { mapping, .. } if mapping.depends_on_roughness() => {
+                "lookup coordinate `t` of each `mu` sample (their `mu` depends on the row)"
+                    .to_string()
+            }
+            _ => format!("`{}` coordinate of each sample", axis.name),
+        };
+        let _ = writeln!(out, "/// The {what} of [`{prefix}`] ({}).", axis.formula);
         let _ = write!(
             out,
             "pub const {prefix}_{}: [f32; {}] = ",
@@ -162,5 +283,6 @@ pub fn encode(table: &Table) -> String {
         write_array(&mut out, &axis.values, &[axis.size]);
         let _ = writeln!(out, ";");
     }
+    write_lookup(&mut out, table, &prefix, &ty);
     out
 }

@@ -16,7 +16,9 @@
 use super::estimate::Estimate;
 use super::sobol::{OwenSobol, mix_seed};
 use crate::model::ndf::BeckmannVisibleNormals;
-use crate::model::{Beckmann, Ggx, Masking, MicrofacetDistribution, Model, Ndf, Vec3};
+use crate::model::{
+    Beckmann, Ggx, Masking, MicrofacetDistribution, Model, Ndf, SMOOTH_ALPHA, Vec3, smooth_point,
+};
 
 /// How a QMC estimate is run.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
@@ -78,8 +80,9 @@ const TAG_E_AVG: u64 = 0x4541;
 
 /// `E(mu)` for the model at `alpha` (slope-space roughness), `mu = cos(theta_o)` in [0, 1].
 ///
-/// Exact limits are returned without sampling: `alpha = 0` (a mirror, `E = 1`) and, for
-/// height-correlated masking, `mu = 0` (`E(0) = 1`, `physics.md`).
+/// Exact limits are returned without sampling: `alpha = 0` with `mu > 0` (a mirror, `E = 1`)
+/// and, for height-correlated masking, `mu = 0` (`E(0) = 1`, `physics.md`). Below
+/// [`SMOOTH_ALPHA`] the estimate is taken at the similar point ([`smooth_point`]).
 ///
 /// # Panics
 /// If the settings are invalid ([`QmcSettings::validate`]) or `mu`/`alpha` are out of range;
@@ -87,9 +90,10 @@ const TAG_E_AVG: u64 = 0x4541;
 #[must_use]
 pub fn albedo(model: Model, alpha: f64, mu: f64, settings: &QmcSettings) -> Estimate {
     assert!((0.0..=1.0).contains(&mu) && alpha >= 0.0 && alpha.is_finite());
-    if alpha == 0.0 || (mu == 0.0 && model.masking == Masking::HeightCorrelated) {
+    if (alpha == 0.0 && mu > 0.0) || (mu == 0.0 && model.masking == Masking::HeightCorrelated) {
         return Estimate::exact(0.0);
     }
+    let (alpha, mu) = smooth_point(alpha, mu);
     let key = [TAG_E, model_key(model), alpha.to_bits(), mu.to_bits()];
     replicates(settings, &key, |seq, log2_n| {
         match (model.ndf, model.masking) {
@@ -121,7 +125,7 @@ pub fn albedo(model: Model, alpha: f64, mu: f64, settings: &QmcSettings) -> Esti
 #[must_use]
 pub fn average_albedo(model: Model, alpha: f64, settings: &QmcSettings) -> Estimate {
     assert!(alpha >= 0.0 && alpha.is_finite());
-    if alpha == 0.0 {
+    if alpha < SMOOTH_ALPHA {
         return Estimate::exact(0.0);
     }
     let key = [TAG_E_AVG, model_key(model), alpha.to_bits()];

@@ -27,11 +27,14 @@
 //! Where it gives up: each adaptive level has an interval budget ([`ReferenceSettings`]). When a
 //! budget runs out the best value is returned with `converged: false` and its error estimate; the
 //! caller decides. Outside `alpha` in [1e-3, 2] and `mu` in [1e-6, 1], where the 1e-10 target is
-//! tested, the method still runs and reports its own estimate. `alpha = 0` returns the mirror's
+//! tested, the method still runs and reports its own estimate. Below [`SMOOTH_ALPHA`] it works at
+//! the similar point ([`smooth_point`]), and `alpha = 0` with `mu > 0` returns the mirror's
 //! exact `E = 1`.
 
 use super::gauss_kronrod::{Quadrature, integrate_pieces};
-use crate::model::{Beckmann, Ggx, Masking, MicrofacetDistribution, Model, Ndf, Vec3};
+use crate::model::{
+    Beckmann, Ggx, Masking, MicrofacetDistribution, Model, Ndf, SMOOTH_ALPHA, Vec3, smooth_point,
+};
 use serde::Serialize;
 use std::f64::consts::PI;
 
@@ -82,9 +85,10 @@ pub fn reference_albedo(
     settings: &ReferenceSettings,
 ) -> ReferenceValue {
     assert!((0.0..=1.0).contains(&mu) && alpha >= 0.0 && alpha.is_finite());
-    if alpha == 0.0 {
+    if alpha == 0.0 && mu > 0.0 {
         return MIRROR;
     }
+    let (alpha, mu) = smooth_point(alpha, mu);
     finish(quadrature_for(model, alpha, mu, settings))
 }
 
@@ -118,7 +122,7 @@ pub fn reference_average_albedo(
     settings: &ReferenceSettings,
 ) -> ReferenceValue {
     assert!(alpha >= 0.0 && alpha.is_finite());
-    if alpha == 0.0 {
+    if alpha < SMOOTH_ALPHA {
         return MIRROR;
     }
     // The inner E(mu) integrals get a tenth of the budget each: their errors add up under the

@@ -3,6 +3,7 @@
 //! The reflection BRDF (`physics.md`) is `f(o, i) = F(o.h) D(h) G2(o, i) / (4 |n.i| |n.o|)`;
 //! the tables here are for `F = 1`.
 
+pub mod kulla_conty;
 pub mod masking;
 pub mod ndf;
 pub mod special;
@@ -13,6 +14,34 @@ use serde::{Deserialize, Serialize};
 pub use masking::Masking;
 pub use ndf::{Beckmann, Ggx, MicrofacetDistribution};
 pub use vector::Vec3;
+
+/// Below this slope-space roughness kiln treats the surface as smooth: `E` comes from the
+/// grazing boundary layer's similarity, `E(mu, alpha) = E(mu SMOOTH_ALPHA / alpha, SMOOTH_ALPHA)`
+/// ([`smooth_point`]), and `E_avg` is the mirror's 1.
+///
+/// Why: as `alpha -> 0`, `E` depends on `mu / alpha` alone up to `O(alpha^2)` (`physics.md`,
+/// "Hard cases": `E(mu = alpha) ~ 0.89` at every small `alpha`), so the rescaled point is exact
+/// to about `1e-14` here; below ~1e-12 the reference quadrature stops resolving `mu ~ alpha`
+/// in f64 (the view sits within `1e-12` rad of the horizon) and plain sampling would follow it.
+/// `1 - E_avg` below this roughness is under `2 alpha^2 (0.25 + ln(1 / alpha) / 2) ~ 2e-13`.
+/// `E` stays continuous into `alpha = 0`: it tends to 1 at every fixed `mu > 0` (the mirror),
+/// and at `mu = 0` to the layer's limit (1 height-correlated, 0.936 separable GGX), which is
+/// what kiln returns at `alpha = 0` itself.
+pub const SMOOTH_ALPHA: f64 = 1e-7;
+
+/// The point `(alpha, mu)` at which kiln evaluates `E(mu, alpha)`: itself from
+/// [`SMOOTH_ALPHA`] up, the similar point at `SMOOTH_ALPHA` below it (see there); at
+/// `alpha = 0`, `mu > 0` maps to `mu = 1` (the mirror) and `mu = 0` stays 0 (the layer's limit).
+#[must_use]
+pub fn smooth_point(alpha: f64, mu: f64) -> (f64, f64) {
+    if alpha >= SMOOTH_ALPHA {
+        (alpha, mu)
+    } else if mu == 0.0 {
+        (SMOOTH_ALPHA, 0.0)
+    } else {
+        (SMOOTH_ALPHA, (mu * (SMOOTH_ALPHA / alpha)).min(1.0))
+    }
+}
 
 /// Which normal distribution a table is computed for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -83,6 +112,16 @@ impl RoughnessConvention {
         match self {
             RoughnessConvention::Perceptual => value * value,
             RoughnessConvention::Alpha => value,
+        }
+    }
+
+    /// The roughness value in this convention that stands for `alpha` (the inverse of
+    /// [`RoughnessConvention::to_alpha`]).
+    #[must_use]
+    pub fn from_alpha(self, alpha: f64) -> f64 {
+        match self {
+            RoughnessConvention::Perceptual => alpha.sqrt(),
+            RoughnessConvention::Alpha => alpha,
         }
     }
 

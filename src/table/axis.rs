@@ -12,8 +12,20 @@
 //! Mappings from `t` to the physical coordinate:
 //!
 //! - `mu`, `linear`: `mu = t`; `sqrt`: `mu = t^2`, i.e. the texture coordinate is `sqrt(mu)`
-//!   (Unity HDRP), which puts more samples near grazing;
+//!   (Unity HDRP), which puts more samples near grazing; `adaptive` (kiln's default): the texture
+//!   coordinate depends on the roughness too, `t = (mu (1 + c alpha) / (mu + c alpha))^p` with
+//!   `c = 4`, `p = 0.4` ([`MuMapping::Adaptive`]);
 //! - roughness `r` (perceptual): `r = t`, `alpha = r^2`; roughness `alpha`: `alpha = t`.
+//!
+//! Why `adaptive`: at small `alpha`, `E` has a boundary layer at `mu ~ alpha` (`physics.md`,
+//! "Hard cases"): `E(mu, alpha)` is, to `O(alpha^2)`, a function of `x = mu / alpha` alone that
+//! dips to 0.89 at `x ~ 1` (height-correlated GGX) whatever `alpha` is. No axis that ignores
+//! `alpha` can follow the dip as `alpha -> 0`; in `t` above, `x = c s / (1 + c alpha - s)` with
+//! `s = t^(1/p)`, so the dip stays at the same `t` for every small `alpha` and a bilinear lookup
+//! resolves it everywhere. The constants were chosen by measured lookup error at 32 x 32 (c in
+//! 1..5, p in 0.33..1; see the README). At `alpha = 0` the mapping gives `t = 1` for every
+//! `mu > 0` (the mirror's `E = 1`) and `t = 0` at `mu = 0`; the row at `alpha = 0` holds the
+//! boundary layer's limit `alpha -> 0+`, computed at [`LAYER_LIMIT_ALPHA`].
 
 use crate::model::RoughnessConvention;
 use serde::{Deserialize, Serialize};
@@ -59,6 +71,16 @@ impl Grid {
     }
 }
 
+/// The scale `c` of [`MuMapping::Adaptive`]: the boundary layer's `mu ~ alpha` maps near
+/// `t = (1 / (1 + c))^p`, about the middle of the axis.
+pub const ADAPTIVE_SCALE: f64 = 4.0;
+/// The power `p` of [`MuMapping::Adaptive`]: below 1 it spreads the samples near `mu = 0`.
+pub const ADAPTIVE_POWER: f64 = 0.4;
+/// The `alpha` at which a row at `alpha = 0` of an [`MuMapping::Adaptive`] table is computed:
+/// that row holds the limit `alpha -> 0+` at fixed `t`, which `E` approaches as `O(alpha^2)`, so
+/// the difference at 1e-7 is about 1e-14 (equal to [`crate::model::SMOOTH_ALPHA`]).
+pub const LAYER_LIMIT_ALPHA: f64 = crate::model::SMOOTH_ALPHA;
+
 /// How the `mu` axis is spaced.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
@@ -68,6 +90,9 @@ pub enum MuMapping {
     Linear,
     /// `mu = t^2` (texture coordinate `sqrt(mu)`).
     Sqrt,
+    /// `t = (mu (1 + c alpha) / (mu + c alpha))^p`, `c = 4`, `p = 0.4`: follows the grazing
+    /// boundary layer `mu ~ alpha` at every roughness (see the module docs). The default.
+    Adaptive,
 }
 
 impl MuMapping {
@@ -77,24 +102,49 @@ impl MuMapping {
         match self {
             MuMapping::Linear => "linear",
             MuMapping::Sqrt => "sqrt",
+            MuMapping::Adaptive => "adaptive",
         }
     }
 
-    /// `mu` at texture coordinate `t`.
+    /// Whether the texture coordinate depends on `alpha` as well as `mu`.
     #[must_use]
-    pub fn mu(self, t: f64) -> f64 {
+    pub fn depends_on_roughness(self) -> bool {
+        self == MuMapping::Adaptive
+    }
+
+    /// `mu` at texture coordinate `t` on the row of slope-space roughness `alpha`.
+    #[must_use]
+    pub fn mu(self, t: f64, alpha: f64) -> f64 {
         match self {
             MuMapping::Linear => t,
             MuMapping::Sqrt => t * t,
+            MuMapping::Adaptive => {
+                // s (mu + k) = mu (1 + k)  =>  mu = s k / (1 + k - s), with k = c alpha.
+                let s = t.powf(1.0 / ADAPTIVE_POWER);
+                let k = ADAPTIVE_SCALE * alpha;
+                if s >= 1.0 {
+                    1.0
+                } else {
+                    (s * k / (1.0 + k - s)).min(1.0)
+                }
+            }
         }
     }
 
-    /// The texture coordinate of `mu` (the inverse of [`MuMapping::mu`]).
+    /// The texture coordinate of `mu` at roughness `alpha` (the inverse of [`MuMapping::mu`]).
+    /// For `adaptive`, `mu = 0` gives 0 whatever `alpha`, and `alpha = 0` gives 1 for `mu > 0`.
     #[must_use]
-    pub fn coordinate(self, mu: f64) -> f64 {
+    pub fn coordinate(self, mu: f64, alpha: f64) -> f64 {
         match self {
             MuMapping::Linear => mu,
             MuMapping::Sqrt => mu.sqrt(),
+            MuMapping::Adaptive => {
+                if mu <= 0.0 {
+                    return 0.0;
+                }
+                let k = ADAPTIVE_SCALE * alpha;
+                (mu * (1.0 + k) / (mu + k)).min(1.0).powf(ADAPTIVE_POWER)
+            }
         }
     }
 
@@ -104,6 +154,11 @@ impl MuMapping {
         match self {
             MuMapping::Linear => "mu = t",
             MuMapping::Sqrt => "mu = t^2 (lookup coordinate t = sqrt(mu))",
+            MuMapping::Adaptive => {
+                "lookup coordinate t = (mu (1 + 4 alpha) / (mu + 4 alpha))^0.4 (t = 0 at mu = 0; \
+                 t = 1 at alpha = 0, mu > 0); mu = s k / (1 + k - s) with s = t^2.5, k = 4 alpha; \
+                 the row at alpha = 0 holds the limit alpha -> 0+ (computed at alpha = 1e-7)"
+            }
         }
     }
 }
@@ -152,30 +207,43 @@ impl Axis {
         }
     }
 
-    /// The physical coordinate (`mu`, `r` or `alpha`, as [`Axis::name`] says) of sample `i`.
+    /// The texture coordinate `t_i` of sample `i`.
     #[must_use]
-    pub fn value(&self, i: usize) -> f64 {
+    pub fn coordinate(&self, i: usize) -> f64 {
+        self.grid().coordinate(i, self.size())
+    }
+
+    /// The physical coordinate (`mu`, `r` or `alpha`, as [`Axis::name`] says) of sample `i`, on
+    /// the row of roughness `alpha` (only the `adaptive` mu mapping depends on it).
+    #[must_use]
+    pub fn value_at(&self, i: usize, alpha: f64) -> f64 {
         match *self {
-            Axis::Mu {
-                size,
-                mapping,
-                grid,
-            } => mapping.mu(grid.coordinate(i, size)),
-            Axis::Roughness { size, grid, .. } => grid.coordinate(i, size),
+            Axis::Mu { mapping, .. } => mapping.mu(self.coordinate(i), alpha),
+            Axis::Roughness { .. } => self.coordinate(i),
         }
     }
 
-    /// The values of every sample.
+    /// What metadata lists for sample `i`: the physical coordinate, or for an axis whose
+    /// physical coordinate depends on the row (the `adaptive` mu mapping) the texture coordinate.
     #[must_use]
-    pub fn values(&self) -> Vec<f64> {
-        (0..self.size()).map(|i| self.value(i)).collect()
+    pub fn listed_value(&self, i: usize) -> f64 {
+        match *self {
+            Axis::Mu { mapping, .. } if mapping.depends_on_roughness() => self.coordinate(i),
+            _ => self.value_at(i, 1.0),
+        }
+    }
+
+    /// [`Axis::listed_value`] of every sample.
+    #[must_use]
+    pub fn listed_values(&self) -> Vec<f64> {
+        (0..self.size()).map(|i| self.listed_value(i)).collect()
     }
 
     /// `alpha` at sample `i` of a roughness axis. Panics on a `mu` axis.
     #[must_use]
     pub fn alpha(&self, i: usize) -> f64 {
         match *self {
-            Axis::Roughness { convention, .. } => convention.to_alpha(self.value(i)),
+            Axis::Roughness { convention, .. } => convention.to_alpha(self.coordinate(i)),
             Axis::Mu { .. } => panic!("alpha asked of a mu axis"),
         }
     }
@@ -203,11 +271,12 @@ impl Axis {
     }
 
     /// The continuous sample position (in units of samples, clamped to `[0, N - 1]`) of the
-    /// physical coordinate `x`: what a bilinear lookup of this axis interpolates at.
+    /// physical coordinate `x` on the row of roughness `alpha`: what a bilinear lookup of this
+    /// axis interpolates at.
     #[must_use]
-    pub fn position(&self, x: f64) -> f64 {
+    pub fn position(&self, x: f64, alpha: f64) -> f64 {
         let t = match *self {
-            Axis::Mu { mapping, .. } => mapping.coordinate(x),
+            Axis::Mu { mapping, .. } => mapping.coordinate(x, alpha),
             Axis::Roughness { .. } => x,
         };
         let n = self.size() as f64;
@@ -234,27 +303,30 @@ mod tests {
             mapping: MuMapping::Sqrt,
             grid: Grid::Nodes,
         };
-        assert_eq!(mu.values(), [0.0, 1.0 / 9.0, 4.0 / 9.0, 1.0]);
+        assert_eq!(mu.listed_values(), [0.0, 1.0 / 9.0, 4.0 / 9.0, 1.0]);
         let r = Axis::Roughness {
             size: 2,
             convention: RoughnessConvention::Perceptual,
             grid: Grid::Centers,
         };
-        assert_eq!(r.values(), [0.25, 0.75]);
+        assert_eq!(r.listed_values(), [0.25, 0.75]);
         assert_eq!(r.alpha(1), 0.5625);
     }
 
     #[test]
     fn position_inverts_value() {
         for grid in [Grid::Centers, Grid::Nodes] {
-            for mapping in [MuMapping::Linear, MuMapping::Sqrt] {
+            for mapping in [MuMapping::Linear, MuMapping::Sqrt, MuMapping::Adaptive] {
                 let axis = Axis::Mu {
                     size: 16,
                     mapping,
                     grid,
                 };
-                for i in 0..16 {
-                    assert!((axis.position(axis.value(i)) - i as f64).abs() < 1e-12);
+                for alpha in [1e-7, 1e-3, 0.3, 1.0, 2.0] {
+                    for i in 0..16 {
+                        let p = axis.position(axis.value_at(i, alpha), alpha);
+                        assert!((p - i as f64).abs() < 1e-9, "{mapping:?} {alpha} {i}: {p}");
+                    }
                 }
             }
         }

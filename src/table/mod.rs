@@ -162,9 +162,32 @@ impl TableSpec {
         match self.mu {
             Some(mu) => {
                 let n = mu.size();
-                (self.roughness.alpha(index / n), Some(mu.value(index % n)))
+                let (alpha, mu) = self.point(
+                    self.roughness.coordinate(index / n),
+                    mu.coordinate(index % n),
+                );
+                (alpha, mu)
             }
             None => (self.roughness.alpha(index), None),
+        }
+    }
+
+    /// The physical point `(alpha, mu)` at texture coordinates `t_roughness` and `t_mu` (the
+    /// latter ignored for `E_avg`). On the row `alpha = 0` of an `adaptive` mu axis this is the
+    /// boundary layer's limit, taken at [`axis::LAYER_LIMIT_ALPHA`] (see [`axis`]).
+    #[must_use]
+    pub fn point(&self, t_roughness: f64, t_mu: f64) -> (f64, Option<f64>) {
+        let alpha = self.roughness_convention().to_alpha(t_roughness);
+        match self.mu {
+            Some(Axis::Mu { mapping, .. }) => {
+                let alpha = if alpha == 0.0 && mapping.depends_on_roughness() {
+                    axis::LAYER_LIMIT_ALPHA
+                } else {
+                    alpha
+                };
+                (alpha, Some(mapping.mu(t_mu, alpha)))
+            }
+            _ => (alpha, None),
         }
     }
 }
@@ -219,20 +242,33 @@ impl Table {
     /// table's convention; `mu` is ignored for a 1-D table), with clamp-to-edge.
     #[must_use]
     pub fn lookup(&self, mu: f64, roughness: f64) -> f64 {
+        self.lookup_channel(&self.value, mu, roughness)
+    }
+
+    /// As [`Table::lookup`], of `one_minus_value`.
+    #[must_use]
+    pub fn lookup_one_minus(&self, mu: f64, roughness: f64) -> f64 {
+        self.lookup_channel(&self.one_minus_value, mu, roughness)
+    }
+
+    /// As [`Table::lookup`], of any channel laid out like the table (one of [`Table::channels`]).
+    #[must_use]
+    pub fn lookup_channel(&self, channel: &[f64], mu: f64, roughness: f64) -> f64 {
+        let alpha = self.spec.roughness_convention().to_alpha(roughness);
         let lerp_axis = |axis: &Axis, x: f64| {
-            let p = axis.position(x);
+            let p = axis.position(x, alpha);
             let i = (p.floor() as usize).min(axis.size().saturating_sub(2));
             (i, p - i as f64)
         };
         let (ri, rf) = lerp_axis(&self.spec.roughness, roughness);
         let r1 = (ri + 1).min(self.spec.roughness.size() - 1);
         match self.spec.mu {
-            None => self.value[ri] * (1.0 - rf) + self.value[r1] * rf,
+            None => channel[ri] * (1.0 - rf) + channel[r1] * rf,
             Some(mu_axis) => {
                 let n = mu_axis.size();
                 let (mi, mf) = lerp_axis(&mu_axis, mu);
                 let m1 = (mi + 1).min(n - 1);
-                let at = |r: usize, m: usize| self.value[r * n + m];
+                let at = |r: usize, m: usize| channel[r * n + m];
                 let row0 = at(ri, mi) * (1.0 - mf) + at(ri, m1) * mf;
                 let row1 = at(r1, mi) * (1.0 - mf) + at(r1, m1) * mf;
                 row0 * (1.0 - rf) + row1 * rf
@@ -283,27 +319,37 @@ mod tests {
     #[test]
     fn lookup_returns_stored_values_at_sample_coordinates_and_lerps_between() {
         for grid in [Grid::Centers, Grid::Nodes] {
-            for mapping in [MuMapping::Linear, MuMapping::Sqrt] {
+            for mapping in [MuMapping::Linear, MuMapping::Sqrt, MuMapping::Adaptive] {
                 let t = synthetic(grid, mapping);
                 let (r_axis, mu_axis) = (t.spec.roughness, t.spec.mu.unwrap());
-                for row in 0..5 {
+                // At alpha = 0 the adaptive mapping sends every mu > 0 to the last column.
+                let first_row = usize::from(grid == Grid::Nodes && mapping == MuMapping::Adaptive);
+                for row in first_row..5 {
+                    let r = r_axis.coordinate(row);
                     for col in 0..4 {
-                        let got = t.lookup(mu_axis.value(col), r_axis.value(row));
+                        let mu = mu_axis.value_at(col, r * r);
+                        let got = t.lookup(mu, r);
                         assert!(
-                            (got - t.value[row * 4 + col]).abs() < 1e-12,
-                            "{grid:?} {mapping:?}"
+                            (got - t.value[row * 4 + col]).abs() < 1e-9,
+                            "{grid:?} {mapping:?} {row} {col}: {got}"
                         );
                     }
                 }
                 // Halfway between two rows and two columns (in texture coordinates).
-                let r = (r_axis.value(1) + r_axis.value(2)) / 2.0;
-                let mu = mapping.mu((mapping.coordinate(mu_axis.value(2))
-                    + mapping.coordinate(mu_axis.value(3)))
-                    / 2.0);
-                assert!((t.lookup(mu, r) - 17.5).abs() < 1e-12);
+                let r = (r_axis.coordinate(1) + r_axis.coordinate(2)) / 2.0;
+                let t_mu = (mu_axis.coordinate(2) + mu_axis.coordinate(3)) / 2.0;
+                let mu = mapping.mu(t_mu, r * r);
+                assert!(
+                    (t.lookup(mu, r) - 17.5).abs() < 1e-9,
+                    "{grid:?} {mapping:?}"
+                );
                 // Clamp to edge beyond the outermost samples.
                 assert_eq!(t.lookup(0.0, 0.0), t.value[0]);
                 assert_eq!(t.lookup(1.0, 1.0), t.value[19]);
+                if first_row == 1 {
+                    // The mirror row: E = 1 for every mu > 0 is the last column.
+                    assert_eq!(t.lookup(0.3, 0.0), t.value[3]);
+                }
             }
         }
     }

@@ -2,10 +2,10 @@
 //! the coordinates it says it was computed at, and what a renderer's bilinear lookup of it returns
 //! between those coordinates.
 
+pub mod furnace;
 pub mod input;
 
 use crate::integrate::reference::{ReferenceSettings, reference_albedo, reference_average_albedo};
-use crate::model::RoughnessConvention;
 use crate::table::{Quantity, Table};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -72,7 +72,8 @@ pub struct Report {
     pub node_max_error: f64,
     pub node_rms_error: f64,
     pub worst_node: Point,
-    /// The bilinear lookup against the truth on a dense grid that includes the axis ends.
+    /// The bilinear lookup against the truth on a dense grid that includes the axis ends, plus
+    /// grazing probes down to `mu = 0` ([`lookup_coordinates`]).
     pub lookup_points: usize,
     pub lookup_max_error: f64,
     pub lookup_rms_error: f64,
@@ -84,10 +85,8 @@ pub struct Report {
     pub reference_converged: bool,
 }
 
-/// The truth at `(mu, roughness)` (roughness in `table`'s convention): value, error estimate and
-/// whether it converged.
-fn truth(table: &Table, against: &Against, mu: Option<f64>, roughness: f64) -> (f64, f64, bool) {
-    let alpha = table.spec.roughness_convention().to_alpha(roughness);
+/// The truth at `(mu, alpha)`: value, error estimate and whether it converged.
+fn truth(against: &Against, table: &Table, mu: Option<f64>, alpha: f64) -> (f64, f64, bool) {
     match against {
         Against::Reference(settings) => {
             let r = match mu {
@@ -97,10 +96,7 @@ fn truth(table: &Table, against: &Against, mu: Option<f64>, roughness: f64) -> (
             (r.value, r.error, r.converged)
         }
         Against::Table(other) => {
-            let theirs = match other.spec.roughness_convention() {
-                RoughnessConvention::Perceptual => alpha.sqrt(),
-                RoughnessConvention::Alpha => alpha,
-            };
+            let theirs = other.spec.roughness_convention().from_alpha(alpha);
             (other.lookup(mu.unwrap_or(1.0), theirs), 0.0, true)
         }
     }
@@ -121,12 +117,12 @@ pub fn audit(
     let convention = spec.roughness_convention();
     let clamp = |x: f64| x.max(settings.clamp_min);
 
-    // One table value against the truth at (mu, roughness), with the truth's error estimate.
-    let compare = |mu: Option<f64>, roughness: f64, value: f64| {
-        let (reference, error_estimate, converged) = truth(table, against, mu, roughness);
+    // One table value against the truth at (mu, alpha), with the truth's error estimate.
+    let compare = |mu: Option<f64>, alpha: f64, value: f64| {
+        let (reference, error_estimate, converged) = truth(against, table, mu, alpha);
         progress();
         let error = (value - reference).abs();
-        let alpha = convention.to_alpha(roughness);
+        let roughness = convention.from_alpha(alpha);
         (
             Point {
                 mu,
@@ -141,37 +137,36 @@ pub fn audit(
         )
     };
 
-    // Nodes: each stored value against the truth where the table says it was computed.
-    let n_mu = spec.mu.map_or(1, |axis| axis.size());
+    // Nodes: each stored value against the truth where the table says it was computed (with
+    // the roughness and mu clamped as the author says they clamped them).
+    // Against a table of the same layout, node k is compared with its node k (a lookup at the
+    // physical point of the `alpha = 0` row of an adaptive axis, computed at alpha = 1e-7, would
+    // sit a hair off that row).
+    let same_layout = match against {
+        Against::Table(other) => other.spec.axes() == spec.axes(),
+        Against::Reference(_) => false,
+    };
     let nodes: Vec<(Point, f64, bool)> = (0..spec.len())
         .into_par_iter()
         .map(|k| {
-            let roughness = clamp(spec.roughness.value(k / n_mu));
-            let mu = spec.mu.map(|axis| clamp(axis.value(k % n_mu)));
-            compare(mu, roughness, table.value[k])
+            let (alpha, mu) = spec.texel_coordinates(k);
+            let alpha = convention.to_alpha(clamp(convention.from_alpha(alpha)));
+            let (mut point, estimate, converged) = compare(mu.map(clamp), alpha, table.value[k]);
+            if let (true, Against::Table(other)) = (same_layout, against) {
+                point.reference = other.value[k];
+                point.error = (point.table - point.reference).abs();
+            }
+            (point, estimate, converged)
         })
         .collect();
 
-    // Lookups: the texture coordinate t runs over [0, 1] in steps of 1 / (density * N).
-    let ladder = |n: usize| -> Vec<f64> {
-        let steps = settings.density.max(1) * n;
-        (0..=steps).map(|j| j as f64 / steps as f64).collect()
-    };
-    let r_points = ladder(spec.roughness.size());
-    let mu_points: Vec<Option<f64>> = match spec.mu {
-        Some(crate::table::axis::Axis::Mu { size, mapping, .. }) => ladder(size)
-            .into_iter()
-            .map(|t| Some(mapping.mu(t)))
-            .collect(),
-        _ => vec![None],
-    };
-    let coordinates: Vec<(f64, Option<f64>)> = r_points
-        .iter()
-        .flat_map(|&r| mu_points.iter().map(move |&mu| (r, mu)))
-        .collect();
-    let lookups: Vec<(Point, f64, bool)> = coordinates
+    // Lookups at every point of `lookup_coordinates`.
+    let lookups: Vec<(Point, f64, bool)> = lookup_coordinates(table, settings)
         .into_par_iter()
-        .map(|(roughness, mu)| compare(mu, roughness, table.lookup(mu.unwrap_or(1.0), roughness)))
+        .map(|(alpha, mu)| {
+            let value = table.lookup(mu.unwrap_or(1.0), convention.from_alpha(alpha));
+            compare(mu, alpha, value)
+        })
         .collect();
 
     let worst = |points: &[(Point, f64, bool)]| {
@@ -222,16 +217,46 @@ pub fn audit(
     }
 }
 
-/// How many points [`audit`] compares: every node, and `(density N + 1)` lookups per axis.
+/// The `mu` of the grazing probes [`audit`] adds on every roughness of its ladder, whatever the
+/// table's axis: exactly 0, 1e-12, and 1e-6 to 1 in 24 log steps (the boundary layer `mu ~ alpha`
+/// that a coarse texture-space ladder can step over).
+fn grazing_probes() -> Vec<f64> {
+    let mut probes = vec![0.0, 1e-12];
+    probes.extend((0..=24).map(|k| 10f64.powf(-6.0 + f64::from(k) / 4.0)));
+    probes
+}
+
+/// The `(alpha, mu)` at which [`audit`] compares lookups: a ladder over each axis' texture
+/// coordinate `t` in [0, 1], in steps of `1 / (density N)` (texel centres or nodes, the points
+/// halfway between, and the axis ends), and for a 2-D table the grazing probes on every rung
+/// of the roughness ladder.
+#[must_use]
+pub fn lookup_coordinates(table: &Table, settings: &AuditSettings) -> Vec<(f64, Option<f64>)> {
+    let spec = &table.spec;
+    let ladder = |n: usize| -> Vec<f64> {
+        let steps = settings.density.max(1) * n;
+        (0..=steps).map(|j| j as f64 / steps as f64).collect()
+    };
+    let mut points = Vec::new();
+    for t_r in ladder(spec.roughness.size()) {
+        match spec.mu {
+            Some(axis) => {
+                for t_mu in ladder(axis.size()) {
+                    points.push(spec.point(t_r, t_mu));
+                }
+                let alpha = spec.roughness_convention().to_alpha(t_r);
+                points.extend(grazing_probes().into_iter().map(|mu| (alpha, Some(mu))));
+            }
+            None => points.push(spec.point(t_r, 0.0)),
+        }
+    }
+    points
+}
+
+/// How many points [`audit`] compares: every node and every [`lookup_coordinates`] point.
 #[must_use]
 pub fn audit_points(table: &Table, settings: &AuditSettings) -> u64 {
-    let lookups: usize = table
-        .spec
-        .shape()
-        .iter()
-        .map(|&n| settings.density.max(1) * n + 1)
-        .product();
-    (table.spec.len() + lookups) as u64
+    (table.spec.len() + lookup_coordinates(table, settings).len()) as u64
 }
 
 /// The largest number of `E_avg` entries [`node_errors`] checks: each costs the reference about

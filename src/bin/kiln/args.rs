@@ -9,11 +9,17 @@ Conventions:
   mu         cos(theta) of the view direction, in [0, 1] (0 = grazing, 1 = normal incidence).
   roughness  either perceptual r with alpha = r^2 (Burley, Filament, Cycles; the default axis)
              or alpha itself (the slope-space width; Mitsuba). Every file says which.
-  grid       'centers': sample i sits at texel centre t = (i + 0.5) / N, right for a GPU texture
-             sampled with bilinear filtering and clamp-to-edge. 'nodes': t = i / (N - 1), the
-             first and last samples on the axis ends (Cycles); a GPU lookup must remap
-             t' = (t (N - 1) + 0.5) / N.
-  mu axis    'linear': mu = t. 'sqrt': mu = t^2 (look up at t = sqrt(mu)), denser near grazing.
+  grid       'nodes' (bake's default): t = i / (N - 1), the first and last samples on the axis
+             ends, so lookups interpolate all the way to mu = 0 and 1 and r = 0 and 1; a GPU
+             lookup must remap t' = (t (N - 1) + 0.5) / N before sampling. 'centers': sample i
+             sits at texel centre t = (i + 0.5) / N, sampled at raw t by a GPU, but the outer
+             half texel on each side is clamped (errors up to 1e-2 at 32 x 32).
+  mu axis    'adaptive' (bake's default): look up at t = (mu (1 + 4 alpha) / (mu + 4 alpha))^0.4
+             (t = 0 at mu = 0, t = 1 at alpha = 0 and mu > 0). It keeps the grazing boundary
+             layer mu ~ alpha at the same t for every roughness: 6.5e-4 max lookup error at
+             32 x 32 against 1e-1 for 'linear' and 'sqrt'. The row alpha = 0 holds the limit
+             alpha -> 0+ (computed at alpha = 1e-7). 'linear': mu = t. 'sqrt': mu = t^2 (look up
+             at t = sqrt(mu)).
   layout     row-major, roughness rows (slow), mu columns (fast); as an image x = mu, y = roughness.
   E          directional albedo of the single-scattering BRDF with F = 1; E_avg = 2 ∫ E(mu) mu dmu.
              one_minus_E is stored beside E, estimated directly: use it when E is near 1,

@@ -63,11 +63,14 @@ pub struct BakeArgs {
     /// Roughness axis: perceptual r (alpha = r^2) or alpha.
     #[arg(long, value_enum, default_value = "r")]
     roughness_axis: RoughnessConvention,
-    /// Spacing of the mu axis: linear (mu = t) or sqrt (mu = t^2).
-    #[arg(long, value_enum, default_value = "linear")]
+    /// Spacing of the mu axis: adaptive (follows the grazing layer mu ~ alpha; lookup
+    /// coordinate t = (mu (1 + 4 alpha) / (mu + 4 alpha))^0.4), linear (mu = t) or sqrt
+    /// (mu = t^2). See "Conventions" below.
+    #[arg(long, value_enum, default_value = "adaptive")]
     mu_axis: MuMapping,
-    /// Where samples sit: texel centres (i + 0.5)/N or nodes i/(N - 1).
-    #[arg(long, value_enum, default_value = "centers")]
+    /// Where samples sit: nodes i/(N - 1) on the axis ends (lookups must remap, see below) or
+    /// texel centres (i + 0.5)/N.
+    #[arg(long, value_enum, default_value = "nodes")]
     grid: Grid,
     /// How to compute the values: quasi-Monte Carlo (with a standard error per texel) or the
     /// deterministic reference quadrature (error at most 1e-10, about as fast for E tables,

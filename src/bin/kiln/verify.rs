@@ -4,6 +4,7 @@ use crate::args::{CONVENTIONS, parse_error_bound, parse_number};
 use clap::Args;
 use kiln::format::Precision;
 use kiln::integrate::reference::ReferenceSettings;
+use kiln::verify::furnace::furnace;
 use kiln::verify::input::{AxisName, Encoding, Layout, read_external, read_kiln};
 use kiln::verify::{Against, AuditSettings, Point, audit, audit_points};
 use kiln::{Grid, Masking, Model, MuMapping, Ndf, Quantity, RoughnessConvention, Table};
@@ -29,6 +30,15 @@ pub struct VerifyArgs {
     /// What to compare with: 'reference' (the deterministic quadrature) or another table's file.
     #[arg(long, default_value = "reference")]
     against: String,
+    /// White furnace test instead of an audit: with FILE's E table and its E_avg table (found
+    /// beside it, `...-E_avg` with the same extension, or given with --average), check that
+    /// the Kulla-Conty lobe f_ms restores exactly the energy E loses, over roughness and mu.
+    /// Reports the worst deviation E + albedo(f_ms) - 1; --max-error applies to it.
+    #[arg(long, conflicts_with = "against")]
+    furnace: bool,
+    /// The E_avg table for --furnace (default: beside FILE).
+    #[arg(long, requires = "furnace")]
+    average: Option<PathBuf>,
     /// Print one JSON object instead of text.
     #[arg(long)]
     json: bool,
@@ -169,9 +179,90 @@ fn describe(point: &Point, convention: &str) -> String {
     )
 }
 
+/// Where the `E_avg` table of a kiln `E` file is: `NAME-E.EXT` -> `NAME-E_avg.EXT`.
+fn sibling_average(path: &Path) -> kiln::Result<PathBuf> {
+    let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("");
+    let extension = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+    match stem.strip_suffix("-E") {
+        Some(base) => Ok(path.with_file_name(format!("{base}-E_avg.{extension}"))),
+        None => Err(kiln::Error::InvalidInput(format!(
+            "{} is not named like a kiln E table (NAME-E.EXT): give its E_avg table with --average",
+            path.display()
+        ))),
+    }
+}
+
+fn run_furnace(args: &VerifyArgs, table: &Table) -> kiln::Result<bool> {
+    let average_path = match &args.average {
+        Some(path) => path.clone(),
+        None => sibling_average(&args.file)?,
+    };
+    let average = args.load(&average_path)?;
+    let report = furnace(table, &average, args.density as usize)?;
+    let passed = args
+        .max_error
+        .is_none_or(|bound| report.max_deviation <= bound);
+    if args.json {
+        let mut object = serde_json::to_value(&report).expect("a report serialises");
+        object["file"] = args.file.display().to_string().into();
+        object["average"] = average_path.display().to_string().into();
+        if let Some(bound) = args.max_error {
+            object["max_error"] = bound.into();
+            object["passed"] = passed.into();
+        }
+        println!("{object}");
+        return Ok(passed);
+    }
+    let convention = table.spec.roughness_convention().name();
+    println!(
+        "{} with {}: white furnace test of the Kulla-Conty lobe, {} roughness values",
+        args.file.display(),
+        average_path.display(),
+        report.rows.len()
+    );
+    let w = &report.worst;
+    println!(
+        "  max |E + albedo(f_ms) - 1| = {:.2e} at mu = {:.3e}, {convention} = {:.4} (alpha {:.3e}): \
+         1 - E_avg is {:.4e} in the table, {:.4e} as the average of the E lookup (mismatch {:+.2e})",
+        report.max_deviation,
+        w.worst_mu,
+        w.roughness,
+        w.alpha,
+        w.one_minus_e_avg,
+        w.one_minus_e_avg_of_e,
+        w.relative_mismatch
+    );
+    println!(
+        "  {convention:>8} {:>12} {:>12} {:>11} {:>11}",
+        "1-E_avg", "1-avg(E)", "mismatch", "deviation"
+    );
+    let step = (report.rows.len() / 16).max(1);
+    for row in report.rows.iter().step_by(step) {
+        println!(
+            "  {:>8.4} {:>12.4e} {:>12.4e} {:>+11.2e} {:>+11.2e}",
+            row.roughness,
+            row.one_minus_e_avg,
+            row.one_minus_e_avg_of_e,
+            row.relative_mismatch,
+            row.deviation
+        );
+    }
+    if let Some(bound) = args.max_error {
+        let verdict = if passed { "passes" } else { "FAILS" };
+        println!(
+            "  {verdict} --max-error {bound:e} (max deviation {:.2e})",
+            report.max_deviation
+        );
+    }
+    Ok(passed)
+}
+
 /// Returns whether the table passed `--max-error` (always true without it).
 pub fn run(args: VerifyArgs) -> kiln::Result<bool> {
     let table = args.load(&args.file)?;
+    if args.furnace {
+        return run_furnace(&args, &table);
+    }
     let other;
     let against = if args.against == "reference" {
         Against::Reference(ReferenceSettings::default())

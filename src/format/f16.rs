@@ -1,0 +1,113 @@
+//! Half-float storage without silent loss: values beyond f16's range are clamped, never turned
+//! into infinity or zero, and the metadata counts them.
+//!
+//! f16 has 11 significant bits: a rounding error of at most `2^-11` (4.9e-4) relative for
+//! normal values, down to `2^-14` (6.1e-5). Below that, subnormals keep a fixed spacing of `2^-24` (6.0e-8), so their
+//! relative precision falls; below half that spacing a value would round to zero. `1 - E` is
+//! stored beside `E` for this reason (`physics.md`, "Hard cases"): `E(1, alpha = 0.01)` rounds
+//! to exactly 1 as an f16, while `1 - E` keeps 0.05 % relative precision down to 6.1e-5.
+
+use half::f16;
+use serde::{Deserialize, Serialize};
+
+/// The largest finite f16, 65504.
+pub const MAX: f64 = 65504.0;
+/// The smallest positive normal f16, `2^-14`.
+pub const MIN_NORMAL: f64 = 6.103_515_625e-5;
+/// The smallest positive subnormal f16, `2^-24`.
+pub const MIN_SUBNORMAL: f64 = 5.960_464_477_539_063e-8;
+
+/// What storing one value as f16 did.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Outcome {
+    /// Stored to f16's full relative precision (or exactly zero).
+    Exact,
+    /// Stored as a subnormal: absolute spacing 6e-8, reduced relative precision.
+    Subnormal,
+    /// Beyond f16's range (above 65504 in magnitude, or so small that it would round to zero):
+    /// clamped to the largest finite or the smallest subnormal value of the same sign.
+    Clamped,
+}
+
+/// `v` as an f16, clamped into f16's finite non-zero range if it would overflow or underflow.
+/// Goes through f32 (whose rounding to f16 is the same on every CPU). NaN stays NaN.
+#[must_use]
+pub fn encode(v: f64) -> (f16, Outcome) {
+    let magnitude = v.abs();
+    if v == 0.0 || v.is_nan() {
+        return (f16::from_f32(v as f32), Outcome::Exact);
+    }
+    if magnitude > MAX {
+        return (f16::from_f64(MAX.copysign(v)), Outcome::Clamped);
+    }
+    let h = f16::from_f32(v as f32);
+    if h.to_f32() == 0.0 {
+        return (f16::from_f64(MIN_SUBNORMAL.copysign(v)), Outcome::Clamped);
+    }
+    let outcome = if f64::from(h.to_f32()).abs() < MIN_NORMAL {
+        Outcome::Subnormal
+    } else {
+        Outcome::Exact
+    };
+    (h, outcome)
+}
+
+/// How many values of a channel [`encode`] clamped or stored as subnormals.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Counts {
+    /// Values beyond f16's range, clamped (never stored as infinity or zero).
+    pub clamped: usize,
+    /// Values stored as subnormals (below 6.1e-5), with absolute spacing 6e-8.
+    pub subnormal: usize,
+}
+
+/// [`Counts`] for storing `values` as f16.
+#[must_use]
+pub fn counts(values: &[f64]) -> Counts {
+    let mut counts = Counts::default();
+    for &v in values {
+        match encode(v).1 {
+            Outcome::Exact => {}
+            Outcome::Subnormal => counts.subnormal += 1,
+            Outcome::Clamped => counts.clamped += 1,
+        }
+    }
+    counts
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn overflow_and_underflow_are_clamped_not_infinite_or_zero() {
+        assert_eq!(encode(1e6), (f16::MAX, Outcome::Clamped));
+        assert_eq!(encode(-1e6), (f16::MIN, Outcome::Clamped));
+        let (tiny, outcome) = encode(1e-9);
+        assert_eq!(outcome, Outcome::Clamped);
+        assert_eq!(f64::from(tiny.to_f32()), MIN_SUBNORMAL);
+        assert_eq!(encode(0.0), (f16::ZERO, Outcome::Exact));
+        assert_eq!(encode(1e-6).1, Outcome::Subnormal);
+        assert_eq!(encode(0.5), (f16::from_f32(0.5), Outcome::Exact));
+        assert!(encode(f64::NAN).0.is_nan());
+        assert_eq!(
+            counts(&[1e-9, 1e-6, 0.5, 0.0, 7e4]),
+            Counts {
+                clamped: 2,
+                subnormal: 1
+            }
+        );
+    }
+
+    #[test]
+    fn normal_range_keeps_relative_precision() {
+        // 0.1 % relative accuracy down to 1e-4 (kiln's promise for one_minus_E): rounding to
+        // 11 significant bits errs by at most 2^-11 relative throughout f16's normal range.
+        let mut v = 1e-4;
+        while v < 1.0 {
+            let stored = f64::from(encode(v).0.to_f32());
+            assert!(((stored - v) / v).abs() <= 2f64.powi(-11), "{v}");
+            v *= 1.013;
+        }
+    }
+}
