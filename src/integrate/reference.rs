@@ -85,7 +85,9 @@ pub fn reference_albedo(
     settings: &ReferenceSettings,
 ) -> ReferenceValue {
     assert!((0.0..=1.0).contains(&mu) && alpha >= 0.0 && alpha.is_finite());
-    if alpha == 0.0 && mu > 0.0 {
+    // A mirror, and the exact height-correlated grazing limit E(0) = 1 (physics.md): G2 / G1(o)
+    // = (1 + Lambda(o)) / (1 + Lambda(o) + Lambda(i)) -> 1 as Lambda(o) -> infinity.
+    if (alpha == 0.0 && mu > 0.0) || (mu == 0.0 && model.masking == Masking::HeightCorrelated) {
         return MIRROR;
     }
     let (alpha, mu) = smooth_point(alpha, mu);

@@ -61,11 +61,13 @@ impl MicrofacetDistribution for Ggx {
         self.alpha
     }
 
-    /// `D = alpha^2 / (pi (1 + (alpha^2 - 1) c^2)^2)` (Walter 2007, eq. 33, rewritten in `c`).
+    /// `D = alpha^2 / (pi (1 + (alpha^2 - 1) c^2)^2)` (Walter 2007, eq. 33, rewritten in `c`),
+    /// with `1 + (alpha^2 - 1) c^2` summed as `(1 - c)(1 + c) + alpha^2 c^2`: the plain form
+    /// cancels to 0 at `c = 1` once `alpha^2` is below f64's epsilon.
     fn d(&self, cos_theta_m: f64) -> f64 {
         let a2 = self.alpha * self.alpha;
-        let c2 = cos_theta_m * cos_theta_m;
-        let t = 1.0 + (a2 - 1.0) * c2;
+        let c = cos_theta_m;
+        let t = (1.0 - c) * (1.0 + c) + a2 * c * c;
         a2 / (PI * t * t)
     }
 
