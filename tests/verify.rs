@@ -478,3 +478,39 @@ fn audit_of_cycles_ggx_table() {
         "{worst}"
     );
 }
+
+/// `--furnace` finds the E_avg table beside the E file (or takes --average), reports JSON, and
+/// gates on --max-error; a file not named like a kiln E table asks for --average.
+#[test]
+fn furnace_flag_finds_the_average_and_gates() {
+    let tables = Path::new(env!("CARGO_MANIFEST_DIR")).join("tables");
+    let e = tables.join("ggx-height-correlated-E.json");
+    let (status, report) = verify(&["--furnace", e.to_str().unwrap()]);
+    assert_eq!(status, Some(0));
+    assert!(
+        report["average"]
+            .as_str()
+            .unwrap()
+            .ends_with("ggx-height-correlated-E_avg.json")
+    );
+    let max = number(&report, "max_deviation");
+    assert!(max > 0.0 && max < 1.0, "{report}");
+    let (status, report) = verify(&["--furnace", e.to_str().unwrap(), "--max-error", "1e-9"]);
+    assert_eq!((status, &report["passed"]), (Some(1), &Value::Bool(false)));
+    // The binary copy, with its E_avg given explicitly: the same test within f32 rounding.
+    let bin = tables.join("ggx-height-correlated-E.bin");
+    let avg = tables.join("ggx-height-correlated-E_avg.bin");
+    let (_, from_bin) = verify(&[
+        "--furnace",
+        bin.to_str().unwrap(),
+        "--average",
+        avg.to_str().unwrap(),
+    ]);
+    assert!((number(&from_bin, "max_deviation") - max).abs() < 1e-4 * max);
+    let renamed = tempfile::tempdir().unwrap();
+    let other = renamed.path().join("mine.json");
+    std::fs::copy(&e, &other).unwrap();
+    let output = kiln(&["verify", "--furnace", other.to_str().unwrap()]);
+    assert_eq!(output.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&output.stderr).contains("--average"));
+}
