@@ -1,4 +1,5 @@
-//! Samples per second of kiln's QMC estimators (VNDF sampling with Owen-scrambled Sobol points).
+//! Samples per second of kiln's QMC estimators (VNDF sampling with Owen-scrambled Sobol points),
+//! and of every estimator `kiln study` compares ([`kiln::study::estimators`]).
 //!
 //! Run with `cargo bench --bench estimators`; criterion reports throughput in elements (integrand
 //! evaluations) per second, single-threaded.
@@ -30,5 +31,38 @@ fn estimators(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, estimators);
+/// Every estimator of `kiln study`, GGX height-correlated at alpha 0.25, mu 0.5 (the quadrature's
+/// elements are its integrand evaluations, at tolerance 1e-10).
+fn study_estimators(c: &mut Criterion) {
+    use kiln::study::estimators::{Estimator, estimate};
+    let model = Model {
+        ndf: Ndf::Ggx,
+        masking: Masking::HeightCorrelated,
+    };
+    let samples = 1u64 << 14;
+    let mut group = c.benchmark_group("study");
+    for estimator in Estimator::ALL {
+        let elements = match estimator {
+            Estimator::Quadrature => estimate(estimator, model, 0.25, 0.5, 0, 1e-10, 0).1,
+            _ => samples,
+        };
+        group.throughput(Throughput::Elements(elements));
+        group.bench_function(estimator.name(), |b| {
+            b.iter(|| {
+                estimate(
+                    estimator,
+                    model,
+                    black_box(0.25),
+                    black_box(0.5),
+                    samples,
+                    1e-10,
+                    0,
+                )
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, estimators, study_estimators);
 criterion_main!(benches);

@@ -36,6 +36,7 @@ pub mod error;
 pub mod format;
 pub mod integrate;
 pub mod model;
+pub mod study;
 pub mod table;
 pub mod verify;
 

@@ -475,3 +475,59 @@ fn reference_method_bakes_tables_within_1e_10_that_qmc_agrees_with() {
         }
     }
 }
+
+/// `kiln study --quick`: every file, consistent with each other (CSV rows are the JSON's runs),
+/// plots that are an SVG with the legend's entries and a PNG of the stated size, and a summary
+/// line per method. Its timings are not asserted.
+#[test]
+fn study_quick_writes_consistent_files_and_a_summary() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("study");
+    let output = kiln(&["study", "--quick", "-q", "--out", out.to_str().unwrap()]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    assert_eq!(
+        files_in(&out),
+        [
+            "lookup.csv",
+            "lookup.png",
+            "lookup.svg",
+            "study.csv",
+            "study.json",
+            "study.png",
+            "study.svg"
+        ]
+    );
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("study.json")).unwrap()).unwrap();
+    let runs = json["runs"].as_array().unwrap();
+    let csv = std::fs::read_to_string(out.join("study.csv")).unwrap();
+    assert_eq!(csv.lines().count(), runs.len() + 1);
+    for (line, run) in csv.lines().skip(1).zip(runs) {
+        assert!(line.starts_with(&format!(
+            "{},{},",
+            run["method"].as_str().unwrap(),
+            run["samples"]
+        )));
+    }
+    let methods: std::collections::BTreeSet<&str> =
+        runs.iter().map(|r| r["method"].as_str().unwrap()).collect();
+    assert_eq!(methods.len(), 6, "every method, even in --quick");
+    assert!(json["cores"].as_u64().unwrap() >= 1 && json["kiln_version"].is_string());
+    let svg = std::fs::read_to_string(out.join("study.svg")).unwrap();
+    assert!(
+        svg.starts_with("<svg")
+            && svg.contains("Pareto front")
+            && svg.contains("VNDF sampling, Sobol")
+    );
+    let png = std::fs::read(out.join("study.png")).unwrap();
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+    assert_eq!(u32::from_be_bytes(png[16..20].try_into().unwrap()), 1100);
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    for method in &methods {
+        assert!(stdout.lines().any(|l| l.starts_with(method)), "{stdout}");
+    }
+    assert!(
+        stdout.contains("to 1e-6") || stdout.contains("did not reach 1e-6"),
+        "{stdout}"
+    );
+}

@@ -3,6 +3,8 @@
 mod args;
 mod bake;
 mod eval;
+mod plot;
+mod study;
 mod verify;
 
 use clap::{Parser, Subcommand};
@@ -24,6 +26,8 @@ enum Command {
     Eval(eval::EvalArgs),
     /// Audit a table (kiln's or an engine's) against the deterministic reference.
     Verify(verify::VerifyArgs),
+    /// Measure what accuracy costs: error against time per estimator, lookup error against size.
+    Study(study::StudyArgs),
 }
 
 /// A progress bar on stderr, drawn only when stderr is a terminal; hidden with `quiet`.
@@ -65,6 +69,7 @@ fn main() -> ExitCode {
         Command::Bake(args) => bake::run(args).map(|()| true),
         Command::Eval(args) => eval::run(args).map(|()| true),
         Command::Verify(args) => verify::run(args),
+        Command::Study(args) => study::run(args).map(|()| true),
     };
     match result {
         Ok(true) => ExitCode::SUCCESS,

@@ -1,0 +1,222 @@
+//! The study's plots, as SVG and PNG, with plotters (no system libraries: the PNG's text uses an
+//! embedded font, registered once).
+
+use kiln::study::estimators::Estimator;
+use kiln::study::{LookupRun, StudyReport};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use std::sync::Once;
+
+const SIZE: (u32, u32) = (1100, 700);
+
+/// Distinct colours (Okabe-Ito), one per series.
+const COLOURS: [RGBColor; 6] = [
+    RGBColor(230, 159, 0),
+    RGBColor(86, 180, 233),
+    RGBColor(0, 158, 115),
+    RGBColor(204, 121, 167),
+    RGBColor(213, 94, 0),
+    RGBColor(0, 114, 178),
+];
+
+fn register_font() {
+    static ONCE: Once = Once::new();
+    ONCE.call_once(|| {
+        // The font is a compile-time constant known to parse.
+        let _ = plotters::style::register_font(
+            "sans-serif",
+            FontStyle::Normal,
+            epaint_default_fonts::UBUNTU_LIGHT,
+        );
+    });
+}
+
+/// A series: name and points `(x, y)`, both positive.
+struct Series {
+    name: String,
+    points: Vec<(f64, f64)>,
+}
+
+/// The range covering `values` on a log axis, padded by a factor of 2 each way.
+fn log_range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
+    let (lo, hi) = values
+        .filter(|v| *v > 0.0 && v.is_finite())
+        .fold((f64::INFINITY, 0.0_f64), |(lo, hi), v| {
+            (lo.min(v), hi.max(v))
+        });
+    if lo > hi {
+        return 1e-3..1.0;
+    }
+    lo / 2.0..hi * 2.0
+}
+
+/// Draws a log-log chart: each series as a line with dots, and an optional highlighted path.
+fn chart<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    series: &[Series],
+    highlight: Option<(&str, &[(f64, f64)])>,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    root.fill(&WHITE)?;
+    let all = || series.iter().flat_map(|s| s.points.iter().copied());
+    let x_range = log_range(all().map(|p| p.0));
+    let y_range = log_range(all().map(|p| p.1));
+    let mut chart = ChartBuilder::on(root)
+        .caption(title, ("sans-serif", 26))
+        .margin(18)
+        .x_label_area_size(55)
+        .y_label_area_size(80)
+        .build_cartesian_2d(x_range.log_scale(), y_range.log_scale())?;
+    chart
+        .configure_mesh()
+        .x_desc(x_label)
+        .y_desc(y_label)
+        .axis_desc_style(("sans-serif", 20))
+        .label_style(("sans-serif", 16))
+        .x_label_formatter(&|x| format!("{x:.0e}"))
+        .y_label_formatter(&|y| format!("{y:.0e}"))
+        .light_line_style(WHITE.mix(0.0))
+        .draw()?;
+    for (k, s) in series.iter().enumerate() {
+        let colour = COLOURS[k % COLOURS.len()];
+        let points: Vec<(f64, f64)> = s
+            .points
+            .iter()
+            .copied()
+            .filter(|p| p.0 > 0.0 && p.1 > 0.0)
+            .collect();
+        chart
+            .draw_series(LineSeries::new(points.clone(), colour.stroke_width(2)))?
+            .label(s.name.as_str())
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 24, y)], colour.stroke_width(3))
+            });
+        chart.draw_series(points.iter().map(|&p| Circle::new(p, 4, colour.filled())))?;
+    }
+    if let Some((name, path)) = highlight {
+        let path: Vec<(f64, f64)> = path.to_vec();
+        chart
+            .draw_series(DashedLineSeries::new(
+                path.clone(),
+                6,
+                4,
+                BLACK.stroke_width(2),
+            ))?
+            .label(name)
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], BLACK.stroke_width(2)));
+        chart.draw_series(
+            path.iter()
+                .map(|&p| Circle::new(p, 8, BLACK.stroke_width(2))),
+        )?;
+    }
+    chart
+        .configure_series_labels()
+        .label_font(("sans-serif", 17))
+        .background_style(WHITE.mix(0.9))
+        .border_style(BLACK)
+        .position(SeriesLabelPosition::LowerLeft)
+        .draw()?;
+    root.present()?;
+    Ok(())
+}
+
+/// Renders a chart as SVG text and as PNG bytes.
+fn render(
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    series: &[Series],
+    highlight: Option<(&str, &[(f64, f64)])>,
+) -> Result<(String, Vec<u8>), String> {
+    register_font();
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
+        chart(&root, title, x_label, y_label, series, highlight).map_err(|e| e.to_string())?;
+    }
+    let mut pixels = vec![255u8; (SIZE.0 * SIZE.1 * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut pixels, SIZE).into_drawing_area();
+        chart(&root, title, x_label, y_label, series, highlight).map_err(|e| e.to_string())?;
+    }
+    let mut png_bytes = Vec::new();
+    {
+        let mut encoder = png::Encoder::new(&mut png_bytes, SIZE.0, SIZE.1);
+        encoder.set_color(png::ColorType::Rgb);
+        encoder.set_depth(png::BitDepth::Eight);
+        let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
+        writer
+            .write_image_data(&pixels)
+            .map_err(|e| e.to_string())?;
+    }
+    Ok((svg, png_bytes))
+}
+
+/// Error against time, one line per method, the Pareto front dashed.
+pub fn cost_plot(report: &StudyReport) -> Result<(String, Vec<u8>), String> {
+    let series: Vec<Series> = Estimator::ALL
+        .iter()
+        .map(|e| Series {
+            name: e.describe().to_string(),
+            points: report
+                .runs
+                .iter()
+                .filter(|r| r.method == e.name())
+                .map(|r| (r.seconds, r.max_error.max(1e-16)))
+                .collect(),
+        })
+        .filter(|s| !s.points.is_empty())
+        .collect();
+    let front: Vec<(f64, f64)> = report
+        .pareto
+        .iter()
+        .map(|&k| (report.runs[k].seconds, report.runs[k].max_error.max(1e-16)))
+        .collect();
+    render(
+        &format!(
+            "What accuracy costs: {} {} E, {} x {} table",
+            report.ndf, report.masking, report.size, report.size
+        ),
+        &format!(
+            "wall time to fill the table, {} threads (s)",
+            report.threads
+        ),
+        "max error at the nodes",
+        &series,
+        Some(("Pareto front", &front)),
+    )
+}
+
+/// Lookup error against table size, one line per mu mapping.
+pub fn lookup_plot(report: &StudyReport) -> Result<(String, Vec<u8>), String> {
+    let mut mappings: Vec<&str> = Vec::new();
+    for r in &report.lookup {
+        if !mappings.contains(&r.mapping.as_str()) {
+            mappings.push(&r.mapping);
+        }
+    }
+    let series: Vec<Series> = mappings
+        .iter()
+        .map(|m| Series {
+            name: format!("mu axis {m}, nodes grid"),
+            points: report
+                .lookup
+                .iter()
+                .filter(|r: &&LookupRun| r.mapping == *m)
+                .map(|r| (r.size as f64, r.max_error.max(1e-16)))
+                .collect(),
+        })
+        .collect();
+    render(
+        &format!(
+            "Lookup error of reference-filled {} {} E tables",
+            report.ndf, report.masking
+        ),
+        "table size N (N x N)",
+        "max lookup error (kiln verify)",
+        &series,
+        None,
+    )
+}

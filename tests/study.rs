@@ -1,0 +1,123 @@
+//! `kiln study`: its measurements are what they claim (errors recomputed independently against
+//! the reference, lookup errors as `verify` gives them), and its files follow their schema.
+//! Timings are never asserted.
+
+use kiln::integrate::reference::{ReferenceSettings, reference_albedo};
+use kiln::study::estimators::{Estimator, estimate};
+use kiln::study::{StudySettings, lookup_csv, run, runs_csv};
+use kiln::table::axis::MuMapping;
+use kiln::{Masking, Model, Ndf};
+
+fn model() -> Model {
+    Model {
+        ndf: Ndf::Ggx,
+        masking: Masking::HeightCorrelated,
+    }
+}
+
+fn tiny() -> StudySettings {
+    StudySettings {
+        model: model(),
+        size: 4,
+        samples: vec![
+            (Estimator::CosineRandom, vec![64, 256]),
+            (Estimator::VndfSobol, vec![256]),
+        ],
+        tolerances: vec![1e-4],
+        lookup_sizes: vec![4],
+        lookup_mappings: vec![MuMapping::Linear, MuMapping::Adaptive],
+        seed: 5,
+    }
+}
+
+#[test]
+fn study_errors_are_recomputed_against_the_reference() {
+    let settings = tiny();
+    let done = std::sync::atomic::AtomicU64::new(0);
+    let report = run(&settings, &|n| {
+        done.fetch_add(n, std::sync::atomic::Ordering::Relaxed);
+    });
+    // Progress adds up to the announced work.
+    assert_eq!(
+        done.load(std::sync::atomic::Ordering::Relaxed),
+        settings.work()
+    );
+    assert_eq!(report.runs.len(), 4);
+    let spec = settings.table_spec();
+    for r in &report.runs {
+        let estimator = Estimator::ALL
+            .into_iter()
+            .find(|e| e.name() == r.method)
+            .unwrap();
+        let tolerance = r.tolerance.unwrap_or(0.0);
+        let diffs: Vec<f64> = (0..spec.len())
+            .map(|k| {
+                let (alpha, mu) = spec.texel_coordinates(k);
+                let mu = mu.unwrap();
+                let (value, _) = estimate(
+                    estimator,
+                    model(),
+                    alpha,
+                    mu,
+                    r.samples,
+                    tolerance,
+                    settings.seed,
+                );
+                let truth =
+                    reference_albedo(model(), alpha, mu, &ReferenceSettings::default()).value;
+                (value - truth).abs()
+            })
+            .collect();
+        let max = diffs.iter().copied().fold(0.0, f64::max);
+        let rms = (diffs.iter().map(|d| d * d).sum::<f64>() / diffs.len() as f64).sqrt();
+        if estimator == Estimator::Quadrature {
+            // Its `samples` is the mean evaluation count; the estimates do not depend on it.
+            assert!(r.samples > 0);
+        }
+        assert_eq!(r.max_error, max, "{r:?}");
+        assert!((r.rms_error - rms).abs() <= 1e-15 * rms.max(1.0), "{r:?}");
+        assert!(r.seconds > 0.0);
+    }
+    // The Pareto front is a subset of the runs, time-ordered with falling error.
+    let front: Vec<_> = report.pareto.iter().map(|&k| &report.runs[k]).collect();
+    assert!(!front.is_empty());
+    for pair in front.windows(2) {
+        assert!(pair[0].seconds <= pair[1].seconds && pair[0].max_error > pair[1].max_error);
+    }
+    // One summary per method, each with the three targets.
+    assert_eq!(report.summary.len(), 3);
+    assert!(report.summary.iter().all(|s| s.reaches.len() == 3));
+    // The adaptive axis beats the linear one at this size, as verify measures.
+    assert_eq!(report.lookup.len(), 2);
+    assert!(report.lookup[1].max_error < report.lookup[0].max_error);
+}
+
+#[test]
+fn csv_files_follow_their_schema() {
+    let report = run(&tiny(), &|_| {});
+    let csv = runs_csv(&report);
+    let mut lines = csv.lines();
+    assert_eq!(
+        lines.next(),
+        Some("method,samples,seconds,max_error,rms_error")
+    );
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), report.runs.len());
+    for (row, run) in rows.iter().zip(&report.runs) {
+        assert_eq!(row.len(), 5);
+        assert_eq!(row[0], run.method);
+        assert_eq!(row[1].parse::<u64>().unwrap(), run.samples);
+        let seconds: f64 = row[2].parse().unwrap();
+        assert!((seconds - run.seconds).abs() <= 1e-6);
+        let max: f64 = row[3].parse().unwrap();
+        assert!((max - run.max_error).abs() <= 1e-6 * run.max_error);
+        let _: f64 = row[4].parse().unwrap();
+    }
+    let lookup = lookup_csv(&report);
+    let mut lines = lookup.lines();
+    assert_eq!(
+        lines.next(),
+        Some("mapping,grid,size,max_error,rms_error,p99_error")
+    );
+    assert_eq!(lines.count(), report.lookup.len());
+}
