@@ -203,13 +203,8 @@ fn run_furnace(args: &VerifyArgs, table: &Table) -> kiln::Result<bool> {
         .max_error
         .is_none_or(|bound| report.max_deviation <= bound);
     if args.json {
-        let mut object = serde_json::to_value(&report).expect("a report serialises");
-        object["file"] = args.file.display().to_string().into();
+        let mut object = json_report(&report, args, passed);
         object["average"] = average_path.display().to_string().into();
-        if let Some(bound) = args.max_error {
-            object["max_error"] = bound.into();
-            object["passed"] = passed.into();
-        }
         println!("{object}");
         return Ok(passed);
     }
@@ -247,14 +242,36 @@ fn run_furnace(args: &VerifyArgs, table: &Table) -> kiln::Result<bool> {
             row.deviation
         );
     }
-    if let Some(bound) = args.max_error {
-        let verdict = if passed { "passes" } else { "FAILS" };
-        println!(
-            "  {verdict} --max-error {bound:e} (max deviation {:.2e})",
-            report.max_deviation
-        );
-    }
+    print_verdict(
+        args.max_error,
+        passed,
+        "max deviation",
+        report.max_deviation,
+    );
     Ok(passed)
+}
+
+/// The `--max-error` line of the text report.
+fn print_verdict(bound: Option<f64>, passed: bool, what: &str, value: f64) {
+    if let Some(bound) = bound {
+        let verdict = if passed { "passes" } else { "FAILS" };
+        println!("  {verdict} --max-error {bound:e} ({what} {value:.2e})");
+    }
+}
+
+/// A report as one JSON object, with the file and the `--max-error` verdict.
+fn json_report(
+    report: &impl serde::Serialize,
+    args: &VerifyArgs,
+    passed: bool,
+) -> serde_json::Value {
+    let mut object = serde_json::to_value(report).expect("a report serialises");
+    object["file"] = args.file.display().to_string().into();
+    if let Some(bound) = args.max_error {
+        object["max_error"] = bound.into();
+        object["passed"] = passed.into();
+    }
+    object
 }
 
 /// Returns whether the table passed `--max-error` (always true without it).
@@ -294,13 +311,7 @@ pub fn run(args: VerifyArgs) -> kiln::Result<bool> {
         .max_error
         .is_none_or(|bound| report.node_max_error <= bound);
     if args.json {
-        let mut object = serde_json::to_value(&report).expect("a report serialises");
-        object["file"] = args.file.display().to_string().into();
-        if let Some(bound) = args.max_error {
-            object["max_error"] = bound.into();
-            object["passed"] = passed.into();
-        }
-        println!("{object}");
+        println!("{}", json_report(&report, &args, passed));
     } else {
         let shape: Vec<String> = report.shape.iter().map(|n| n.to_string()).collect();
         println!(
@@ -345,13 +356,12 @@ pub fn run(args: VerifyArgs) -> kiln::Result<bool> {
                 report.reference_error_estimate
             );
         }
-        if let Some(bound) = args.max_error {
-            let verdict = if passed { "passes" } else { "FAILS" };
-            println!(
-                "  {verdict} --max-error {bound:e} (node max error {:.2e})",
-                report.node_max_error
-            );
-        }
+        print_verdict(
+            args.max_error,
+            passed,
+            "node max error",
+            report.node_max_error,
+        );
     }
     Ok(passed)
 }
