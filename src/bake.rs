@@ -5,7 +5,8 @@
 //! cores and collects them in index order, so a table is byte-identical for any thread count.
 
 use crate::error::{Error, Result};
-use crate::integrate::reference::{ReferenceSettings, reference_albedo, reference_average_albedo};
+use crate::integrate::average_quadrature::quadrature_average_albedo;
+use crate::integrate::reference::{ReferenceSettings, reference_albedo};
 use crate::integrate::{Estimate, QmcSettings, albedo, average_albedo};
 use crate::model::{Masking, Model, Ndf, RoughnessConvention};
 use crate::table::axis::{Axis, Grid, MuMapping};
@@ -251,7 +252,9 @@ pub fn estimate_texel(spec: &TableSpec, index: usize) -> Estimate {
             let settings = ReferenceSettings::default();
             let r = match mu {
                 Some(mu) => reference_albedo(spec.model, alpha, mu, &settings),
-                None => reference_average_albedo(spec.model, alpha, &settings),
+                // The composite rule in smooth variables: within 1e-10 of the nested reference
+                // (tested) at a fraction of its cost.
+                None => quadrature_average_albedo(spec.model, alpha, &settings),
             };
             Estimate {
                 value: r.value,

@@ -75,8 +75,8 @@ pub struct Metadata {
     pub max_std_error: f64,
     pub rms_std_error: f64,
     /// The error of the stored values against the deterministic reference (in `1 - E`), as
-    /// measured by `kiln bake`: largest, RMS, and over how many texels (all of an `E` table; a
-    /// few evenly spaced entries of an `E_avg` table, each of which costs the reference ~0.5 s).
+    /// measured by `kiln bake`: largest, RMS, and over how many texels (all of an `E` table; five
+    /// evenly spaced entries of an `E_avg` table, each of which costs the reference ~0.5 s CPU).
     pub node_max_error: Option<f64>,
     pub node_rms_error: Option<f64>,
     pub node_error_texels: Option<usize>,

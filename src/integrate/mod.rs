@@ -1,6 +1,7 @@
 //! Integration: Owen-scrambled Sobol points and the QMC albedo estimators.
 
 pub mod albedo;
+pub mod average_quadrature;
 pub mod estimate;
 pub mod gauss_kronrod;
 pub mod reference;

@@ -27,6 +27,7 @@ pub trait MicrofacetDistribution: Copy + Send + Sync {
     fn lambda_from_tan2(&self, tan2_theta: f64) -> f64;
 
     /// Smith's `Lambda(v)`, with `tan^2(theta)` taken from the components of `v`.
+    #[inline(always)]
     fn lambda(&self, v: Vec3) -> f64 {
         self.lambda_from_tan2(v.tan2_theta())
     }
@@ -86,6 +87,8 @@ impl MicrofacetDistribution for Ggx {
 
     /// `Lambda = (sqrt(1 + x) - 1) / 2` with `x = alpha^2 tan^2(theta)` (Heitz 2014, eq. 72),
     /// evaluated as `x / (2 (1 + sqrt(1 + x)))`, which does not cancel for small `x`.
+    /// Always inlined: the vectorised `E_avg` kernel evaluates it per sample.
+    #[inline(always)]
     fn lambda_from_tan2(&self, tan2_theta: f64) -> f64 {
         if self.alpha == 0.0 {
             return 0.0;

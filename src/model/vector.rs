@@ -44,6 +44,7 @@ impl Vec3 {
     /// `tan^2(theta)` of this direction from its components, `(x^2 + y^2) / z^2`, which keeps full
     /// relative precision near the normal (unlike `(1 - mu^2) / mu^2`). Infinite on the horizon.
     #[must_use]
+    #[inline(always)]
     pub fn tan2_theta(self) -> f64 {
         (self.x * self.x + self.y * self.y) / (self.z * self.z)
     }

@@ -74,7 +74,7 @@ pub struct BakeArgs {
     grid: Grid,
     /// How to compute the values: quasi-Monte Carlo (with a standard error per texel) or the
     /// deterministic reference quadrature (error at most 1e-10, about as fast for E tables,
-    /// and exact where QMC misses rare events at low roughness; E_avg takes ~0.5 s per entry).
+    /// and exact where QMC misses rare events at low roughness; E_avg about 0.1 s per entry).
     #[arg(long, value_enum, default_value = "qmc")]
     method: Method,
     /// Skip measuring each table's node error against the deterministic reference (a few
