@@ -18,7 +18,7 @@ use rayon::prelude::*;
 ///
 /// The default is GGX with height-correlated masking; Beckmann's visible-normal sampling needs a
 /// numerical inversion per sample and runs about 20 times slower, so it is baked on request.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct BakeOptions {
     pub ndfs: Vec<Ndf>,
     pub maskings: Vec<Masking>,
@@ -40,6 +40,9 @@ pub struct BakeOptions {
     pub check_against_reference: bool,
     /// How to compute the values.
     pub method: Method,
+    /// Bake to this max error instead: kiln picks the method and its sample count or tolerance
+    /// ([`BakeOptions::resolved`]), then confirms the result against the reference.
+    pub max_error: Option<f64>,
 }
 
 impl Default for BakeOptions {
@@ -57,6 +60,7 @@ impl Default for BakeOptions {
             grid: Grid::Nodes,
             check_against_reference: true,
             method: Method::Qmc,
+            max_error: None,
         }
     }
 }
@@ -74,6 +78,14 @@ impl BakeOptions {
                 "size must be between 2 and {} (got {})",
                 Self::MAX_SIZE,
                 self.size
+            )));
+        }
+        if let Some(x) = self.max_error
+            && !(Self::MIN_MAX_ERROR..=0.5).contains(&x)
+        {
+            return Err(Error::InvalidInput(format!(
+                "max-error must be between {:e} and 0.5 (got {x})",
+                Self::MIN_MAX_ERROR
             )));
         }
         if self.ndfs.is_empty() || self.maskings.is_empty() {
@@ -94,6 +106,44 @@ impl BakeOptions {
             .map_err(|e| Error::InvalidInput(format!("{what}: {e}")))?;
         }
         Ok(())
+    }
+
+    /// The smallest `--max-error` accepted (the reference itself is good to 1e-10).
+    pub const MIN_MAX_ERROR: f64 = 1e-10;
+
+    /// The options `bake` runs with: these, or for a `max_error` the cheapest method that meets
+    /// it, by what `kiln study` measured (GGX, 32 x 32, kiln's axes; README "What accuracy
+    /// costs"): from 1e-3 up, QMC with visible-normal sampling, whose max error over a table
+    /// falls as about `N^-0.9`, at the smallest power of two `N >= (2 / max_error)^(1 / 0.9)`
+    /// (twice the margin; 16 times that for `E_avg`); below 1e-3, where it is cheaper at every
+    /// accuracy, the quadrature at tolerance `10^-d`, the largest power of ten at most
+    /// `max_error / 20` (its measured error reached 6 times its tolerance). Either way the result
+    /// is then checked against the reference.
+    #[must_use]
+    pub fn resolved(&self) -> BakeOptions {
+        let Some(max_error) = self.max_error else {
+            return self.clone();
+        };
+        let mut options = self.clone();
+        options.check_against_reference = true;
+        if max_error >= 1e-3 {
+            let needed = (2.0 / max_error).powf(1.0 / 0.9).ceil() as u64;
+            let samples = needed.next_power_of_two().max(64);
+            options.method = Method::Qmc;
+            options.samples = samples;
+            options.average_samples = 16 * samples;
+        } else {
+            options.method = Method::Reference;
+        }
+        options
+    }
+
+    /// With a `max_error` below 1e-3: the quadrature's tolerance `10^-digits` (see
+    /// [`BakeOptions::resolved`]).
+    #[must_use]
+    pub fn reference_digits(&self) -> Option<u32> {
+        let max_error = self.max_error.filter(|&x| x < 1e-3)?;
+        Some((-(max_error / 20.0).log10()).ceil() as u32)
     }
 
     /// The models baked, in a fixed order.
@@ -134,6 +184,7 @@ impl BakeOptions {
             .flat_map(|model| {
                 [
                     TableSpec {
+                        reference_digits: self.reference_digits(),
                         model,
                         quantity: Quantity::E,
                         roughness,
@@ -142,6 +193,7 @@ impl BakeOptions {
                         qmc: qmc(self.samples),
                     },
                     TableSpec {
+                        reference_digits: self.reference_digits(),
                         model,
                         quantity: Quantity::EAvg,
                         roughness,
@@ -158,6 +210,19 @@ impl BakeOptions {
     /// every setting spelled out.
     #[must_use]
     pub fn command_for(&self, model: Model) -> String {
+        if let Some(max_error) = self.max_error {
+            return format!(
+                "kiln bake --max-error {max_error:e} --ndf {} --masking {} --size {} --seed {} \
+                 --roughness-axis {} --mu-axis {} --grid {}",
+                model.ndf,
+                model.masking,
+                self.size,
+                self.seed,
+                self.roughness_convention,
+                self.mu_mapping.name(),
+                self.grid.name()
+            );
+        }
         if self.method == Method::Reference {
             return format!(
                 "kiln bake --method reference --ndf {} --masking {} --size {} --roughness-axis {} \
@@ -192,26 +257,44 @@ impl BakeOptions {
     /// Each table then has its node error measured against the deterministic reference
     /// ([`crate::verify::node_errors`]: every `E` texel, a few `E_avg` entries) and recorded in
     /// [`Table::node_errors`], unless `check_against_reference` is off.
+    ///
+    /// With a `max_error`, the options are [`BakeOptions::resolved`] first, every table's node
+    /// error is measured (whatever the method) and a table whose measured error exceeds the
+    /// bound is an error, not a file.
     pub fn bake(&self, progress: &(dyn Fn(u64) + Sync)) -> Result<Vec<Table>> {
         self.validate()?;
-        Ok(self
-            .specs()
-            .into_iter()
-            .map(|spec| {
-                let command = self.command_for(spec.model);
-                let mut table = bake_table(spec, command, progress);
-                if self.check_against_reference && self.method == Method::Qmc {
-                    table.node_errors = Some(node_errors(&table, &ReferenceSettings::default()));
-                }
-                table
-            })
-            .collect())
+        let options = self.resolved();
+        let mut tables = Vec::new();
+        for spec in options.specs() {
+            let command = self.command_for(spec.model);
+            let mut table = bake_table(spec, command, progress);
+            table.requested_max_error = self.max_error;
+            if options.check_against_reference
+                && (options.method == Method::Qmc || self.max_error.is_some())
+            {
+                table.node_errors = Some(node_errors(&table, &ReferenceSettings::default()));
+            }
+            if let (Some(bound), Some(measured)) = (self.max_error, table.node_errors)
+                && measured.max > bound
+            {
+                return Err(Error::InvalidInput(format!(
+                    "{}: the measured node error {:.2e} exceeds --max-error {bound:e}; kiln's \
+                     choice ({}) fell short: please report it, and use --method reference",
+                    table.spec.id(),
+                    measured.max,
+                    table.spec.method.describe()
+                )));
+            }
+            tables.push(table);
+        }
+        Ok(tables)
     }
 
     /// The integrand evaluations [`BakeOptions::bake`] will spend, for a progress bar.
     #[must_use]
     pub fn total_samples(&self) -> u64 {
-        self.specs()
+        self.resolved()
+            .specs()
             .iter()
             .map(|s| s.len() as u64 * s.qmc.samples)
             .sum()
@@ -236,6 +319,7 @@ pub fn bake_table(spec: TableSpec, command: String, progress: &(dyn Fn(u64) + Sy
         spec,
         command,
         node_errors: None,
+        requested_max_error: None,
     }
 }
 
@@ -249,7 +333,7 @@ pub fn estimate_texel(spec: &TableSpec, index: usize) -> Estimate {
             None => average_albedo(spec.model, alpha, &spec.qmc),
         },
         Method::Reference => {
-            let settings = ReferenceSettings::default();
+            let settings = spec.reference_settings();
             let r = match mu {
                 Some(mu) => reference_albedo(spec.model, alpha, mu, &settings),
                 // The composite rule in smooth variables: within 1e-10 of the nested reference

@@ -80,6 +80,12 @@ pub struct Metadata {
     pub node_max_error: Option<f64>,
     pub node_rms_error: Option<f64>,
     pub node_error_texels: Option<usize>,
+    /// The `--max-error` the table was baked to meet, and the quadrature tolerance kiln chose for
+    /// it (with the reference method); the measured error is `node_max_error`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub requested_max_error: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reference_tolerance: Option<f64>,
     /// `f32` or `f16`: how the value channels are stored in the binary formats.
     pub precision: String,
     /// With `f16` precision: per value channel, how many values were clamped into f16's range
@@ -131,6 +137,10 @@ impl Metadata {
             node_max_error: table.node_errors.map(|e| e.max),
             node_rms_error: table.node_errors.map(|e| e.rms),
             node_error_texels: table.node_errors.map(|e| e.texels),
+            requested_max_error: table.requested_max_error,
+            reference_tolerance: spec
+                .reference_digits
+                .map(|_| spec.reference_settings().tolerance),
             precision: precision.to_string(),
             f16_storage: (precision == "f16").then(|| {
                 let names = table.channel_names();

@@ -136,6 +136,7 @@ fn lookup_table_stub(model: Model, size: usize) -> Table {
         std_error: vec![0.0; n],
         command: String::new(),
         node_errors: None,
+        requested_max_error: None,
     }
 }
 
@@ -364,6 +365,7 @@ pub fn run(settings: &StudySettings, progress: &(dyn Fn(u64) + Sync)) -> StudyRe
                 std_error: vec![0.0; n],
                 command: String::new(),
                 node_errors: None,
+                requested_max_error: None,
             };
             let report = audit(
                 &table,

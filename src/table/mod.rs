@@ -108,9 +108,23 @@ pub struct TableSpec {
     pub method: Method,
     /// Sample count, scrambles and seed of each texel's QMC estimate (with [`Method::Qmc`]).
     pub qmc: QmcSettings,
+    /// With [`Method::Reference`]: the quadrature's tolerance is `10^-digits` (absent: the
+    /// reference's own 1e-11).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reference_digits: Option<u32>,
 }
 
 impl TableSpec {
+    /// The quadrature settings of [`Method::Reference`]: tolerance `10^-reference_digits`.
+    #[must_use]
+    pub fn reference_settings(&self) -> crate::integrate::reference::ReferenceSettings {
+        let mut settings = crate::integrate::reference::ReferenceSettings::default();
+        if let Some(digits) = self.reference_digits {
+            settings.tolerance = 10f64.powi(-(digits as i32));
+        }
+        settings
+    }
+
     /// The axes, slowest-varying first: `[roughness, mu]` or `[roughness]`.
     #[must_use]
     pub fn axes(&self) -> Vec<Axis> {
@@ -206,6 +220,8 @@ pub struct Table {
     pub command: String,
     /// The error of the stored values against the deterministic reference, where measured.
     pub node_errors: Option<crate::verify::NodeErrors>,
+    /// The `--max-error` the table was baked to meet, if any.
+    pub requested_max_error: Option<f64>,
 }
 
 impl Table {
@@ -286,6 +302,7 @@ mod tests {
 
     fn synthetic(grid: Grid, mapping: MuMapping) -> Table {
         let spec = TableSpec {
+            reference_digits: None,
             model: Model {
                 ndf: Ndf::Ggx,
                 masking: Masking::HeightCorrelated,
@@ -313,6 +330,7 @@ mod tests {
             spec,
             command: String::new(),
             node_errors: None,
+            requested_max_error: None,
         }
     }
 

@@ -77,6 +77,7 @@ fn table_from_channel(spec: TableSpec, values: Vec<f64>, command: String) -> Tab
         spec,
         command,
         node_errors: None,
+        requested_max_error: None,
     }
 }
 
@@ -280,6 +281,7 @@ fn spec_and_values(
         grid: layout.grid,
     };
     let spec = |roughness, mu| TableSpec {
+        reference_digits: None,
         model: layout.model,
         quantity: layout.quantity,
         roughness,

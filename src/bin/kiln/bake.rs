@@ -81,6 +81,17 @@ pub struct BakeArgs {
     /// seconds) after baking; the metadata then states only the standard errors.
     #[arg(long)]
     no_reference_check: bool,
+    /// Bake to this max error (1e-10 to 0.5): kiln picks the cheapest method that meets it (QMC
+    /// from 1e-3 up, the quadrature below, by what `kiln study` measured), records the choice,
+    /// measures every table's node error against the reference, and fails rather than write a
+    /// table that misses it.
+    #[arg(
+        long,
+        value_parser = crate::args::parse_error_bound,
+        allow_negative_numbers = true,
+        conflicts_with_all = ["method", "samples", "avg_samples", "no_reference_check"]
+    )]
+    max_error: Option<f64>,
     /// No progress bar and no summary.
     #[arg(long, short)]
     quiet: bool,
@@ -100,6 +111,7 @@ pub fn run(args: BakeArgs) -> kiln::Result<()> {
         grid: args.grid,
         check_against_reference: !args.no_reference_check,
         method: args.method,
+        max_error: args.max_error,
     };
     options.validate()?;
     let mut formats = args.format;

@@ -1,0 +1,90 @@
+//! `--max-error`: kiln picks a method and its settings, and the tables meet the bound, checked
+//! here against an independent Gauss-Legendre quadrature (tests/common) where that one is
+//! accurate to 1e-9 (mu >= 0.02, alpha >= 0.05), and against the reference's own node errors.
+
+mod common;
+
+use common::reference_e;
+use kiln::{BakeOptions, Method, Quantity};
+
+fn bake(max_error: f64) -> Vec<kiln::Table> {
+    let options = BakeOptions {
+        size: 8,
+        max_error: Some(max_error),
+        ..BakeOptions::default()
+    };
+    options.bake(&|_| {}).expect("a valid bound")
+}
+
+#[test]
+fn max_error_is_met_by_the_method_kiln_picks() {
+    for (bound, method) in [(2e-2, Method::Qmc), (1e-6, Method::Reference)] {
+        let options = BakeOptions {
+            max_error: Some(bound),
+            ..BakeOptions::default()
+        };
+        assert_eq!(options.resolved().method, method, "{bound}");
+        let tables = bake(bound);
+        for table in &tables {
+            assert_eq!(table.requested_max_error, Some(bound));
+            let measured = table
+                .node_errors
+                .expect("always measured under --max-error");
+            assert!(measured.max <= bound, "{}: {measured:?}", table.spec.id());
+            if table.spec.quantity == Quantity::E {
+                assert_eq!(measured.texels, 64);
+                for k in 0..table.spec.len() {
+                    let (alpha, mu) = table.spec.texel_coordinates(k);
+                    let mu = mu.unwrap();
+                    if mu >= 0.02 && alpha >= 0.05 {
+                        let independent = reference_e(table.spec.model, alpha, mu);
+                        assert!(
+                            (table.value[k] - independent).abs() <= bound + 1e-9,
+                            "{bound}: texel {k} {} vs {independent}",
+                            table.value[k]
+                        );
+                    }
+                }
+            }
+        }
+        // The metadata records the request and, for the quadrature, its tolerance.
+        let meta = kiln::format::metadata::Metadata::new(&tables[0], "f32");
+        assert_eq!(meta.requested_max_error, Some(bound));
+        assert_eq!(
+            meta.reference_tolerance.is_some(),
+            method == Method::Reference
+        );
+        assert!(meta.command.contains("--max-error"));
+    }
+}
+
+#[test]
+fn looser_bounds_cost_fewer_samples() {
+    let samples = |bound: f64| {
+        BakeOptions {
+            max_error: Some(bound),
+            ..BakeOptions::default()
+        }
+        .resolved()
+        .samples
+    };
+    assert!(samples(1e-1) < samples(1e-2) && samples(1e-2) < samples(1e-3));
+    let digits = |bound: f64| {
+        BakeOptions {
+            max_error: Some(bound),
+            ..BakeOptions::default()
+        }
+        .reference_digits()
+    };
+    assert_eq!(digits(1e-6), Some(8));
+    assert_eq!(digits(1e-2), None);
+    // Out of range: a clear error.
+    for bad in [0.0, 1e-12, 0.6, f64::NAN] {
+        let options = BakeOptions {
+            max_error: Some(bad),
+            ..BakeOptions::default()
+        };
+        let error = options.validate().unwrap_err().to_string();
+        assert!(error.contains("max-error"), "{bad}: {error}");
+    }
+}
