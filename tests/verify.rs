@@ -116,6 +116,21 @@ fn every_input_format_and_layout_gives_the_same_audit() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     bake(d, &[]);
+    // Audits a file of `d` read as an external table in the bake's layout, with `extra` flags.
+    let external = |name: &str, extra: &[&str]| {
+        let path = d.join(name);
+        let mut args = vec![
+            path.to_str().unwrap(),
+            "--shape",
+            "6x6",
+            "--grid",
+            "nodes",
+            "--mu-axis",
+            "adaptive",
+        ];
+        args.extend_from_slice(extra);
+        verify(&args).1
+    };
     let (status, from_json) = verify(&[d.join("ggx-height-correlated-E.json").to_str().unwrap()]);
     assert_eq!(status, Some(0));
     let node = number(&from_json, "node_max_error");
@@ -146,15 +161,7 @@ fn every_input_format_and_layout_gives_the_same_audit() {
         format!("# kiln E, r rows\n{}\n", text.join(" ")),
     )
     .unwrap();
-    let (_, from_text) = verify(&[
-        d.join("r-major.txt").to_str().unwrap(),
-        "--shape",
-        "6x6",
-        "--grid",
-        "nodes",
-        "--mu-axis",
-        "adaptive",
-    ]);
+    let from_text = external("r-major.txt", &[]);
     assert_eq!(number(&from_text, "node_max_error"), node);
     assert_eq!(number(&from_text, "lookup_max_error"), lookup);
 
@@ -163,17 +170,7 @@ fn every_input_format_and_layout_gives_the_same_audit() {
         .map(|k| format!("{:?}", values[(k % 6) * 6 + k / 6]))
         .collect();
     std::fs::write(d.join("mu-major.csv"), transposed.join(",")).unwrap();
-    let (_, from_csv) = verify(&[
-        d.join("mu-major.csv").to_str().unwrap(),
-        "--shape",
-        "6x6",
-        "--grid",
-        "nodes",
-        "--mu-axis",
-        "adaptive",
-        "--order",
-        "mu,r",
-    ]);
+    let from_csv = external("mu-major.csv", &["--order", "mu,r"]);
     assert_eq!(number(&from_csv, "node_max_error"), node);
     assert_eq!(number(&from_csv, "lookup_max_error"), lookup);
 
@@ -183,17 +180,7 @@ fn every_input_format_and_layout_gives_the_same_audit() {
         .flat_map(|&v| (v as f32).to_le_bytes())
         .collect();
     std::fs::write(d.join("e.f32"), f32_bytes).unwrap();
-    let (_, raw32) = verify(&[
-        d.join("e.f32").to_str().unwrap(),
-        "--shape",
-        "6x6",
-        "--grid",
-        "nodes",
-        "--mu-axis",
-        "adaptive",
-        "--dtype",
-        "f32",
-    ]);
+    let raw32 = external("e.f32", &["--dtype", "f32"]);
     assert_eq!(
         number(&raw32, "node_max_error"),
         number(&from_exr, "node_max_error")
@@ -203,34 +190,14 @@ fn every_input_format_and_layout_gives_the_same_audit() {
         .flat_map(|&v| half::f16::from_f32(v as f32).to_le_bytes())
         .collect();
     std::fs::write(d.join("e.f16"), f16_bytes).unwrap();
-    let (_, raw16) = verify(&[
-        d.join("e.f16").to_str().unwrap(),
-        "--shape",
-        "6x6",
-        "--grid",
-        "nodes",
-        "--mu-axis",
-        "adaptive",
-        "--dtype",
-        "f16",
-    ]);
+    let raw16 = external("e.f16", &["--dtype", "f16"]);
     assert!(
         (number(&raw16, "node_max_error") - node).abs() <= 2f64.powi(-11),
         "{raw16}"
     );
 
     // One EXR channel, read as an external table.
-    let (_, channel) = verify(&[
-        d.join("ggx-height-correlated-E.exr").to_str().unwrap(),
-        "--channel",
-        "E",
-        "--shape",
-        "6x6",
-        "--grid",
-        "nodes",
-        "--mu-axis",
-        "adaptive",
-    ]);
+    let channel = external("ggx-height-correlated-E.exr", &["--channel", "E"]);
     assert_eq!(
         number(&channel, "node_max_error"),
         number(&from_exr, "node_max_error")

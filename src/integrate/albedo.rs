@@ -17,7 +17,8 @@ use super::estimate::Estimate;
 use super::sobol::{OwenSobol, mix_seed};
 use crate::model::ndf::BeckmannVisibleNormals;
 use crate::model::{
-    Beckmann, Ggx, Masking, MicrofacetDistribution, Model, Ndf, SMOOTH_ALPHA, Vec3, smooth_point,
+    Beckmann, Ggx, Masking, MicrofacetDistribution, Model, Ndf, SMOOTH_ALPHA, Vec3,
+    albedo_is_exactly_one, smooth_point,
 };
 
 /// How a QMC estimate is run.
@@ -90,7 +91,7 @@ const TAG_E_AVG: u64 = 0x4541;
 #[must_use]
 pub fn albedo(model: Model, alpha: f64, mu: f64, settings: &QmcSettings) -> Estimate {
     assert!((0.0..=1.0).contains(&mu) && alpha >= 0.0 && alpha.is_finite());
-    if (alpha == 0.0 && mu > 0.0) || (mu == 0.0 && model.masking == Masking::HeightCorrelated) {
+    if albedo_is_exactly_one(model, alpha, mu) {
         return Estimate::exact(0.0);
     }
     let (alpha, mu) = smooth_point(alpha, mu);

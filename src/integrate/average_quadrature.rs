@@ -15,7 +15,7 @@
 //! estimate adds.
 
 use super::gauss_kronrod::integrate_pieces;
-use super::reference::{ReferenceSettings, ReferenceValue, reference_albedo};
+use super::reference::{MIRROR, ReferenceSettings, ReferenceValue, reference_albedo};
 use crate::model::{Model, SMOOTH_ALPHA};
 use crate::table::axis::{ADAPTIVE_POWER, ADAPTIVE_SCALE, MuMapping};
 
@@ -30,26 +30,9 @@ pub fn quadrature_average_albedo(
     alpha: f64,
     settings: &ReferenceSettings,
 ) -> ReferenceValue {
-    quadrature_average_albedo_in(model, alpha, settings, PANELS)
-}
-
-/// As [`quadrature_average_albedo`], with `panels` panels per part.
-#[must_use]
-pub fn quadrature_average_albedo_in(
-    model: Model,
-    alpha: f64,
-    settings: &ReferenceSettings,
-    panels: usize,
-) -> ReferenceValue {
     assert!(alpha >= 0.0 && alpha.is_finite());
     if alpha < SMOOTH_ALPHA {
-        return ReferenceValue {
-            value: 1.0,
-            one_minus_value: 0.0,
-            error: 0.0,
-            evaluations: 0,
-            converged: true,
-        };
+        return MIRROR;
     }
     // The weights integrate to 1, so the inner errors add at most their tolerance.
     let inner = *settings;
@@ -74,11 +57,11 @@ pub fn quadrature_average_albedo_in(
         [w * e, w * l]
     };
     let split = |a: f64, b: f64| -> Vec<f64> {
-        (0..=panels)
-            .map(|j| a + (b - a) * j as f64 / panels as f64)
+        (0..=PANELS)
+            .map(|j| a + (b - a) * j as f64 / PANELS as f64)
             .collect()
     };
-    let budget = settings.max_intervals.max(4 * panels);
+    let budget = settings.max_intervals.max(4 * PANELS);
     let first = integrate_pieces(
         &mut head,
         &split(0.0, t_c),

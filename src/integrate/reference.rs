@@ -33,7 +33,8 @@
 
 use super::gauss_kronrod::{Quadrature, integrate_pieces};
 use crate::model::{
-    Beckmann, Ggx, Masking, MicrofacetDistribution, Model, Ndf, SMOOTH_ALPHA, Vec3, smooth_point,
+    Beckmann, Ggx, Masking, MicrofacetDistribution, Model, Ndf, SMOOTH_ALPHA, Vec3,
+    albedo_is_exactly_one, smooth_point,
 };
 use serde::Serialize;
 use std::f64::consts::PI;
@@ -85,9 +86,7 @@ pub fn reference_albedo(
     settings: &ReferenceSettings,
 ) -> ReferenceValue {
     assert!((0.0..=1.0).contains(&mu) && alpha >= 0.0 && alpha.is_finite());
-    // A mirror, and the exact height-correlated grazing limit E(0) = 1 (physics.md): G2 / G1(o)
-    // = (1 + Lambda(o)) / (1 + Lambda(o) + Lambda(i)) -> 1 as Lambda(o) -> infinity.
-    if (alpha == 0.0 && mu > 0.0) || (mu == 0.0 && model.masking == Masking::HeightCorrelated) {
+    if albedo_is_exactly_one(model, alpha, mu) {
         return MIRROR;
     }
     let (alpha, mu) = smooth_point(alpha, mu);
@@ -95,7 +94,7 @@ pub fn reference_albedo(
 }
 
 /// A mirror (`alpha = 0`) reflects everything: `E = 1` exactly.
-const MIRROR: ReferenceValue = ReferenceValue {
+pub(crate) const MIRROR: ReferenceValue = ReferenceValue {
     value: 1.0,
     one_minus_value: 0.0,
     error: 0.0,

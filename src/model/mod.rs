@@ -43,6 +43,15 @@ pub fn smooth_point(alpha: f64, mu: f64) -> (f64, f64) {
     }
 }
 
+/// Whether `E(mu, alpha) = 1` exactly, with nothing to integrate: a mirror (`alpha = 0`,
+/// `mu > 0`), and the height-correlated grazing limit `E(0) = 1` (`physics.md`: `G2 / G1(o) =
+/// (1 + Lambda(o)) / (1 + Lambda(o) + Lambda(i)) -> 1` as `Lambda(o) -> infinity`). Every
+/// estimator returns these without sampling.
+#[must_use]
+pub fn albedo_is_exactly_one(model: Model, alpha: f64, mu: f64) -> bool {
+    (alpha == 0.0 && mu > 0.0) || (mu == 0.0 && model.masking == Masking::HeightCorrelated)
+}
+
 /// Which normal distribution a table is computed for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[cfg_attr(feature = "cli", derive(clap::ValueEnum))]

@@ -18,10 +18,12 @@
 //! or `G1(i) / projected_area(mu_o)` (separable), finite at `mu_o = 0`.
 
 use crate::integrate::QmcSettings;
-use crate::integrate::albedo::albedo;
+use crate::integrate::albedo::{albedo, reflection_loss};
 use crate::integrate::reference::{ReferenceSettings, reference_albedo};
 use crate::integrate::sobol::{OwenSobol, mix_seed};
-use crate::model::{Beckmann, Ggx, Masking, MicrofacetDistribution, Model, Ndf, Vec3};
+use crate::model::{
+    Beckmann, Ggx, Masking, MicrofacetDistribution, Model, Ndf, Vec3, albedo_is_exactly_one,
+};
 use serde::Serialize;
 use std::f64::consts::PI;
 
@@ -140,6 +142,7 @@ fn sum_generic<N: MicrofacetDistribution>(
     let o = Vec3::from_mu(mu);
     let mut random = SplitMix64::new(seed);
     let sobol = OwenSobol::new(seed);
+    let lambda_o = ndf.lambda(o);
     let mut sum = 0.0;
     for k in 0..samples {
         sum += match estimator {
@@ -176,25 +179,12 @@ fn sum_generic<N: MicrofacetDistribution>(
             }
             Estimator::VndfRandom => {
                 let m = ndf.sample_visible_normal(o, [random.next_f64(), random.next_f64()]);
-                let i = o.reflect(m);
-                if i.z > 0.0 {
-                    let lambda_o = ndf.lambda(o);
-                    1.0 - masking.loss(lambda_o, ndf.lambda(i))
-                } else {
-                    0.0
-                }
+                1.0 - reflection_loss(ndf, masking, o, lambda_o, m)
             }
             Estimator::VndfSobol | Estimator::Quadrature => unreachable!("not sampled here"),
         };
     }
     sum / samples as f64
-}
-
-/// The exact values every estimator returns without sampling: a mirror (`alpha = 0`, `mu > 0`)
-/// and the height-correlated grazing limit `E(0) = 1`.
-fn exact(model: Model, alpha: f64, mu: f64) -> Option<f64> {
-    ((alpha == 0.0 && mu > 0.0) || (mu == 0.0 && model.masking == Masking::HeightCorrelated))
-        .then_some(1.0)
 }
 
 /// `E(mu)` for `model` at `alpha` by `estimator` with `samples` points (for
@@ -210,8 +200,8 @@ pub fn estimate(
     tolerance: f64,
     seed: u64,
 ) -> (f64, u64) {
-    if let Some(value) = exact(model, alpha, mu) {
-        return (value, 0);
+    if albedo_is_exactly_one(model, alpha, mu) {
+        return (1.0, 0);
     }
     let seed = mix_seed(&[seed, alpha.to_bits(), mu.to_bits()]);
     match estimator {

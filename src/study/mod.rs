@@ -8,11 +8,11 @@
 
 pub mod estimators;
 
-use crate::bake::BakeOptions;
+use crate::bake::{BakeOptions, bake_table};
 use crate::integrate::reference::{ReferenceSettings, reference_albedo};
 use crate::model::Model;
 use crate::table::axis::{Grid, MuMapping};
-use crate::table::{Method, Quantity, Table, TableSpec};
+use crate::table::{Method, Quantity, TableSpec};
 use crate::verify::{Against, AuditSettings, audit, audit_points};
 use estimators::{Estimator, estimate};
 use rayon::prelude::*;
@@ -100,14 +100,14 @@ impl StudySettings {
         let runs: usize =
             self.samples.iter().map(|(_, s)| s.len()).sum::<usize>() + self.tolerances.len();
         let lookup: u64 = self
-            .lookup_sizes
+            .lookup_mappings
             .iter()
-            .map(|&n| {
-                let table = lookup_table_stub(self.model, n);
-                (n * n) as u64 + audit_points(&table, &AuditSettings::default())
+            .flat_map(|&mapping| self.lookup_sizes.iter().map(move |&n| (mapping, n)))
+            .map(|(mapping, n)| {
+                let spec = lookup_spec(self.model, n, mapping);
+                spec.len() as u64 + audit_points(&spec, &AuditSettings::default())
             })
-            .sum::<u64>()
-            * self.lookup_mappings.len() as u64;
+            .sum();
         texels * (runs as u64 + 1) + lookup
     }
 }
@@ -126,17 +126,11 @@ fn e_spec(model: Model, size: usize, mapping: MuMapping, method: Method) -> Tabl
     spec
 }
 
-fn lookup_table_stub(model: Model, size: usize) -> Table {
-    let spec = e_spec(model, size, MuMapping::Adaptive, Method::Reference);
-    let n = spec.len();
-    Table {
-        spec,
-        value: vec![0.0; n],
-        one_minus_value: vec![0.0; n],
-        std_error: vec![0.0; n],
-        command: String::new(),
-        node_errors: None,
-        requested_max_error: None,
+/// A table of the lookup study: filled by the reference quadrature at 1e-10.
+fn lookup_spec(model: Model, size: usize, mapping: MuMapping) -> TableSpec {
+    TableSpec {
+        reference_digits: Some(10),
+        ..e_spec(model, size, mapping, Method::Reference)
     }
 }
 
@@ -339,34 +333,8 @@ pub fn run(settings: &StudySettings, progress: &(dyn Fn(u64) + Sync)) -> StudyRe
     };
     for &mapping in &settings.lookup_mappings {
         for &size in &settings.lookup_sizes {
-            let spec = e_spec(settings.model, size, mapping, Method::Reference);
-            let values: Vec<(f64, f64)> = (0..spec.len())
-                .into_par_iter()
-                .map(|k| {
-                    let (alpha, mu) = spec.texel_coordinates(k);
-                    let r = reference_albedo(
-                        settings.model,
-                        alpha,
-                        mu.expect("an E table"),
-                        &ReferenceSettings {
-                            tolerance: 1e-10,
-                            max_intervals: 200,
-                        },
-                    );
-                    progress(1);
-                    (r.value, r.one_minus_value)
-                })
-                .collect();
-            let n = spec.len();
-            let table = Table {
-                spec,
-                value: values.iter().map(|v| v.0).collect(),
-                one_minus_value: values.iter().map(|v| v.1).collect(),
-                std_error: vec![0.0; n],
-                command: String::new(),
-                node_errors: None,
-                requested_max_error: None,
-            };
+            let spec = lookup_spec(settings.model, size, mapping);
+            let table = bake_table(spec, String::new(), &|_| progress(1));
             let report = audit(
                 &table,
                 &Against::Reference(audit_reference),

@@ -106,11 +106,7 @@ pub fn furnace(e: &Table, e_avg: &Table, density: usize) -> Result<FurnaceReport
             let mut mus: Vec<f64> = (0..=steps(n_mu))
                 .map(|k| mapping.mu(k as f64 / steps(n_mu) as f64, alpha))
                 .collect();
-            mus.extend(
-                [0.0, 1e-12]
-                    .into_iter()
-                    .chain((0..=24).map(|k| 10f64.powf(-6.0 + f64::from(k) / 4.0))),
-            );
+            mus.extend(super::grazing_probes());
             let (worst_mu, deviation) = mus
                 .into_iter()
                 .map(|mu| {

@@ -7,7 +7,7 @@ pub mod input;
 
 use crate::integrate::average_quadrature::quadrature_average_albedo;
 use crate::integrate::reference::{ReferenceSettings, reference_albedo};
-use crate::table::{Quantity, Table};
+use crate::table::{Quantity, Table, TableSpec};
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -162,7 +162,7 @@ pub fn audit(
         .collect();
 
     // Lookups at every point of `lookup_coordinates`.
-    let lookups: Vec<(Point, f64, bool)> = lookup_coordinates(table, settings)
+    let lookups: Vec<(Point, f64, bool)> = lookup_coordinates(spec, settings)
         .into_par_iter()
         .map(|(alpha, mu)| {
             let value = table.lookup(mu.unwrap_or(1.0), convention.from_alpha(alpha));
@@ -221,7 +221,7 @@ pub fn audit(
 /// The `mu` of the grazing probes [`audit`] adds on every roughness of its ladder, whatever the
 /// table's axis: exactly 0, 1e-12, and 1e-6 to 1 in 24 log steps (the boundary layer `mu ~ alpha`
 /// that a coarse texture-space ladder can step over).
-fn grazing_probes() -> Vec<f64> {
+pub(crate) fn grazing_probes() -> Vec<f64> {
     let mut probes = vec![0.0, 1e-12];
     probes.extend((0..=24).map(|k| 10f64.powf(-6.0 + f64::from(k) / 4.0)));
     probes
@@ -232,8 +232,7 @@ fn grazing_probes() -> Vec<f64> {
 /// halfway between, and the axis ends), and for a 2-D table the grazing probes on every rung
 /// of the roughness ladder.
 #[must_use]
-pub fn lookup_coordinates(table: &Table, settings: &AuditSettings) -> Vec<(f64, Option<f64>)> {
-    let spec = &table.spec;
+pub fn lookup_coordinates(spec: &TableSpec, settings: &AuditSettings) -> Vec<(f64, Option<f64>)> {
     let ladder = |n: usize| -> Vec<f64> {
         let steps = settings.density.max(1) * n;
         (0..=steps).map(|j| j as f64 / steps as f64).collect()
@@ -256,8 +255,8 @@ pub fn lookup_coordinates(table: &Table, settings: &AuditSettings) -> Vec<(f64, 
 
 /// How many points [`audit`] compares: every node and every [`lookup_coordinates`] point.
 #[must_use]
-pub fn audit_points(table: &Table, settings: &AuditSettings) -> u64 {
-    (table.spec.len() + lookup_coordinates(table, settings).len()) as u64
+pub fn audit_points(spec: &TableSpec, settings: &AuditSettings) -> u64 {
+    (spec.len() + lookup_coordinates(spec, settings).len()) as u64
 }
 
 /// The largest number of `E_avg` entries [`node_errors`] checks: each costs the reference about

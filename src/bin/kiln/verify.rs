@@ -302,7 +302,7 @@ pub fn run(args: VerifyArgs) -> kiln::Result<bool> {
     };
     let bar = crate::progress_bar(
         args.quiet || args.json,
-        audit_points(&table, &settings),
+        audit_points(&table.spec, &settings),
         "verifying",
     );
     let report = audit(&table, &against, &settings, &|| bar.inc(1));
