@@ -8,12 +8,14 @@
 //! ```
 //! use kiln::{BakeOptions, Format, Ndf, Precision};
 //!
-//! // A small, fast GGX table: 8 x 8 texels, 2^12 samples each.
+//! // A small, fast GGX table: 8 x 8 texels by QMC, 2^12 samples each (the default instead
+//! // bakes to `max_error: Some(1e-7)` by the deterministic quadrature).
 //! let options = BakeOptions {
 //!     ndfs: vec![Ndf::Ggx],
 //!     size: 8,
 //!     samples: 1 << 12,
 //!     average_samples: 1 << 14,
+//!     max_error: None,
 //!     ..BakeOptions::default()
 //! };
 //! let tables = options.bake(&|_samples_done| {})?;

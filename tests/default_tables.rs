@@ -58,7 +58,7 @@ fn default_e_table_meets_the_lookup_error_goal() {
         report.lookup_max_error,
         report.worst_lookup
     );
-    // The stored values are the QMC estimates: within 5 standard errors of the reference
-    // (the rare-event caveat of the README applies below ~1e-5).
-    assert!(report.node_max_error <= 5.0 * e.max_std_error().max(3e-6));
+    // The stored values meet the default bake's max error at every node, not only on the
+    // sample the bake checked.
+    assert!(report.node_max_error <= kiln::BakeOptions::DEFAULT_MAX_ERROR);
 }

@@ -48,7 +48,7 @@ fn furnace_integrates_the_lookup_and_reports_the_identity() {
 /// What kiln promises of its default tables: from r = 0.25 up the lobe restores energy within
 /// the E table's lookup-error goal (1e-3). Below, `1 - E_avg` is under 1.3e-2 and its relative
 /// mismatch is multiplied by `1 - E` of up to 0.11 in the grazing layer: the README gives the
-/// figures. At r = 0 (a mirror) there is no loss and no lobe.
+/// figures. At r = 0 (a mirror) there is no loss and no lobe (up to the limit row's residue).
 #[test]
 fn default_tables_restore_energy_from_r_one_quarter() {
     let e = committed("ggx-height-correlated-E");
@@ -60,8 +60,10 @@ fn default_tables_restore_energy_from_r_one_quarter() {
             assert!(row.deviation.abs() <= 1e-3, "{row:?}");
         }
     }
+    // The r = 0 row of E holds the limit alpha -> 0+, evaluated at alpha = 1e-7 where
+    // 1 - E <= 2 alpha^2 (1 + 1 / mu^2) away from grazing (4e-14 at mu = 1): no more than that.
     assert!(
-        report.rows[0].deviation.abs() < 1e-20,
+        report.rows[0].deviation.abs() < 4e-14,
         "{:?}",
         report.rows[0]
     );

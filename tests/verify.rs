@@ -79,6 +79,7 @@ fn node_errors_of_a_kiln_table_are_consistent_with_its_standard_errors() {
         average_samples: 1 << 16,
         roughness_convention: RoughnessConvention::Alpha,
         check_against_reference: false,
+        max_error: None,
         ..BakeOptions::default()
     };
     let tables = options.bake(&|_| {}).unwrap();

@@ -15,12 +15,52 @@
 //! estimate adds.
 
 use super::gauss_kronrod::integrate_pieces;
+use super::gauss_legendre;
 use super::reference::{MIRROR, ReferenceSettings, ReferenceValue, reference_albedo};
-use crate::model::{Model, SMOOTH_ALPHA};
+use crate::model::{Model, Ndf, SMOOTH_ALPHA};
 use crate::table::axis::{ADAPTIVE_POWER, ADAPTIVE_SCALE, MuMapping};
 
 /// Panels each part starts with.
 pub const PANELS: usize = 3;
+
+/// The two parts of `2 ∫_0^1 g(mu) mu dmu` in smooth variables (see the module docs): the head
+/// `mu in [0, mu_c]` in the adaptive coordinate `t in [0, t_c]`, the tail `mu in [mu_c, 1]` in
+/// `v = ln mu in [ln mu_c, 0]` (absent when `mu_c = 1`).
+struct Split {
+    alpha: f64,
+    mu_c: f64,
+    t_c: f64,
+}
+
+impl Split {
+    fn new(alpha: f64) -> Self {
+        let mu_c = (8.0 * alpha).min(1.0);
+        Split {
+            alpha,
+            mu_c,
+            t_c: MuMapping::Adaptive.coordinate(mu_c, alpha),
+        }
+    }
+
+    /// `(mu, 2 mu dmu/dt)` at head coordinate `t`.
+    fn head(&self, t: f64) -> (f64, f64) {
+        let (p, k) = (ADAPTIVE_POWER, ADAPTIVE_SCALE * self.alpha);
+        let s = t.powf(1.0 / p);
+        let mu = MuMapping::Adaptive.mu(t, self.alpha);
+        let dmu_dt = k * (1.0 + k) / (1.0 + k - s).powi(2) * s / (p * t);
+        (mu, 2.0 * mu * dmu_dt)
+    }
+
+    /// `(mu, 2 mu dmu/dv)` at tail coordinate `v = ln mu`.
+    fn tail(v: f64) -> (f64, f64) {
+        let mu = v.exp();
+        (mu, 2.0 * mu * mu)
+    }
+
+    fn has_tail(&self) -> bool {
+        self.mu_c < 1.0
+    }
+}
 
 /// `E_avg` and `1 - E_avg` (see the module docs), with the rule's error estimate plus the inner
 /// tolerance, and the `E` evaluations' integrand count.
@@ -44,56 +84,140 @@ pub fn quadrature_average_albedo(
         converged &= r.converged;
         [r.value, r.one_minus_value]
     };
-    let (p, k) = (ADAPTIVE_POWER, ADAPTIVE_SCALE * alpha);
-    let mapping = MuMapping::Adaptive;
-    let mu_c = (8.0 * alpha).min(1.0);
-    let t_c = mapping.coordinate(mu_c, alpha);
-    let mut head = |t: f64| {
-        let s = t.powf(1.0 / p);
-        let mu = mapping.mu(t, alpha);
-        let dmu_dt = k * (1.0 + k) / (1.0 + k - s).powi(2) * s / (p * t);
-        let [e, l] = albedo(mu);
-        let w = 2.0 * mu * dmu_dt;
-        [w * e, w * l]
-    };
-    let split = |a: f64, b: f64| -> Vec<f64> {
+    let split = Split::new(alpha);
+    let panels = |a: f64, b: f64| -> Vec<f64> {
         (0..=PANELS)
             .map(|j| a + (b - a) * j as f64 / PANELS as f64)
             .collect()
     };
     let budget = settings.max_intervals.max(4 * PANELS);
-    let first = integrate_pieces(
-        &mut head,
-        &split(0.0, t_c),
+    let mut parts = vec![integrate_pieces(
+        &mut |t| {
+            let (mu, w) = split.head(t);
+            albedo(mu).map(|g| w * g)
+        },
+        &panels(0.0, split.t_c),
         settings.tolerance / 2.0,
         budget,
-    );
-    let mut total = first.value;
-    let mut error = first.error;
-    let mut all_converged = first.converged;
-    if mu_c < 1.0 {
-        let mut tail = |v: f64| {
-            let mu = v.exp();
-            let [e, l] = albedo(mu);
-            let w = 2.0 * mu * mu;
-            [w * e, w * l]
-        };
-        let second = integrate_pieces(
-            &mut tail,
-            &split(mu_c.ln(), 0.0),
+    )];
+    if split.has_tail() {
+        parts.push(integrate_pieces(
+            &mut |v| {
+                let (mu, w) = Split::tail(v);
+                albedo(mu).map(|g| w * g)
+            },
+            &panels(split.mu_c.ln(), 0.0),
             settings.tolerance / 2.0,
             budget,
-        );
-        total[0] += second.value[0];
-        total[1] += second.value[1];
-        error += second.error;
-        all_converged &= second.converged;
+        ));
     }
-    let converged = converged && all_converged;
     ReferenceValue {
-        value: total[0],
+        value: parts.iter().map(|q| q.value[0]).sum(),
+        one_minus_value: parts.iter().map(|q| q.value[1]).sum(),
+        error: parts.iter().map(|q| q.error).sum::<f64>() + inner.tolerance,
+        evaluations,
+        converged: converged && parts.iter().all(|q| q.converged),
+    }
+}
+
+/// The orders of the fixed Gauss-Legendre rule [`rule_average_albedo`] offers, with the largest
+/// rule error measured for each, per distribution (`|rule - quadrature_average_albedo|` with
+/// inner tolerance 1e-11, over 63 roughness rungs `r = j / 63` and both maskings; the test
+/// `fixed_rules_stay_within_their_measured_bounds` rechecks a sample), rounded up by a factor of
+/// two. Beckmann's `E(mu)` approaches 1 like `exp(-1 / (alpha^2 (1 - mu^2)))` near `mu = 1`:
+/// smooth but not analytic, so its rules converge slowly and the adaptive rule serves the
+/// tighter tolerances.
+pub const RULE_BOUNDS: [(Ndf, usize, f64); 12] = [
+    (Ndf::Ggx, 8, 6.3e-6),
+    (Ndf::Ggx, 10, 4.4e-7),
+    (Ndf::Ggx, 12, 1.9e-8),
+    (Ndf::Ggx, 14, 1.1e-9),
+    (Ndf::Ggx, 16, 5.1e-11),
+    (Ndf::Ggx, 20, 1.5e-12),
+    (Ndf::Beckmann, 8, 1.6e-4),
+    (Ndf::Beckmann, 10, 2.9e-5),
+    (Ndf::Beckmann, 12, 5.9e-6),
+    (Ndf::Beckmann, 16, 1.1e-6),
+    (Ndf::Beckmann, 20, 2.0e-7),
+    (Ndf::Beckmann, 24, 2.8e-8),
+];
+
+/// The measured bound of the `order`-point rule for `ndf` ([`RULE_BOUNDS`]), if offered.
+#[must_use]
+pub fn rule_bound(ndf: Ndf, order: usize) -> Option<f64> {
+    RULE_BOUNDS
+        .iter()
+        .find(|&&(n, o, _)| n == ndf && o == order)
+        .map(|&(_, _, bound)| bound)
+}
+
+/// The smallest order in [`RULE_BOUNDS`] for `ndf` whose bound is at most `tolerance`; `None`
+/// if none is (the adaptive rule then serves).
+#[must_use]
+pub fn rule_order_for(ndf: Ndf, tolerance: f64) -> Option<usize> {
+    RULE_BOUNDS
+        .iter()
+        .find(|&&(n, _, bound)| n == ndf && bound <= tolerance)
+        .map(|&(_, order, _)| order)
+}
+
+/// `E_avg` and `1 - E_avg` by a fixed `order`-point Gauss-Legendre rule on each part (head and
+/// tail, see the module docs), each `E` from [`reference_albedo`] at `inner`'s tolerance: `2
+/// order` evaluations of `E` where the adaptive rule spends about 90. No error estimate of its
+/// own: the returned `error` is the inner tolerance plus the rule's measured bound
+/// ([`RULE_BOUNDS`]), which is what a bake at a requested max error relies on before it checks
+/// entries against the reference.
+#[must_use]
+pub fn rule_average_albedo(
+    model: Model,
+    alpha: f64,
+    order: usize,
+    inner: &ReferenceSettings,
+) -> ReferenceValue {
+    assert!(alpha >= 0.0 && alpha.is_finite());
+    if alpha < SMOOTH_ALPHA {
+        return MIRROR;
+    }
+    let rule = gauss_legendre::rule(order);
+    let mut evaluations = 0;
+    let mut converged = true;
+    let mut albedo = |mu: f64| {
+        let r = reference_albedo(model, alpha, mu, inner);
+        evaluations += r.evaluations;
+        converged &= r.converged;
+        [r.value, r.one_minus_value]
+    };
+    let split = Split::new(alpha);
+    let mut total: [f64; 2] = gauss_legendre::integrate(
+        &rule,
+        &mut |t| {
+            let (mu, w) = split.head(t);
+            albedo(mu).map(|g| w * g)
+        },
+        0.0,
+        split.t_c,
+    );
+    if split.has_tail() {
+        let tail = gauss_legendre::integrate(
+            &rule,
+            &mut |v| {
+                let (mu, w) = Split::tail(v);
+                albedo(mu).map(|g| w * g)
+            },
+            split.mu_c.ln(),
+            0.0,
+        );
+        total[0] += tail[0];
+        total[1] += tail[1];
+    }
+    let bound = rule_bound(model.ndf, order).unwrap_or(f64::NAN);
+    // `E_avg = 1 - (1 - E_avg)`: the weight `2 mu dmu` integrates to exactly 1, which a fixed rule
+    // only approximates (its error on `∫ w E` is mostly its error on `∫ w`); `1 - E` is the
+    // integrand the bounds were measured on.
+    ReferenceValue {
+        value: 1.0 - total[1],
         one_minus_value: total[1],
-        error: error + inner.tolerance,
+        error: inner.tolerance + bound,
         evaluations,
         converged,
     }
@@ -103,7 +227,7 @@ pub fn quadrature_average_albedo(
 mod tests {
     use super::*;
     use crate::integrate::reference::reference_average_albedo;
-    use crate::model::{Masking, Ndf};
+    use crate::model::Masking;
 
     /// Within 1e-10 of the nested adaptive reference from alpha = 1e-3 (where `1 - E_avg` is
     /// 7.4e-6) to 2, both maskings, both distributions (Beckmann at alpha = 1 needs the
@@ -146,5 +270,40 @@ mod tests {
             // The estimate is an upper bound of the actual difference here.
             assert!(fast.converged && fast.error >= error, "{fast:?}");
         }
+    }
+
+    /// The fixed rules stay within their [`RULE_BOUNDS`] on a sample of rungs around where the
+    /// measured worst cases sat (GGX: `r` near 0.35; Beckmann: rough), both maskings.
+    #[test]
+    fn fixed_rules_stay_within_their_measured_bounds() {
+        use rayon::prelude::*;
+        let settings = ReferenceSettings::default();
+        let mut cases = Vec::new();
+        for ndf in Ndf::ALL {
+            for masking in Masking::ALL {
+                for r in [0.05, 0.2, 0.35, 0.5, 0.8, 1.0] {
+                    cases.push((Model { ndf, masking }, r * r));
+                }
+            }
+        }
+        cases.par_iter().for_each(|&(model, alpha)| {
+            let exact = quadrature_average_albedo(model, alpha, &settings);
+            for &(ndf, order, bound) in &RULE_BOUNDS {
+                if ndf != model.ndf {
+                    continue;
+                }
+                let fixed = rule_average_albedo(model, alpha, order, &settings);
+                let error = (fixed.one_minus_value - exact.one_minus_value).abs();
+                // The measured bound plus both inner tolerances.
+                assert!(
+                    error <= bound + 2.0 * settings.tolerance,
+                    "{model:?} alpha {alpha} order {order}: {error:.2e} > {bound:.1e}"
+                );
+                assert!((fixed.value - exact.value).abs() <= bound + 2.0 * settings.tolerance);
+                assert!(fixed.converged && fixed.evaluations > 0);
+            }
+        });
+        assert_eq!(rule_order_for(Ndf::Ggx, 1e-7), Some(12));
+        assert_eq!(rule_order_for(Ndf::Beckmann, 1e-10), None);
     }
 }

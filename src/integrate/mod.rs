@@ -4,6 +4,7 @@ pub mod albedo;
 pub mod average_quadrature;
 pub mod estimate;
 pub mod gauss_kronrod;
+pub mod gauss_legendre;
 pub mod reference;
 pub mod sobol;
 

@@ -118,6 +118,7 @@ fn e_spec(model: Model, size: usize, mapping: MuMapping, method: Method) -> Tabl
         mu_mapping: mapping,
         grid: Grid::Nodes,
         method,
+        max_error: None,
         ..BakeOptions::default()
     };
     let mut spec = options.specs().remove(0);

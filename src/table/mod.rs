@@ -125,6 +125,24 @@ impl TableSpec {
         settings
     }
 
+    /// With [`Method::Reference`] at a chosen tolerance (`reference_digits` set, as a bake at a
+    /// requested max error does), `E_avg` entries use the fixed Gauss-Legendre rule of this order
+    /// ([`crate::integrate::average_quadrature::rule_average_albedo`]) whose measured bound is
+    /// within the tolerance; otherwise (`None`, or no offered rule is that good) the adaptive
+    /// rule.
+    #[must_use]
+    pub fn average_rule_order(&self) -> Option<usize> {
+        (self.method == Method::Reference && self.quantity == Quantity::EAvg)
+            .then_some(self.reference_digits)
+            .flatten()
+            .and_then(|_| {
+                crate::integrate::average_quadrature::rule_order_for(
+                    self.model.ndf,
+                    self.reference_settings().tolerance,
+                )
+            })
+    }
+
     /// The axes, slowest-varying first: `[roughness, mu]` or `[roughness]`.
     #[must_use]
     pub fn axes(&self) -> Vec<Axis> {

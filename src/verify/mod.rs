@@ -271,15 +271,34 @@ pub const MAX_AVERAGE_ENTRIES_CHECKED: usize = 5;
 #[must_use]
 pub fn node_errors(table: &Table, settings: &ReferenceSettings) -> NodeErrors {
     let spec = &table.spec;
-    let n = spec.len();
-    let indices: Vec<usize> = if spec.quantity == Quantity::E || n <= MAX_AVERAGE_ENTRIES_CHECKED {
-        (0..n).collect()
+    let indices: Vec<usize> = if spec.quantity == Quantity::E {
+        (0..spec.len()).collect()
     } else {
-        let last = MAX_AVERAGE_ENTRIES_CHECKED - 1;
-        (0..=last)
-            .map(|j| (j * (n - 1) + last / 2) / last)
-            .collect()
+        spread_indices(spec.len(), MAX_AVERAGE_ENTRIES_CHECKED)
     };
+    node_errors_at(table, &indices, settings)
+}
+
+/// At most `count` indices of `0..n`, evenly spread with both ends (all of them if `n <= count`).
+#[must_use]
+pub fn spread_indices(n: usize, count: usize) -> Vec<usize> {
+    if n <= count {
+        return (0..n).collect();
+    }
+    let last = count - 1;
+    (0..=last)
+        .map(|j| (j * (n - 1) + last / 2) / last)
+        .collect()
+}
+
+/// As [`node_errors`], at the given texel indices only.
+#[must_use]
+pub fn node_errors_at(
+    table: &Table,
+    indices: &[usize],
+    settings: &ReferenceSettings,
+) -> NodeErrors {
+    let spec = &table.spec;
     let errors: Vec<f64> = indices
         .par_iter()
         .map(|&k| {

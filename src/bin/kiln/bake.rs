@@ -10,12 +10,15 @@ use std::time::Instant;
 /// Bake E(mu, roughness) and E_avg(roughness) tables and write them to a directory.
 #[derive(Args, Debug)]
 #[command(
-    long_about = "Bake E(mu, roughness) and E_avg(roughness) tables by quasi-Monte Carlo \
-                  (visible-normal sampling, Owen-scrambled Sobol points) and write them as EXR, \
-                  raw binary, Rust source, JSON and PNG. Each texel carries its standard error, \
-                  measured from independent scrambles; the metadata of every file states the \
-                  model, axes, grid, samples, seed, error and the command that reproduces it. \
-                  Output is byte-identical for any thread count.",
+    long_about = "Bake E(mu, roughness) and E_avg(roughness) tables and write them as EXR, \
+                  raw binary, Rust source, JSON and PNG. By default to a max error of 1e-7: \
+                  kiln picks the cheapest method that meets --max-error (the deterministic \
+                  quadrature below 1e-3, quasi-Monte Carlo with visible-normal sampling and \
+                  Owen-scrambled Sobol points above) and checks a sample of texels against its \
+                  reference. --method qmc --samples N bakes by QMC with a standard error per \
+                  texel from independent scrambles. The metadata of every file states the model, \
+                  axes, grid, method, error and the command that reproduces it. Output is \
+                  byte-identical for any thread count.",
     after_help = CONVENTIONS
 )]
 pub struct BakeArgs {
@@ -34,9 +37,10 @@ pub struct BakeArgs {
     /// Samples per axis: E is SIZE x SIZE, E_avg has SIZE entries. 2 to 4096.
     #[arg(long, default_value_t = BakeOptions::DEFAULT_SIZE, value_parser = parse_size, allow_negative_numbers = true)]
     size: usize,
-    /// QMC samples per E texel, a power of two (split over the scrambles).
-    #[arg(long, default_value_t = QmcSettings::DEFAULT_SAMPLES, value_parser = parse_samples, allow_negative_numbers = true)]
-    samples: u64,
+    /// QMC samples per E texel, a power of two (split over the scrambles); implies --method qmc
+    /// [default: 2^16].
+    #[arg(long, value_parser = parse_samples, allow_negative_numbers = true)]
+    samples: Option<u64>,
     /// QMC samples per E_avg entry, a power of two [default: 16 x --samples].
     #[arg(long, value_parser = parse_samples, allow_negative_numbers = true)]
     avg_samples: Option<u64>,
@@ -72,19 +76,19 @@ pub struct BakeArgs {
     /// texel centres (i + 0.5)/N.
     #[arg(long, value_enum, default_value = "nodes")]
     grid: Grid,
-    /// How to compute the values: quasi-Monte Carlo (with a standard error per texel) or the
-    /// deterministic reference quadrature (error at most 1e-10, about as fast for E tables,
-    /// and exact where QMC misses rare events at low roughness; E_avg about 0.1 s per entry).
-    #[arg(long, value_enum, default_value = "qmc")]
-    method: Method,
-    /// Skip measuring each table's node error against the deterministic reference (a few
-    /// seconds) after baking; the metadata then states only the standard errors.
+    /// Compute the values by this method instead of to a max error: quasi-Monte Carlo (with a
+    /// standard error per texel, --samples) or the deterministic reference quadrature at its
+    /// full accuracy (error at most 1e-10).
+    #[arg(long, value_enum)]
+    method: Option<Method>,
+    /// With --method qmc: skip measuring each table's node error against the deterministic
+    /// reference after baking; the metadata then states only the standard errors.
     #[arg(long)]
     no_reference_check: bool,
-    /// Bake to this max error (1e-10 to 0.5): kiln picks the cheapest method that meets it (QMC
-    /// from 1e-3 up, the quadrature below, by what `kiln study` measured), records the choice,
-    /// measures every table's node error against the reference, and fails rather than write a
-    /// table that misses it.
+    /// Bake to this max error (1e-10 to 0.5) [default: 1e-7 unless --method or --samples is
+    /// given]: kiln picks the cheapest method that meets it (QMC from 1e-3 up, the quadrature
+    /// below, by what `kiln study` measured), records the choice, checks a sample of texels
+    /// against the reference, and fails rather than write a table that misses it.
     #[arg(
         long,
         value_parser = crate::args::parse_error_bound,
@@ -98,20 +102,31 @@ pub struct BakeArgs {
 }
 
 pub fn run(args: BakeArgs) -> kiln::Result<()> {
+    // Naming a method or a sample count asks for that method; otherwise a max error decides.
+    let explicit_method = args.method.is_some()
+        || args.samples.is_some()
+        || args.avg_samples.is_some()
+        || args.no_reference_check;
+    let max_error = match args.max_error {
+        Some(x) => Some(x),
+        None if explicit_method => None,
+        None => Some(BakeOptions::DEFAULT_MAX_ERROR),
+    };
+    let samples = args.samples.unwrap_or(QmcSettings::DEFAULT_SAMPLES);
     let options = BakeOptions {
         ndfs: args.ndf,
         maskings: args.masking,
         size: args.size,
-        samples: args.samples,
-        average_samples: args.avg_samples.unwrap_or(16 * args.samples),
+        samples,
+        average_samples: args.avg_samples.unwrap_or(16 * samples),
         scrambles: args.scrambles,
         seed: args.seed,
         roughness_convention: args.roughness_axis,
         mu_mapping: args.mu_axis,
         grid: args.grid,
         check_against_reference: !args.no_reference_check,
-        method: args.method,
-        max_error: args.max_error,
+        method: args.method.unwrap_or(Method::Qmc),
+        max_error,
     };
     options.validate()?;
     let mut formats = args.format;
