@@ -46,6 +46,6 @@ pub use bake::{BakeOptions, bake_table};
 pub use error::{Error, Result};
 pub use format::{Format, Precision};
 pub use integrate::{Estimate, QmcSettings, albedo, average_albedo};
-pub use model::{Masking, Model, Ndf, RoughnessConvention};
+pub use model::{Fresnel, Masking, Model, Ndf, RoughnessConvention};
 pub use table::axis::{Axis, Grid, MuMapping};
 pub use table::{Method, Quantity, Table, TableSpec};

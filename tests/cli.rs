@@ -203,6 +203,76 @@ fn eval_json_is_one_object_with_the_agreed_fields() {
     assert!((object["value"].as_f64().unwrap() - 0.409_137_09).abs() < 1e-4);
 }
 
+/// `kiln eval --quantity f-avg`: the check values through the JSON interface, every
+/// Fresnel model, and bad Fresnel flags named with status 2.
+#[test]
+fn eval_f_avg_json_and_fresnel_flags() {
+    let json = |args: &[&str]| -> serde_json::Value {
+        let mut all = vec!["eval", "--quantity", "f-avg", "--json"];
+        all.extend_from_slice(args);
+        let output = kiln(&all);
+        assert!(output.status.success(), "{args:?}: {}", stderr(&output));
+        let text = String::from_utf8(output.stdout).unwrap();
+        assert_eq!(text.trim_end().lines().count(), 1);
+        serde_json::from_str(&text).unwrap()
+    };
+    let glass = json(&["--fresnel", "dielectric", "--ior", "1.5"]);
+    for field in ["value", "std_error", "method", "samples", "seconds"] {
+        assert!(glass.get(field).is_some(), "missing {field} in {glass}");
+    }
+    assert_eq!(glass["quantity"], "F_avg");
+    assert!((glass["value"].as_f64().unwrap() - 0.091_777_959_3).abs() < 1e-9);
+    // --ior alone means dielectric; light leaving glass.
+    let inside = json(&["--ior", "0.6666666666666666"]);
+    assert!((inside["value"].as_f64().unwrap() - 0.596_345_759_7).abs() < 1e-9);
+    // --f0 alone means Schlick: (20 F0 + 1) / 21, per channel.
+    let schlick = json(&["--f0", "0.04,0.5,1"]);
+    assert_eq!(schlick["method"], "closed-form");
+    let rgb: Vec<f64> = schlick["value"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    for (got, f0) in rgb.iter().zip([0.04, 0.5, 1.0]) {
+        assert!((got - (20.0 * f0 + 1.0) / 21.0).abs() < 1e-15);
+    }
+    let metal = json(&[
+        "--fresnel",
+        "conductor",
+        "--eta",
+        "0.18,0.42,1.37",
+        "--k",
+        "3.42,2.35,1.77",
+    ]);
+    assert_eq!(metal["value_rgb"].as_array().unwrap().len(), 3);
+    assert_eq!(json(&["--fresnel", "none"])["value"], 1.0);
+
+    for (args, needle) in [
+        (&["--fresnel", "dielectric"][..], "needs --ior"),
+        (&["--fresnel", "conductor", "--eta", "1"][..], "needs --k"),
+        (&["--ior", "-1"][..], "ior must be > 0"),
+        (&["--f0", "1.2"][..], "f0 must be in [0, 1]"),
+        (&["--f0", "0.1,0.2"][..], "three comma-separated"),
+        (
+            &["--fresnel", "dielectric", "--ior", "1.5", "--k", "2"][..],
+            "--k does not apply",
+        ),
+        (&["--ior", "1.5", "--mu", "0.5"][..], "drop --mu"),
+    ] {
+        let mut all = vec!["eval", "--quantity", "f-avg"];
+        all.extend_from_slice(args);
+        let output = kiln(&all);
+        assert_eq!(output.status.code(), Some(2), "{args:?}");
+        assert!(
+            stderr(&output).contains(needle),
+            "{args:?}: {}",
+            stderr(&output)
+        );
+        assert!(output.stdout.is_empty());
+    }
+}
+
 #[test]
 fn outputs_agree_with_each_other_and_round_trip() {
     let dir = tempfile::tempdir().unwrap();

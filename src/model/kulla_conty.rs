@@ -32,9 +32,53 @@ pub fn multiple_scattering(one_minus_e_o: f64, one_minus_e_i: f64, one_minus_e_a
     one_minus_e_o * one_minus_e_i * normalisation(one_minus_e_avg)
 }
 
+/// The colour multiplier of the additive `f_ms` lobe for a coloured Fresnel,
+/// `F_avg^2 E_avg / (1 - F_avg (1 - E_avg))` per channel (Kulla and Conty 2017; `physics.md`).
+///
+/// Why the square: a path that bounces `k + 1` times between microfacets keeps `F_avg^(k+1)`; with
+/// a fraction `1 - E_avg` of the energy going on to another bounce each time, the total albedo
+/// is the geometric series `F_avg E_avg / (1 - F_avg (1 - E_avg))`. The single-scattering lobe
+/// already returns its first term, `F_avg E_avg` on average; the rest,
+/// `F_avg^2 E_avg (1 - E_avg) / (1 - F_avg (1 - E_avg))`, is what `f_ms` must add, and `f_ms`
+/// with `F = 1` returns `1 - E_avg` on average, hence this multiplier. Every path it stands for
+/// has met Fresnel at least twice. The unsquared form (`F_avg E_avg / (...)`, a frequent slip)
+/// credits those paths with one reflection only and adds energy for every `F_avg < 1`. At
+/// `F_avg = 1` the multiplier is 1 (the white furnace).
+#[must_use]
+pub fn fresnel_colour(f_avg: f64, e_avg: f64) -> f64 {
+    let denominator = 1.0 - f_avg * (1.0 - e_avg);
+    if denominator > 0.0 {
+        f_avg * f_avg * e_avg / denominator
+    } else {
+        // F_avg = 1 and E_avg = 0: nothing is ever reflected by one bounce; the limit along
+        // F_avg = 1 is 1.
+        1.0
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The multiplier completes the geometric series: single scattering's `F_avg E_avg` plus
+    /// `colour (1 - E_avg)` is the total `F_avg E_avg / (1 - F_avg (1 - E_avg))`; at `F_avg = 1`
+    /// it is 1; it never exceeds `F_avg` (no energy gain from the lobe).
+    #[test]
+    fn fresnel_colour_completes_the_series() {
+        for f in [0.0, 0.04, 0.3, 0.9, 1.0] {
+            for e in [0.01, 0.4, 0.9, 1.0] {
+                let colour = fresnel_colour(f, e);
+                let total = f * e / (1.0 - f * (1.0 - e));
+                assert!(
+                    (f * e + colour * (1.0 - e) - total).abs() < 1e-15,
+                    "{f} {e}"
+                );
+                assert!(colour <= f + 1e-15, "{f} {e}");
+            }
+            assert!((fresnel_colour(1.0, f.max(0.01)) - 1.0).abs() < 1e-15);
+        }
+        assert_eq!(fresnel_colour(1.0, 0.0), 1.0);
+    }
     use crate::integrate::gauss_kronrod::integrate_pieces;
     use crate::integrate::reference::{
         ReferenceSettings, reference_albedo, reference_average_albedo,

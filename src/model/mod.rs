@@ -3,6 +3,7 @@
 //! The reflection BRDF (`physics.md`) is `f(o, i) = F(o.h) D(h) G2(o, i) / (4 |n.i| |n.o|)`;
 //! the tables here are for `F = 1`.
 
+pub mod fresnel;
 pub mod kulla_conty;
 pub mod masking;
 pub mod ndf;
@@ -11,6 +12,7 @@ pub mod vector;
 
 use serde::{Deserialize, Serialize};
 
+pub use fresnel::Fresnel;
 pub use masking::Masking;
 pub use ndf::{Beckmann, Ggx, MicrofacetDistribution};
 pub use vector::Vec3;

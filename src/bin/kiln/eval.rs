@@ -1,9 +1,10 @@
 //! `kiln eval`.
 
 use crate::args::{CONVENTIONS, parse_mu, parse_roughness, parse_samples};
+use crate::fresnel_args::FresnelArgs;
 use clap::{Args, ValueEnum};
 use kiln::integrate::reference::{ReferenceSettings, reference_albedo, reference_average_albedo};
-use kiln::{Masking, Model, Ndf, QmcSettings, Quantity, RoughnessConvention};
+use kiln::{Fresnel, Masking, Model, Ndf, QmcSettings, Quantity, RoughnessConvention};
 use std::time::Instant;
 
 /// How to evaluate.
@@ -15,14 +16,30 @@ pub enum Method {
     Reference,
 }
 
-/// Evaluate E or E_avg at one point.
+/// What `kiln eval` evaluates.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum EvalQuantity {
+    /// Directional albedo E(mu) (needs --mu and a roughness).
+    E,
+    /// Average albedo E_avg (needs a roughness).
+    EAvg,
+    /// Average Fresnel reflectance F_avg = 2 * integral of F(mu) mu dmu for the --fresnel model
+    /// (per channel; no roughness).
+    FAvg,
+}
+
+/// Evaluate E or E_avg at one point, or F_avg.
 #[derive(Args, Debug)]
 #[command(
     long_about = "Evaluate E(mu) or E_avg at one roughness, by QMC (with its standard error) or by \
-                  the deterministic reference quadrature (with its error estimate). With --json, \
-                  print exactly one JSON object with the fields value, one_minus_value, std_error, \
-                  method, samples, seconds and the inputs; for the reference, std_error is the \
-                  quadrature's error estimate and samples its integrand evaluations.",
+                  the deterministic reference quadrature (with its error estimate); or F_avg, the \
+                  average Fresnel reflectance of a --fresnel model (Schlick's closed form, \
+                  otherwise quadrature to 1e-14). With --json, print exactly one JSON object with \
+                  the fields value, one_minus_value, std_error, method, samples, seconds and the \
+                  inputs; for the reference, std_error is the quadrature's error estimate and \
+                  samples its integrand evaluations. For F_avg, value is a number when the model \
+                  is the same in every channel and [R, G, B] otherwise; value_rgb is always the \
+                  three channels.",
     after_help = CONVENTIONS
 )]
 pub struct EvalArgs {
@@ -33,7 +50,7 @@ pub struct EvalArgs {
     #[arg(long, value_enum, default_value = "height-correlated")]
     masking: Masking,
     /// Slope-space roughness alpha, >= 0 (give this or --roughness).
-    #[arg(long, value_parser = parse_roughness, required_unless_present = "roughness", conflicts_with = "roughness", allow_negative_numbers = true)]
+    #[arg(long, value_parser = parse_roughness, conflicts_with = "roughness", allow_negative_numbers = true)]
     alpha: Option<f64>,
     /// Perceptual roughness r >= 0, alpha = r^2 (give this or --alpha).
     #[arg(long, value_parser = parse_roughness, allow_negative_numbers = true)]
@@ -43,7 +60,9 @@ pub struct EvalArgs {
     mu: Option<f64>,
     /// What to evaluate.
     #[arg(long, value_enum, default_value = "e")]
-    quantity: Quantity,
+    quantity: EvalQuantity,
+    #[command(flatten)]
+    fresnel: FresnelArgs,
     /// How to evaluate it.
     #[arg(long, value_enum, default_value = "qmc")]
     method: Method,
@@ -63,6 +82,19 @@ pub struct EvalArgs {
 }
 
 pub fn run(args: EvalArgs) -> kiln::Result<()> {
+    let fresnel = args.fresnel.model()?;
+    let quantity = match args.quantity {
+        EvalQuantity::FAvg => return fresnel_average(&args, fresnel),
+        EvalQuantity::E => Quantity::E,
+        EvalQuantity::EAvg => Quantity::EAvg,
+    };
+    if args.fresnel.given() {
+        return Err(kiln::Error::InvalidInput(
+            "Fresnel-weighted E and E_avg are not in this version: --fresnel applies to \
+             --quantity f-avg"
+                .into(),
+        ));
+    }
     let model = Model {
         ndf: args.ndf,
         masking: args.masking,
@@ -70,9 +102,14 @@ pub fn run(args: EvalArgs) -> kiln::Result<()> {
     let alpha = match (args.alpha, args.roughness) {
         (Some(alpha), _) => alpha,
         (None, Some(r)) => RoughnessConvention::Perceptual.to_alpha(r),
-        (None, None) => unreachable!("clap requires one of them"),
+        (None, None) => {
+            return Err(kiln::Error::InvalidInput(format!(
+                "--quantity {} needs --alpha A or --roughness R",
+                quantity.cli_name()
+            )));
+        }
     };
-    let mu = match (args.quantity, args.mu) {
+    let mu = match (quantity, args.mu) {
         (Quantity::E, None) => {
             return Err(kiln::Error::InvalidInput(
                 "--quantity e needs --mu (cos(theta) in [0, 1])".into(),
@@ -85,7 +122,7 @@ pub fn run(args: EvalArgs) -> kiln::Result<()> {
     // (value, one_minus_value, error, samples or evaluations, converged)
     let (value, one_minus_value, error, samples, converged) = match args.method {
         Method::Qmc => {
-            let samples = args.samples.unwrap_or(match args.quantity {
+            let samples = args.samples.unwrap_or(match quantity {
                 Quantity::E => QmcSettings::DEFAULT_SAMPLES,
                 Quantity::EAvg => 16 * QmcSettings::DEFAULT_SAMPLES,
             });
@@ -128,7 +165,7 @@ pub fn run(args: EvalArgs) -> kiln::Result<()> {
         Method::Qmc => "qmc",
         Method::Reference => "reference",
     };
-    let symbol = args.quantity.symbol();
+    let symbol = quantity.symbol();
     if args.json {
         let mut object = serde_json::json!({
             "quantity": symbol,
@@ -168,6 +205,70 @@ pub fn run(args: EvalArgs) -> kiln::Result<()> {
                 "kiln: warning: the quadrature did not reach its tolerance; the error estimate is what it reached"
             );
         }
+    }
+    Ok(())
+}
+
+/// `kiln eval --quantity f-avg`: `F_avg` per channel for the `--fresnel` model.
+fn fresnel_average(args: &EvalArgs, fresnel: Fresnel) -> kiln::Result<()> {
+    let irrelevant: Vec<&str> = [
+        ("--alpha", args.alpha.is_some()),
+        ("--roughness", args.roughness.is_some()),
+        ("--mu", args.mu.is_some()),
+        ("--samples", args.samples.is_some()),
+    ]
+    .iter()
+    .filter(|(_, given)| *given)
+    .map(|(name, _)| *name)
+    .collect();
+    if !irrelevant.is_empty() {
+        return Err(kiln::Error::InvalidInput(format!(
+            "F_avg depends on the Fresnel model only: drop {}",
+            irrelevant.join(", ")
+        )));
+    }
+    let start = Instant::now();
+    let average = fresnel.average_report();
+    let seconds = start.elapsed().as_secs_f64();
+    let [r, g, b] = average.value;
+    let uniform = r == g && g == b;
+    if args.json {
+        let value: serde_json::Value = if uniform {
+            r.into()
+        } else {
+            serde_json::json!([r, g, b])
+        };
+        let object = serde_json::json!({
+            "quantity": "F_avg",
+            "fresnel": fresnel,
+            "value": value,
+            "value_rgb": [r, g, b],
+            "one_minus_value": if uniform {
+                serde_json::Value::from(1.0 - r)
+            } else {
+                serde_json::json!([1.0 - r, 1.0 - g, 1.0 - b])
+            },
+            "std_error": average.error,
+            "method": average.method,
+            "samples": average.evaluations,
+            "seconds": seconds,
+            "converged": true,
+            "kiln_version": kiln::format::metadata::KILN_VERSION,
+        });
+        println!("{object}");
+    } else {
+        let shown = if uniform {
+            format!("{r:.10}")
+        } else {
+            format!("[{r:.10}, {g:.10}, {b:.10}]")
+        };
+        println!(
+            "F_avg({}) = {shown} ± {:.1e} ({}, {} evaluations, {seconds:.3} s)",
+            fresnel.name(),
+            average.error,
+            average.method,
+            average.evaluations
+        );
     }
     Ok(())
 }

@@ -3,6 +3,7 @@
 mod args;
 mod bake;
 mod eval;
+mod fresnel_args;
 mod plot;
 mod study;
 mod verify;
@@ -22,7 +23,7 @@ struct Cli {
 enum Command {
     /// Bake E(mu, roughness) and E_avg(roughness) tables and write them to a directory.
     Bake(bake::BakeArgs),
-    /// Evaluate E or E_avg at one point, by QMC or by the deterministic reference.
+    /// Evaluate E or E_avg at one point (QMC or the deterministic reference), or F_avg.
     Eval(eval::EvalArgs),
     /// Audit a table (kiln's or an engine's) against the deterministic reference.
     Verify(verify::VerifyArgs),

@@ -1,0 +1,368 @@
+//! Fresnel reflectance models and their hemispherical averages `F_avg = 2 ∫_0^1 F(mu) mu dmu`.
+//!
+//! - Schlick's approximation with `F0` and `F90` per RGB channel: `F = F0 + (F90 - F0) (1 - c)^5`
+//!   (Schlick 1994, "An Inexpensive BRDF Model for Physically-based Rendering"), whose average has
+//!   the closed form `(20 F0 + F90) / 21` (`physics.md`).
+//! - The exact unpolarised Fresnel reflectance of a dielectric interface with relative index
+//!   `eta = n_transmitted / n_incident` (`eta < 1`: light leaving the denser medium, with total
+//!   internal reflection beyond the critical angle): Walter, Marschner, Li and Torrance 2007,
+//!   "Microfacet Models for Refraction through Rough Surfaces", eq. 22,
+//!   `F = (g - c)^2 / (2 (g + c)^2) (1 + ((c (g + c) - 1) / (c (g - c) + 1))^2)` with
+//!   `g^2 = eta^2 - 1 + c^2`, and `F = 1` where `g^2 < 0`.
+//! - Conductors with a complex index `eta + i k` per RGB channel: the unpolarised average of the
+//!   two Fresnel amplitude reflectances `r_s = (c - n cos_t) / (c + n cos_t)` and
+//!   `r_p = (n c - cos_t) / (n c + cos_t)`, `n = eta + i k`, `cos_t = sqrt(1 - (1 - c^2) / n^2)`
+//!   (complex Snell's law; Born and Wolf, "Principles of Optics", 1.5.2 and 14.2; pbrt-v4
+//!   `FrComplex`).
+//!
+//! `c` is the cosine between the incident direction and the (micro)surface normal, in `[0, 1]`.
+
+use crate::integrate::gauss_kronrod::integrate_pieces;
+use serde::{Deserialize, Serialize};
+
+/// RGB values, one per channel.
+pub type Rgb = [f64; 3];
+
+/// A Fresnel model.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case", tag = "model")]
+pub enum Fresnel {
+    /// `F = 1`: the tables of energy compensation proper.
+    None,
+    /// Schlick's approximation.
+    Schlick { f0: Rgb, f90: Rgb },
+    /// An exact dielectric interface with relative index of refraction `eta > 0`.
+    Dielectric { eta: f64 },
+    /// A conductor with complex index `eta + i k` per channel (`eta > 0`, `k >= 0`).
+    Conductor { eta: Rgb, k: Rgb },
+}
+
+impl Fresnel {
+    /// The model's name on the command line and in files.
+    #[must_use]
+    pub fn name(&self) -> &'static str {
+        match self {
+            Fresnel::None => "none",
+            Fresnel::Schlick { .. } => "schlick",
+            Fresnel::Dielectric { .. } => "dielectric",
+            Fresnel::Conductor { .. } => "conductor",
+        }
+    }
+
+    /// Checks the parameters, naming the bad one and the allowed range.
+    pub fn validate(&self) -> Result<(), String> {
+        let finite = |what: &str, v: &[f64]| -> Result<(), String> {
+            match v.iter().find(|x| !x.is_finite()) {
+                Some(x) => Err(format!("{what} must be finite (got {x})")),
+                None => Ok(()),
+            }
+        };
+        match *self {
+            Fresnel::None => Ok(()),
+            Fresnel::Schlick { f0, f90 } => {
+                finite("f0", &f0)?;
+                finite("f90", &f90)?;
+                for (what, v) in [("f0", f0), ("f90", f90)] {
+                    if let Some(x) = v.iter().find(|x| !(0.0..=1.0).contains(*x)) {
+                        return Err(format!("{what} must be in [0, 1] (got {x})"));
+                    }
+                }
+                Ok(())
+            }
+            Fresnel::Dielectric { eta } => {
+                finite("ior", &[eta])?;
+                if eta <= 0.0 {
+                    return Err(format!(
+                        "ior must be > 0 (got {eta}); it is n_inside / n_outside, e.g. 1.5 for \
+                         glass in air, 1/1.5 for light leaving glass"
+                    ));
+                }
+                Ok(())
+            }
+            Fresnel::Conductor { eta, k } => {
+                finite("eta", &eta)?;
+                finite("k", &k)?;
+                if let Some(x) = eta.iter().find(|x| **x <= 0.0) {
+                    return Err(format!("eta must be > 0 (got {x})"));
+                }
+                if let Some(x) = k.iter().find(|x| **x < 0.0) {
+                    return Err(format!("k must be >= 0 (got {x})"));
+                }
+                Ok(())
+            }
+        }
+    }
+
+    /// The reflectance per channel at cosine `c` in `[0, 1]`.
+    #[must_use]
+    pub fn reflectance(&self, c: f64) -> Rgb {
+        let c = c.clamp(0.0, 1.0);
+        match *self {
+            Fresnel::None => [1.0; 3],
+            Fresnel::Schlick { f0, f90 } => {
+                let w = (1.0 - c).powi(5);
+                std::array::from_fn(|j| f0[j] + (f90[j] - f0[j]) * w)
+            }
+            Fresnel::Dielectric { eta } => [dielectric(eta, c); 3],
+            Fresnel::Conductor { eta, k } => std::array::from_fn(|j| conductor(eta[j], k[j], c)),
+        }
+    }
+
+    /// `F_avg = 2 ∫_0^1 F(mu) mu dmu` per channel: Schlick's closed form `(20 F0 + F90) / 21`,
+    /// otherwise adaptive Gauss-Kronrod quadrature to 1e-14, split at the critical angle of a
+    /// dielectric with `eta < 1` (where `F` has a kink).
+    #[must_use]
+    pub fn average(&self) -> Rgb {
+        self.average_report().value
+    }
+
+    /// [`Fresnel::average`] with how it was computed and its error estimate.
+    #[must_use]
+    pub fn average_report(&self) -> FresnelAverage {
+        match *self {
+            Fresnel::None => FresnelAverage {
+                value: [1.0; 3],
+                error: 0.0,
+                evaluations: 0,
+                method: "closed-form",
+            },
+            Fresnel::Schlick { f0, f90 } => FresnelAverage {
+                value: std::array::from_fn(|j| (20.0 * f0[j] + f90[j]) / 21.0),
+                error: 0.0,
+                evaluations: 0,
+                method: "closed-form",
+            },
+            _ => self.average_by_quadrature(),
+        }
+    }
+
+    /// `F_avg` by quadrature for any model (the closed form's check for Schlick).
+    #[must_use]
+    pub fn average_by_quadrature(&self) -> FresnelAverage {
+        let mut breaks = vec![0.0, 1.0];
+        if let Fresnel::Dielectric { eta } = *self
+            && eta < 1.0
+        {
+            breaks.insert(1, ((1.0 - eta) * (1.0 + eta)).sqrt());
+        }
+        let q = integrate_pieces(
+            &mut |mu: f64| self.reflectance(mu).map(|f| 2.0 * f * mu),
+            &breaks,
+            1e-14,
+            1000,
+        );
+        FresnelAverage {
+            value: q.value,
+            error: q.error,
+            evaluations: q.evaluations,
+            method: "quadrature",
+        }
+    }
+}
+
+/// `F_avg` per channel with how it was computed.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct FresnelAverage {
+    pub value: Rgb,
+    /// The quadrature's error estimate (0 for a closed form).
+    pub error: f64,
+    /// Reflectance evaluations spent.
+    pub evaluations: u64,
+    /// `closed-form` or `quadrature`.
+    pub method: &'static str,
+}
+
+/// Exact unpolarised dielectric reflectance (Walter et al. 2007, eq. 22), `eta` relative.
+#[must_use]
+pub fn dielectric(eta: f64, c: f64) -> f64 {
+    let g2 = eta * eta - 1.0 + c * c;
+    if g2 <= 0.0 {
+        return 1.0; // total internal reflection
+    }
+    let g = g2.sqrt();
+    let a = (g - c) / (g + c);
+    let b = (c * (g + c) - 1.0) / (c * (g - c) + 1.0);
+    0.5 * a * a * (1.0 + b * b)
+}
+
+/// Exact unpolarised reflectance for the complex index `eta + i k` (see the module docs).
+#[must_use]
+pub fn conductor(eta: f64, k: f64, c: f64) -> f64 {
+    let n = Complex { re: eta, im: k };
+    let c = Complex { re: c, im: 0.0 };
+    let sin2 = Complex {
+        re: 1.0 - c.re * c.re,
+        im: 0.0,
+    };
+    let cos_t = (Complex { re: 1.0, im: 0.0 } - sin2 / (n * n)).sqrt();
+    let r_s = (c - n * cos_t) / (c + n * cos_t);
+    let r_p = (n * c - cos_t) / (n * c + cos_t);
+    0.5 * (r_s.norm2() + r_p.norm2())
+}
+
+/// Just enough complex arithmetic for [`conductor`].
+#[derive(Clone, Copy, Debug)]
+struct Complex {
+    re: f64,
+    im: f64,
+}
+
+impl Complex {
+    fn norm2(self) -> f64 {
+        self.re * self.re + self.im * self.im
+    }
+
+    /// The principal square root (non-negative real part).
+    fn sqrt(self) -> Self {
+        let r = self.norm2().sqrt();
+        let re = (0.5 * (r + self.re)).max(0.0).sqrt();
+        let im = (0.5 * (r - self.re)).max(0.0).sqrt();
+        Complex {
+            re,
+            im: if self.im < 0.0 { -im } else { im },
+        }
+    }
+}
+
+impl std::ops::Add for Complex {
+    type Output = Complex;
+    fn add(self, o: Complex) -> Complex {
+        Complex {
+            re: self.re + o.re,
+            im: self.im + o.im,
+        }
+    }
+}
+
+impl std::ops::Sub for Complex {
+    type Output = Complex;
+    fn sub(self, o: Complex) -> Complex {
+        Complex {
+            re: self.re - o.re,
+            im: self.im - o.im,
+        }
+    }
+}
+
+impl std::ops::Mul for Complex {
+    type Output = Complex;
+    fn mul(self, o: Complex) -> Complex {
+        Complex {
+            re: self.re * o.re - self.im * o.im,
+            im: self.re * o.im + self.im * o.re,
+        }
+    }
+}
+
+impl std::ops::Div for Complex {
+    type Output = Complex;
+    fn div(self, o: Complex) -> Complex {
+        let d = o.norm2();
+        Complex {
+            re: (self.re * o.re + self.im * o.im) / d,
+            im: (self.im * o.re - self.re * o.im) / d,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The check values of the Fresnel issue: `F_avg` of glass from both sides, to 1e-9.
+    #[test]
+    fn dielectric_averages_match_the_check_values() {
+        let outside = Fresnel::Dielectric { eta: 1.5 }.average()[0];
+        let inside = Fresnel::Dielectric { eta: 1.0 / 1.5 }.average()[0];
+        assert!((outside - 0.091_777_959_3).abs() < 1e-9, "{outside}");
+        assert!((inside - 0.596_345_759_7).abs() < 1e-9, "{inside}");
+    }
+
+    /// Reciprocity: `1 - F_avg(1/eta) = (1 - F_avg(eta)) / eta^2`, over a range of indices.
+    #[test]
+    fn averages_obey_reciprocity() {
+        for eta in [1.01, 1.1, 1.33, 1.5, 2.0, 2.4, 4.0] {
+            let f = Fresnel::Dielectric { eta }.average()[0];
+            let g = Fresnel::Dielectric { eta: 1.0 / eta }.average()[0];
+            assert!(
+                ((1.0 - g) - (1.0 - f) / (eta * eta)).abs() < 1e-9,
+                "eta {eta}: {f} {g}"
+            );
+        }
+    }
+
+    /// Schlick's closed form against the quadrature, to 1e-12.
+    #[test]
+    fn schlick_closed_form_matches_quadrature() {
+        for (f0, f90) in [(0.04, 1.0), (0.5, 1.0), (0.9, 0.7), (0.0, 0.0)] {
+            let model = Fresnel::Schlick {
+                f0: [f0, 0.3, 1.0],
+                f90: [f90, 1.0, 1.0],
+            };
+            let closed = model.average();
+            let numeric = model.average_by_quadrature().value;
+            for j in 0..3 {
+                assert!((closed[j] - numeric[j]).abs() < 1e-12, "{f0} {f90} {j}");
+            }
+        }
+    }
+
+    /// Known values: normal incidence `((eta - 1) / (eta + 1))^2` for dielectrics,
+    /// `((eta - 1)^2 + k^2) / ((eta + 1)^2 + k^2)` for conductors, 1 at grazing; a conductor with
+    /// `k = 0` is the dielectric; TIR beyond the critical angle.
+    #[test]
+    fn reflectance_limits_and_consistency() {
+        for eta in [0.5f64, 1.0 / 1.5, 1.5, 3.0] {
+            let f0 = ((eta - 1.0) / (eta + 1.0)).powi(2);
+            assert!((dielectric(eta, 1.0) - f0).abs() < 1e-15, "{eta}");
+            assert!((dielectric(eta, 0.0) - 1.0).abs() < 1e-15, "{eta}");
+            for c in [0.0, 0.1, 0.3, 0.5, 0.77, 0.95, 1.0] {
+                let d = dielectric(eta, c);
+                let k0 = conductor(eta, 0.0, c);
+                assert!((d - k0).abs() < 1e-13, "eta {eta} c {c}: {d} vs {k0}");
+                assert!((0.0..=1.0).contains(&d));
+            }
+        }
+        // Critical angle of eta = 1/1.5: sin = 1/1.5, so c_crit = sqrt(1 - 1/2.25).
+        let c_crit = (1.0f64 - 1.0 / 2.25).sqrt();
+        assert_eq!(dielectric(1.0 / 1.5, c_crit * 0.999), 1.0);
+        assert!(dielectric(1.0 / 1.5, c_crit * 1.001) < 1.0);
+        // Gold-like conductor.
+        let (n, k) = (0.18, 3.0);
+        let f0 = ((n - 1.0) * (n - 1.0) + k * k) / ((n + 1.0) * (n + 1.0) + k * k);
+        assert!((conductor(n, k, 1.0) - f0).abs() < 1e-14);
+        assert!((conductor(n, k, 0.0) - 1.0).abs() < 1e-12);
+        for c in [0.0, 0.2, 0.6, 1.0] {
+            assert!((0.0..=1.0).contains(&conductor(n, k, c)));
+        }
+    }
+
+    #[test]
+    fn bad_parameters_are_named() {
+        assert!(
+            Fresnel::Dielectric { eta: 0.0 }
+                .validate()
+                .unwrap_err()
+                .contains("ior")
+        );
+        assert!(
+            Fresnel::Conductor {
+                eta: [1.0, -1.0, 1.0],
+                k: [0.0; 3]
+            }
+            .validate()
+            .unwrap_err()
+            .contains("eta")
+        );
+        assert!(
+            Fresnel::Schlick {
+                f0: [1.5; 3],
+                f90: [1.0; 3]
+            }
+            .validate()
+            .unwrap_err()
+            .contains("f0")
+        );
+        assert!(Fresnel::Dielectric { eta: 1.5 }.validate().is_ok());
+    }
+}
