@@ -248,6 +248,26 @@ fn eval_f_avg_json_and_fresnel_flags() {
     assert_eq!(metal["value_rgb"].as_array().unwrap().len(), 3);
     assert_eq!(json(&["--fresnel", "none"])["value"], 1.0);
 
+    // E_F at one point: QMC within its standard error of the reference; RGB gives three values.
+    let e_f = |method: &str, f0: &str| -> serde_json::Value {
+        let output = kiln(&[
+            "eval", "--alpha", "0.25", "--mu", "0.5", "--f0", f0, "--method", method, "--json",
+        ]);
+        assert!(output.status.success(), "{}", stderr(&output));
+        serde_json::from_slice(&output.stdout).unwrap()
+    };
+    let (qmc, reference) = (e_f("qmc", "0.04"), e_f("reference", "0.04"));
+    assert_eq!(qmc["quantity"], "E_F");
+    let difference = (qmc["value"].as_f64().unwrap() - reference["value"].as_f64().unwrap()).abs();
+    assert!(
+        difference <= 5.0 * qmc["std_error"].as_f64().unwrap() + 1e-10,
+        "{qmc} {reference}"
+    );
+    let rgb = e_f("reference", "0.04,0.5,0.9");
+    let values = rgb["value"].as_array().unwrap();
+    assert_eq!(values[0], reference["value"]);
+    assert!(values[0].as_f64() < values[1].as_f64() && values[1].as_f64() < values[2].as_f64());
+
     for (args, needle) in [
         (&["--fresnel", "dielectric"][..], "needs --ior"),
         (&["--fresnel", "conductor", "--eta", "1"][..], "needs --k"),

@@ -78,6 +78,7 @@ impl Default for QmcSettings {
 /// Tags that keep the scrambles of different quantities apart.
 const TAG_E: u64 = 0x45;
 const TAG_E_AVG: u64 = 0x4541;
+const TAG_WEIGHTED: u64 = 0x4548;
 
 /// `E(mu)` for the model at `alpha` (slope-space roughness), `mu = cos(theta_o)` in [0, 1].
 ///
@@ -130,6 +131,65 @@ pub fn albedo(model: Model, alpha: f64, mu: f64, settings: &QmcSettings) -> Esti
             }
         }
     })
+}
+
+/// A weighted directional albedo `E_h(mu) = ∫ f(o, i) h(o.m) mu_i dω_i` with `F = 1` inside `f`
+/// and the weight `h` of the cosine between the view and the microfacet normal `m` (the half
+/// vector) in `[0, 1]`: a Fresnel reflectance `F(o.m)`, or Schlick's `Fc = (1 - o.m)^5` and
+/// `1 - Fc` for the split-sum tables. The estimate is `1 - w h` averaged over visible normals
+/// (`w = G2 / G1(o)`, 0 below the horizon), so `one_minus_value` is `1 - E_h` estimated directly.
+/// Generic visible-normal sampling ([`MicrofacetDistribution::sample_visible_normal`]), not the
+/// specialised GGX kernel.
+///
+/// # Panics
+/// As [`albedo`].
+#[must_use]
+pub fn weighted_albedo(
+    model: Model,
+    alpha: f64,
+    mu: f64,
+    h: impl Fn(f64) -> f64 + Copy,
+    settings: &QmcSettings,
+) -> Estimate {
+    assert!((0.0..=1.0).contains(&mu) && alpha >= 0.0 && alpha.is_finite());
+    if alpha == 0.0 && mu > 0.0 {
+        // A mirror: m = n, so o.m = mu and w = 1.
+        return Estimate::exact(1.0 - h(mu));
+    }
+    let (alpha, mu) = smooth_point(alpha, mu);
+    let key = [
+        TAG_WEIGHTED,
+        model_key(model),
+        alpha.to_bits(),
+        mu.to_bits(),
+    ];
+    fn kernel<N: MicrofacetDistribution>(
+        ndf: N,
+        masking: Masking,
+        mu: f64,
+        h: impl Fn(f64) -> f64 + Copy,
+        settings: &QmcSettings,
+        key: &[u64],
+    ) -> Estimate {
+        let o = Vec3::from_mu(mu);
+        let lambda_o = ndf.lambda(o);
+        replicates(settings, key, |seq, log2_n| {
+            sum_over_block(
+                seq,
+                log2_n,
+                #[inline(always)]
+                |u: [f64; 2]| {
+                    let m = ndf.sample_visible_normal(o, u);
+                    let w = 1.0 - reflection_loss(ndf, masking, o, lambda_o, m);
+                    1.0 - w * h(o.dot(m).clamp(0.0, 1.0))
+                },
+            )
+        })
+    }
+    match model.ndf {
+        Ndf::Ggx => kernel(Ggx { alpha }, model.masking, mu, h, settings, &key),
+        Ndf::Beckmann => kernel(Beckmann { alpha }, model.masking, mu, h, settings, &key),
+    }
 }
 
 /// `E_avg = 2 ∫ E(mu) mu dmu` for the model at `alpha`, integrated directly (see the module docs).

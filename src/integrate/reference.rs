@@ -109,9 +109,54 @@ fn quadrature_for(
     mu: f64,
     settings: &ReferenceSettings,
 ) -> Quadrature<2> {
+    weighted_quadrature_for(model, alpha, mu, |_| 1.0, settings)
+}
+
+/// `[E_h, 1 - E]` for the model's distribution at `alpha` (see [`reference_weighted_albedo`]).
+fn weighted_quadrature_for(
+    model: Model,
+    alpha: f64,
+    mu: f64,
+    h: impl Fn(f64) -> f64 + Copy,
+    settings: &ReferenceSettings,
+) -> Quadrature<2> {
     match model.ndf {
-        Ndf::Ggx => albedo_quadrature(Ggx { alpha }, model.masking, mu, settings),
-        Ndf::Beckmann => albedo_quadrature(Beckmann { alpha }, model.masking, mu, settings),
+        Ndf::Ggx => albedo_quadrature(Ggx { alpha }, model.masking, mu, h, settings),
+        Ndf::Beckmann => albedo_quadrature(Beckmann { alpha }, model.masking, mu, h, settings),
+    }
+}
+
+/// The weighted albedo `E_h(mu) = ∫ f(o, i) h(o.m) mu_i dω_i` (`F = 1` inside `f`, `m` the half
+/// vector; see [`crate::integrate::albedo::weighted_albedo`]) by the same quadrature as `E`, with
+/// `h` applied to the `E` integrand. `one_minus_value` is `1 - E_h` by subtraction (the weighted
+/// integrand has no loss form); `error` is the estimate for the weighted integral and `1 - E`
+/// together.
+#[must_use]
+pub fn reference_weighted_albedo(
+    model: Model,
+    alpha: f64,
+    mu: f64,
+    h: impl Fn(f64) -> f64 + Copy,
+    settings: &ReferenceSettings,
+) -> ReferenceValue {
+    assert!((0.0..=1.0).contains(&mu) && alpha >= 0.0 && alpha.is_finite());
+    if alpha == 0.0 && mu > 0.0 {
+        let value = h(mu);
+        return ReferenceValue {
+            value,
+            one_minus_value: 1.0 - value,
+            ..MIRROR
+        };
+    }
+    let (alpha, mu) = smooth_point(alpha, mu);
+    let q = weighted_quadrature_for(model, alpha, mu, h, settings);
+    let value = q.value[0].clamp(0.0, 1.0);
+    ReferenceValue {
+        value,
+        one_minus_value: 1.0 - value,
+        error: q.error,
+        evaluations: q.evaluations,
+        converged: q.converged,
     }
 }
 
@@ -177,6 +222,7 @@ fn albedo_quadrature<N: MicrofacetDistribution>(
     ndf: N,
     masking: Masking,
     mu: f64,
+    h: impl Fn(f64) -> f64 + Copy,
     settings: &ReferenceSettings,
 ) -> Quadrature<2> {
     let alpha = ndf.alpha();
@@ -224,7 +270,7 @@ fn albedo_quadrature<N: MicrofacetDistribution>(
             Masking::Separable => inverse_area / (1.0 + lambda_i),
         };
         [
-            weight * g2_over_mu,
+            weight * g2_over_mu * h(om.min(1.0)),
             weight * inverse_area * masking.loss(lambda_o, lambda_i),
         ]
     };

@@ -93,6 +93,17 @@ impl Fresnel {
         }
     }
 
+    /// Whether every channel has the same reflectance (a scalar model).
+    #[must_use]
+    pub fn is_grey(&self) -> bool {
+        let same = |v: Rgb| v[0] == v[1] && v[1] == v[2];
+        match *self {
+            Fresnel::None | Fresnel::Dielectric { .. } => true,
+            Fresnel::Schlick { f0, f90 } => same(f0) && same(f90),
+            Fresnel::Conductor { eta, k } => same(eta) && same(k),
+        }
+    }
+
     /// The reflectance per channel at cosine `c` in `[0, 1]`.
     #[must_use]
     pub fn reflectance(&self, c: f64) -> Rgb {

@@ -88,10 +88,10 @@ pub fn run(args: EvalArgs) -> kiln::Result<()> {
         EvalQuantity::E => Quantity::E,
         EvalQuantity::EAvg => Quantity::EAvg,
     };
-    if args.fresnel.given() {
+    if args.fresnel.given() && quantity == Quantity::EAvg {
         return Err(kiln::Error::InvalidInput(
-            "Fresnel-weighted E and E_avg are not in this version: --fresnel applies to \
-             --quantity f-avg"
+            "Fresnel-weighted E_avg is not in this version: --fresnel applies to --quantity e \
+             (E_F) and f-avg"
                 .into(),
         ));
     }
@@ -118,6 +118,10 @@ pub fn run(args: EvalArgs) -> kiln::Result<()> {
         (Quantity::E, Some(mu)) => Some(mu),
         (Quantity::EAvg, _) => None,
     };
+    if fresnel != Fresnel::None {
+        let mu = mu.expect("E has a mu");
+        return fresnel_weighted(&args, model, fresnel, alpha, mu);
+    }
     let start = Instant::now();
     // (value, one_minus_value, error, samples or evaluations, converged)
     let (value, one_minus_value, error, samples, converged) = match args.method {
@@ -268,6 +272,111 @@ fn fresnel_average(args: &EvalArgs, fresnel: Fresnel) -> kiln::Result<()> {
             average.error,
             average.method,
             average.evaluations
+        );
+    }
+    Ok(())
+}
+
+/// `kiln eval --quantity e` with a Fresnel model: `E_F(mu) = ∫ F(o.h) f mu_i dω_i` per channel
+/// (channels with the same reflectance are computed once).
+fn fresnel_weighted(
+    args: &EvalArgs,
+    model: Model,
+    fresnel: Fresnel,
+    alpha: f64,
+    mu: f64,
+) -> kiln::Result<()> {
+    use kiln::integrate::albedo::weighted_albedo;
+    use kiln::integrate::reference::reference_weighted_albedo;
+    let start = Instant::now();
+    let channel = |j: usize| move |c: f64| fresnel.reflectance(c)[j];
+    // (value, error, samples, converged) per channel computed: one for a grey model.
+    let mut channels: Vec<(f64, f64, u64, bool)> = Vec::new();
+    for j in 0..if fresnel.is_grey() { 1 } else { 3 } {
+        channels.push(match args.method {
+            Method::Qmc => {
+                let settings = QmcSettings {
+                    samples: args.samples.unwrap_or(QmcSettings::DEFAULT_SAMPLES),
+                    scrambles: args.scrambles,
+                    seed: args.seed,
+                };
+                settings.validate().map_err(kiln::Error::InvalidInput)?;
+                let e = weighted_albedo(model, alpha, mu, channel(j), &settings);
+                (e.value, e.std_error, e.samples, true)
+            }
+            Method::Reference => {
+                if args.samples.is_some() {
+                    return Err(kiln::Error::InvalidInput(
+                        "--samples sets the QMC sample count; the reference quadrature (--method \
+                         reference) chooses its own evaluations"
+                            .into(),
+                    ));
+                }
+                let r = reference_weighted_albedo(
+                    model,
+                    alpha,
+                    mu,
+                    channel(j),
+                    &ReferenceSettings::default(),
+                );
+                (r.value, r.error, r.evaluations, r.converged)
+            }
+        });
+    }
+    let seconds = start.elapsed().as_secs_f64();
+    let values: Vec<f64> = (0..3)
+        .map(|j| channels[j.min(channels.len() - 1)].0)
+        .collect();
+    let error = channels.iter().map(|c| c.1).fold(0.0, f64::max);
+    let samples: u64 = channels.iter().map(|c| c.2).sum();
+    let converged = channels.iter().all(|c| c.3);
+    let uniform = values[0] == values[1] && values[1] == values[2];
+    let method = match args.method {
+        Method::Qmc => "qmc",
+        Method::Reference => "reference",
+    };
+    if args.json {
+        let value: serde_json::Value = if uniform {
+            values[0].into()
+        } else {
+            serde_json::json!(values)
+        };
+        let one_minus: Vec<f64> = values.iter().map(|v| 1.0 - v).collect();
+        let mut object = serde_json::json!({
+            "quantity": "E_F",
+            "ndf": model.ndf.name(),
+            "masking": model.masking.name(),
+            "fresnel": fresnel,
+            "alpha": alpha,
+            "roughness": args.roughness,
+            "mu": mu,
+            "value": value,
+            "value_rgb": values,
+            "one_minus_value": if uniform { serde_json::Value::from(one_minus[0]) } else { serde_json::json!(one_minus) },
+            "std_error": error,
+            "method": method,
+            "samples": samples,
+            "seconds": seconds,
+            "converged": converged,
+            "kiln_version": kiln::format::metadata::KILN_VERSION,
+        });
+        if args.method == Method::Qmc {
+            object["estimator"] = "vndf-sobol-owen".into();
+            object["scrambles"] = args.scrambles.into();
+            object["seed"] = args.seed.into();
+        }
+        println!("{object}");
+    } else {
+        let shown = if uniform {
+            format!("{:.12}", values[0])
+        } else {
+            format!("[{:.10}, {:.10}, {:.10}]", values[0], values[1], values[2])
+        };
+        println!(
+            "E_F(mu = {mu}, alpha = {alpha}; {} Fresnel) = {shown} ± {error:.1e} ({}, {method}, \
+             {samples} evaluations, {seconds:.3} s)",
+            fresnel.name(),
+            model.ndf
         );
     }
     Ok(())
