@@ -5,6 +5,7 @@
 //! cores and collects them in index order, so a table is byte-identical for any thread count.
 
 use crate::error::{Error, Result};
+use crate::integrate::albedo::weighted_albedo;
 use crate::integrate::average_quadrature::{quadrature_average_albedo, rule_average_albedo};
 use crate::integrate::reference::{ReferenceSettings, reference_albedo};
 use crate::integrate::{Estimate, QmcSettings, albedo, average_albedo};
@@ -22,6 +23,9 @@ use rayon::prelude::*;
 pub struct BakeOptions {
     pub ndfs: Vec<Ndf>,
     pub maskings: Vec<Masking>,
+    /// The tables baked per model: `E` and `E_avg` by default; the split-sum channels
+    /// `E_scale` and `E_bias` on request.
+    pub quantities: Vec<Quantity>,
     /// Samples per axis: `E` is `size x size`, `E_avg` has `size` entries.
     pub size: usize,
     /// QMC evaluations per `E` texel (a power of two).
@@ -52,6 +56,7 @@ impl Default for BakeOptions {
         Self {
             ndfs: vec![Ndf::Ggx],
             maskings: vec![Masking::HeightCorrelated],
+            quantities: vec![Quantity::E, Quantity::EAvg],
             size: Self::DEFAULT_SIZE,
             samples: QmcSettings::DEFAULT_SAMPLES,
             average_samples: 16 * QmcSettings::DEFAULT_SAMPLES,
@@ -95,9 +100,19 @@ impl BakeOptions {
                 Self::MIN_MAX_ERROR
             )));
         }
-        if self.ndfs.is_empty() || self.maskings.is_empty() {
+        if self.mu_mapping == MuMapping::Adaptive
+            && let Some(q) = self.quantities.iter().find(|q| q.weight().is_some())
+        {
+            return Err(Error::InvalidInput(format!(
+                "--quantity {} needs --mu-axis linear or sqrt: the adaptive mu axis follows E's \
+                 grazing layer and maps every mu > 0 to t = 1 at roughness 0, where a split-sum \
+                 channel still varies as Fc(mu) = (1 - mu)^5",
+                q.cli_name()
+            )));
+        }
+        if self.ndfs.is_empty() || self.maskings.is_empty() || self.quantities.is_empty() {
             return Err(Error::InvalidInput(
-                "name at least one ndf and one masking".into(),
+                "name at least one ndf, one masking and one quantity".into(),
             ));
         }
         for (what, samples) in [
@@ -196,28 +211,45 @@ impl BakeOptions {
         self.models()
             .into_iter()
             .flat_map(|model| {
-                [
-                    TableSpec {
+                self.quantities()
+                    .into_iter()
+                    .map(move |quantity| TableSpec {
                         reference_digits,
                         model,
-                        quantity: Quantity::E,
+                        quantity,
                         roughness,
-                        mu: Some(mu),
+                        mu: quantity.has_mu().then_some(mu),
                         method: self.method,
-                        qmc: qmc(self.samples),
-                    },
-                    TableSpec {
-                        reference_digits,
-                        model,
-                        quantity: Quantity::EAvg,
-                        roughness,
-                        mu: None,
-                        method: self.method,
-                        qmc: qmc(self.average_samples),
-                    },
-                ]
+                        qmc: qmc(if quantity.has_mu() {
+                            self.samples
+                        } else {
+                            self.average_samples
+                        }),
+                    })
             })
             .collect()
+    }
+
+    /// The quantities baked per model, in the order given, each once.
+    #[must_use]
+    pub fn quantities(&self) -> Vec<Quantity> {
+        let mut quantities: Vec<Quantity> = Vec::new();
+        for &q in &self.quantities {
+            if !quantities.contains(&q) {
+                quantities.push(q);
+            }
+        }
+        quantities
+    }
+
+    /// ` --quantity ...` for a command line, empty for the default `e,e-avg`.
+    fn quantity_flag(&self) -> String {
+        let quantities = self.quantities();
+        if quantities == [Quantity::E, Quantity::EAvg] {
+            return String::new();
+        }
+        let names: Vec<&str> = quantities.iter().map(|q| q.cli_name()).collect();
+        format!(" --quantity {}", names.join(","))
     }
 
     /// The `kiln bake` command that reproduces the tables of `model` with these options, with
@@ -226,8 +258,9 @@ impl BakeOptions {
     pub fn command_for(&self, model: Model) -> String {
         if let Some(max_error) = self.max_error {
             return format!(
-                "kiln bake --max-error {max_error:e} --ndf {} --masking {} --size {} --seed {} \
+                "kiln bake --max-error {max_error:e}{} --ndf {} --masking {} --size {} --seed {} \
                  --roughness-axis {} --mu-axis {} --grid {}",
+                self.quantity_flag(),
                 model.ndf,
                 model.masking,
                 self.size,
@@ -239,8 +272,9 @@ impl BakeOptions {
         }
         if self.method == Method::Reference {
             return format!(
-                "kiln bake --method reference --ndf {} --masking {} --size {} --roughness-axis {} \
+                "kiln bake --method reference{} --ndf {} --masking {} --size {} --roughness-axis {} \
                  --mu-axis {} --grid {}",
+                self.quantity_flag(),
                 model.ndf,
                 model.masking,
                 self.size,
@@ -250,8 +284,9 @@ impl BakeOptions {
             );
         }
         format!(
-            "kiln bake --ndf {} --masking {} --size {} --samples {} --avg-samples {} \
+            "kiln bake{} --ndf {} --masking {} --size {} --samples {} --avg-samples {} \
              --scrambles {} --seed {} --roughness-axis {} --mu-axis {} --grid {}",
+            self.quantity_flag(),
             model.ndf,
             model.masking,
             self.size,
@@ -381,13 +416,17 @@ pub fn bake_table(spec: TableSpec, command: String, progress: &(dyn Fn(u64) + Sy
 pub fn estimate_texel(spec: &TableSpec, index: usize) -> Estimate {
     let (alpha, mu) = spec.texel_coordinates(index);
     match spec.method {
-        Method::Qmc => match mu {
-            Some(mu) => albedo(spec.model, alpha, mu, &spec.qmc),
-            None => average_albedo(spec.model, alpha, &spec.qmc),
+        Method::Qmc => match (mu, spec.quantity.weight()) {
+            (Some(mu), None) => albedo(spec.model, alpha, mu, &spec.qmc),
+            (Some(mu), Some(h)) => weighted_albedo(spec.model, alpha, mu, h, &spec.qmc),
+            (None, _) => average_albedo(spec.model, alpha, &spec.qmc),
         },
         Method::Reference => {
             let settings = spec.reference_settings();
             let r = match (mu, spec.average_rule_order()) {
+                (Some(mu), _) if spec.quantity.weight().is_some() => {
+                    crate::verify::reference_value(spec, alpha, Some(mu), &settings)
+                }
                 (Some(mu), _) => reference_albedo(spec.model, alpha, mu, &settings),
                 // A fixed rule whose measured error is a tenth of the tolerance.
                 (None, Some(order)) => rule_average_albedo(spec.model, alpha, order, &settings),

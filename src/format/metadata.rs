@@ -119,7 +119,11 @@ impl Metadata {
             description: spec.quantity.describe().to_string(),
             ndf: spec.model.ndf.name().to_string(),
             masking: spec.model.masking.name().to_string(),
-            fresnel: "none (F = 1)".to_string(),
+            fresnel: match spec.quantity.weight() {
+                None => "none (F = 1)".to_string(),
+                Some(_) => "Schlick weight Fc = (1 - o.h)^5 (or 1 - Fc) on F = 1; see description"
+                    .to_string(),
+            },
             roughness_convention: spec.roughness_convention().name().to_string(),
             shape: spec.shape(),
             layout,

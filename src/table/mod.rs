@@ -19,6 +19,18 @@ pub enum Quantity {
     #[serde(rename = "E_avg")]
     #[cfg_attr(feature = "cli", value(name = "e-avg"))]
     EAvg,
+    /// The split-sum scale `E_scale(mu, roughness) = ∫ (1 - Fc(o.h)) f mu_i dω_i` with
+    /// `Fc = (1 - o.h)^5` and `F = 1` inside `f`, a 2-D table: Schlick's Fresnel-weighted albedo
+    /// is `E_F = F0 E_scale + F90 E_bias` (Karis 2013, "Real Shading in Unreal Engine 4").
+    #[serde(rename = "E_scale")]
+    #[cfg_attr(feature = "cli", value(name = "e-scale"))]
+    EScale,
+    /// The split-sum bias `E_bias(mu, roughness) = ∫ Fc(o.h) f mu_i dω_i`, a 2-D table;
+    /// `E_scale + E_bias = E`. With `E` it is the multiscatter layout (Filament, Godot:
+    /// `∫ Fc w` and `∫ w`).
+    #[serde(rename = "E_bias")]
+    #[cfg_attr(feature = "cli", value(name = "e-bias"))]
+    EBias,
 }
 
 impl Quantity {
@@ -28,6 +40,8 @@ impl Quantity {
         match self {
             Quantity::E => "E",
             Quantity::EAvg => "E_avg",
+            Quantity::EScale => "E_scale",
+            Quantity::EBias => "E_bias",
         }
     }
 
@@ -37,6 +51,8 @@ impl Quantity {
         match self {
             Quantity::E => "e",
             Quantity::EAvg => "e-avg",
+            Quantity::EScale => "e-scale",
+            Quantity::EBias => "e-bias",
         }
     }
 
@@ -50,8 +66,43 @@ impl Quantity {
             Quantity::EAvg => {
                 "average albedo E_avg = 2 * integral of E(mu) mu dmu over [0, 1], F = 1"
             }
+            Quantity::EScale => {
+                "split-sum scale E_scale(mu) = integral of (1 - Fc(o.h)) f(o, i) mu_i over \
+                 incoming directions i, Fc = (1 - o.h)^5, F = 1 inside f; Schlick's \
+                 Fresnel-weighted albedo is F0 * E_scale + F90 * E_bias; one_minus_E_scale is \
+                 1 - E_scale"
+            }
+            Quantity::EBias => {
+                "split-sum bias E_bias(mu) = integral of Fc(o.h) f(o, i) mu_i over incoming \
+                 directions i, Fc = (1 - o.h)^5, F = 1 inside f; E_scale + E_bias = E; \
+                 one_minus_E_bias is 1 - E_bias"
+            }
         }
     }
+
+    /// Whether the table has a `mu` axis (every quantity but `E_avg`).
+    #[must_use]
+    pub fn has_mu(self) -> bool {
+        self != Quantity::EAvg
+    }
+
+    /// The weight `h(o.h)` a split-sum quantity puts on the albedo integrand (`None`: `h = 1`).
+    #[must_use]
+    pub fn weight(self) -> Option<fn(f64) -> f64> {
+        match self {
+            Quantity::E | Quantity::EAvg => None,
+            Quantity::EScale => Some(|c| 1.0 - schlick_weight(c)),
+            Quantity::EBias => Some(schlick_weight),
+        }
+    }
+}
+
+/// Schlick's `Fc = (1 - c)^5`.
+#[must_use]
+pub fn schlick_weight(c: f64) -> f64 {
+    let x = 1.0 - c;
+    let x2 = x * x;
+    x2 * x2 * x
 }
 
 /// How a table's values are computed.

@@ -302,22 +302,24 @@ fn spec_and_values(
             layout.shape
         ));
     }
-    match (layout.quantity, &layout.order[..], &layout.shape[..]) {
-        (Quantity::EAvg, [AxisName::R], &[n]) => Ok((spec(roughness_axis(n), None), values)),
-        (Quantity::E, [AxisName::R, AxisName::Mu], &[rows, columns]) => {
+    let two_d = layout.quantity.has_mu();
+    match (two_d, &layout.order[..], &layout.shape[..]) {
+        (false, [AxisName::R], &[n]) => Ok((spec(roughness_axis(n), None), values)),
+        (true, [AxisName::R, AxisName::Mu], &[rows, columns]) => {
             Ok((spec(roughness_axis(rows), Some(mu_axis(columns))), values))
         }
-        (Quantity::E, [AxisName::Mu, AxisName::R], &[n_mu, n_r]) => {
+        (true, [AxisName::Mu, AxisName::R], &[n_mu, n_r]) => {
             // Transpose into roughness-major order.
             let transposed = (0..n_r * n_mu)
                 .map(|k| values[(k % n_mu) * n_r + k / n_mu])
                 .collect();
             Ok((spec(roughness_axis(n_r), Some(mu_axis(n_mu))), transposed))
         }
-        (Quantity::E, _, _) => {
-            Err("an E table needs two axes, e.g. --shape 32x32 --order mu,r".into())
-        }
-        (Quantity::EAvg, _, _) => {
+        (true, _, _) => Err(format!(
+            "an {} table needs two axes, e.g. --shape 32x32 --order mu,r",
+            layout.quantity.symbol()
+        )),
+        (false, _, _) => {
             Err("an E_avg table has one roughness axis, e.g. --shape 32 --order r".into())
         }
     }

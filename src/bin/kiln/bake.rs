@@ -3,7 +3,9 @@
 use crate::args::{CONVENTIONS, parse_samples, parse_size};
 use clap::Args;
 use kiln::format::{self, Format, Precision};
-use kiln::{BakeOptions, Grid, Masking, Method, MuMapping, Ndf, QmcSettings, RoughnessConvention};
+use kiln::{
+    BakeOptions, Grid, Masking, Method, MuMapping, Ndf, QmcSettings, Quantity, RoughnessConvention,
+};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -34,6 +36,12 @@ pub struct BakeArgs {
         default_value = "height-correlated"
     )]
     masking: Vec<Masking>,
+    /// Tables to bake per model, comma-separated: e (E), e-avg (E_avg), and the split-sum
+    /// channels e-scale (integral of (1 - Fc) f mu_i) and e-bias (integral of Fc f mu_i),
+    /// Fc = (1 - o.h)^5: Schlick's E_F = F0 * E_scale + F90 * E_bias. The multiscatter layout
+    /// of Filament and Godot is e-bias with e.
+    #[arg(long, value_enum, value_delimiter = ',', default_value = "e,e-avg")]
+    quantity: Vec<Quantity>,
     /// Samples per axis: E is SIZE x SIZE, E_avg has SIZE entries. 2 to 4096.
     #[arg(long, default_value_t = BakeOptions::DEFAULT_SIZE, value_parser = parse_size, allow_negative_numbers = true)]
     size: usize,
@@ -116,6 +124,7 @@ pub fn run(args: BakeArgs) -> kiln::Result<()> {
     let options = BakeOptions {
         ndfs: args.ndf,
         maskings: args.masking,
+        quantities: args.quantity,
         size: args.size,
         samples,
         average_samples: args.avg_samples.unwrap_or(16 * samples),

@@ -110,13 +110,13 @@ pub fn run(args: EvalArgs) -> kiln::Result<()> {
         }
     };
     let mu = match (quantity, args.mu) {
-        (Quantity::E, None) => {
+        (q, None) if q.has_mu() => {
             return Err(kiln::Error::InvalidInput(
                 "--quantity e needs --mu (cos(theta) in [0, 1])".into(),
             ));
         }
-        (Quantity::E, Some(mu)) => Some(mu),
-        (Quantity::EAvg, _) => None,
+        (q, Some(mu)) if q.has_mu() => Some(mu),
+        _ => None,
     };
     if fresnel != Fresnel::None {
         let mu = mu.expect("E has a mu");
@@ -126,9 +126,10 @@ pub fn run(args: EvalArgs) -> kiln::Result<()> {
     // (value, one_minus_value, error, samples or evaluations, converged)
     let (value, one_minus_value, error, samples, converged) = match args.method {
         Method::Qmc => {
-            let samples = args.samples.unwrap_or(match quantity {
-                Quantity::E => QmcSettings::DEFAULT_SAMPLES,
-                Quantity::EAvg => 16 * QmcSettings::DEFAULT_SAMPLES,
+            let samples = args.samples.unwrap_or(if quantity.has_mu() {
+                QmcSettings::DEFAULT_SAMPLES
+            } else {
+                16 * QmcSettings::DEFAULT_SAMPLES
             });
             let settings = QmcSettings {
                 samples,

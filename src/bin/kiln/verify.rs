@@ -125,9 +125,10 @@ impl VerifyArgs {
                 self.file.display()
             ))
         })?;
-        let order = self.order.clone().unwrap_or(match self.quantity {
-            Quantity::E => vec![AxisName::R, AxisName::Mu],
-            Quantity::EAvg => vec![AxisName::R],
+        let order = self.order.clone().unwrap_or(if self.quantity.has_mu() {
+            vec![AxisName::R, AxisName::Mu]
+        } else {
+            vec![AxisName::R]
         });
         Ok(Layout {
             model: Model {
