@@ -144,13 +144,7 @@ pub fn run(args: EvalArgs) -> kiln::Result<()> {
             (e.value, e.one_minus_value, e.std_error, e.samples, true)
         }
         Method::Reference => {
-            if args.samples.is_some() {
-                return Err(kiln::Error::InvalidInput(
-                    "--samples sets the QMC sample count; the reference quadrature (--method \
-                     reference) chooses its own evaluations"
-                        .into(),
-                ));
-            }
+            args.no_samples_for_reference()?;
             let settings = ReferenceSettings::default();
             let r = match mu {
                 Some(mu) => reference_albedo(model, alpha, mu, &settings),
@@ -172,7 +166,7 @@ pub fn run(args: EvalArgs) -> kiln::Result<()> {
     };
     let symbol = quantity.symbol();
     if args.json {
-        let mut object = serde_json::json!({
+        let object = serde_json::json!({
             "quantity": symbol,
             "ndf": model.ndf.name(),
             "masking": model.masking.name(),
@@ -188,12 +182,7 @@ pub fn run(args: EvalArgs) -> kiln::Result<()> {
             "converged": converged,
             "kiln_version": kiln::format::metadata::KILN_VERSION,
         });
-        if args.method == Method::Qmc {
-            object["estimator"] = "vndf-sobol-owen".into();
-            object["scrambles"] = args.scrambles.into();
-            object["seed"] = args.seed.into();
-        }
-        println!("{object}");
+        print_json(&args, object);
     } else {
         let at = mu.map(|mu| format!("mu = {mu}, ")).unwrap_or_default();
         let what = match args.method {
@@ -238,21 +227,12 @@ fn fresnel_average(args: &EvalArgs, fresnel: Fresnel) -> kiln::Result<()> {
     let [r, g, b] = average.value;
     let uniform = r == g && g == b;
     if args.json {
-        let value: serde_json::Value = if uniform {
-            r.into()
-        } else {
-            serde_json::json!([r, g, b])
-        };
         let object = serde_json::json!({
             "quantity": "F_avg",
             "fresnel": fresnel,
-            "value": value,
+            "value": scalar_or_rgb(average.value),
             "value_rgb": [r, g, b],
-            "one_minus_value": if uniform {
-                serde_json::Value::from(1.0 - r)
-            } else {
-                serde_json::json!([1.0 - r, 1.0 - g, 1.0 - b])
-            },
+            "one_minus_value": scalar_or_rgb(average.value.map(|v| 1.0 - v)),
             "std_error": average.error,
             "method": average.method,
             "samples": average.evaluations,
@@ -306,13 +286,7 @@ fn fresnel_weighted(
                 (e.value, e.std_error, e.samples, true)
             }
             Method::Reference => {
-                if args.samples.is_some() {
-                    return Err(kiln::Error::InvalidInput(
-                        "--samples sets the QMC sample count; the reference quadrature (--method \
-                         reference) chooses its own evaluations"
-                            .into(),
-                    ));
-                }
+                args.no_samples_for_reference()?;
                 let r = reference_weighted_albedo(
                     model,
                     alpha,
@@ -325,9 +299,7 @@ fn fresnel_weighted(
         });
     }
     let seconds = start.elapsed().as_secs_f64();
-    let values: Vec<f64> = (0..3)
-        .map(|j| channels[j.min(channels.len() - 1)].0)
-        .collect();
+    let values: [f64; 3] = std::array::from_fn(|j| channels[j.min(channels.len() - 1)].0);
     let error = channels.iter().map(|c| c.1).fold(0.0, f64::max);
     let samples: u64 = channels.iter().map(|c| c.2).sum();
     let converged = channels.iter().all(|c| c.3);
@@ -337,13 +309,7 @@ fn fresnel_weighted(
         Method::Reference => "reference",
     };
     if args.json {
-        let value: serde_json::Value = if uniform {
-            values[0].into()
-        } else {
-            serde_json::json!(values)
-        };
-        let one_minus: Vec<f64> = values.iter().map(|v| 1.0 - v).collect();
-        let mut object = serde_json::json!({
+        let object = serde_json::json!({
             "quantity": "E_F",
             "ndf": model.ndf.name(),
             "masking": model.masking.name(),
@@ -351,9 +317,9 @@ fn fresnel_weighted(
             "alpha": alpha,
             "roughness": args.roughness,
             "mu": mu,
-            "value": value,
+            "value": scalar_or_rgb(values),
             "value_rgb": values,
-            "one_minus_value": if uniform { serde_json::Value::from(one_minus[0]) } else { serde_json::json!(one_minus) },
+            "one_minus_value": scalar_or_rgb(values.map(|v| 1.0 - v)),
             "std_error": error,
             "method": method,
             "samples": samples,
@@ -361,12 +327,7 @@ fn fresnel_weighted(
             "converged": converged,
             "kiln_version": kiln::format::metadata::KILN_VERSION,
         });
-        if args.method == Method::Qmc {
-            object["estimator"] = "vndf-sobol-owen".into();
-            object["scrambles"] = args.scrambles.into();
-            object["seed"] = args.seed.into();
-        }
-        println!("{object}");
+        print_json(args, object);
     } else {
         let shown = if uniform {
             format!("{:.12}", values[0])
@@ -381,4 +342,37 @@ fn fresnel_weighted(
         );
     }
     Ok(())
+}
+
+/// Prints an eval JSON object, with the QMC settings when QMC computed it.
+fn print_json(args: &EvalArgs, mut object: serde_json::Value) {
+    if args.method == Method::Qmc {
+        object["estimator"] = "vndf-sobol-owen".into();
+        object["scrambles"] = args.scrambles.into();
+        object["seed"] = args.seed.into();
+    }
+    println!("{object}");
+}
+
+/// A number when all three channels agree, `[R, G, B]` otherwise.
+fn scalar_or_rgb(values: [f64; 3]) -> serde_json::Value {
+    if values[0] == values[1] && values[1] == values[2] {
+        values[0].into()
+    } else {
+        serde_json::json!(values)
+    }
+}
+
+impl EvalArgs {
+    /// `--samples` is QMC's: an error with `--method reference`.
+    fn no_samples_for_reference(&self) -> kiln::Result<()> {
+        if self.samples.is_some() {
+            return Err(kiln::Error::InvalidInput(
+                "--samples sets the QMC sample count; the reference quadrature (--method \
+                 reference) chooses its own evaluations"
+                    .into(),
+            ));
+        }
+        Ok(())
+    }
 }
