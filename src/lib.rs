@@ -38,6 +38,7 @@ pub mod error;
 pub mod format;
 pub mod integrate;
 pub mod model;
+pub mod scene;
 pub mod study;
 pub mod table;
 pub mod verify;

@@ -293,6 +293,79 @@ fn eval_f_avg_json_and_fresnel_flags() {
     }
 }
 
+/// `kiln plan --scene`: one model, both NDFs, duplicates merged, no materials; a bad scene file
+/// gets its line and column, status 2.
+#[test]
+fn plan_lists_each_needed_table_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let plan = |name: &str, text: &str| -> (Output, serde_json::Value) {
+        let path = dir.path().join(name);
+        std::fs::write(&path, text).unwrap();
+        let output = kiln(&["plan", "--scene", path.to_str().unwrap(), "--json"]);
+        let json = serde_json::from_slice(&output.stdout).unwrap_or(serde_json::Value::Null);
+        (output, json)
+    };
+    let material = |name: &str, ndf: &str, extra: &str| {
+        format!("[[material]]\nname = \"{name}\"\nndf = \"{ndf}\"\nroughness = 0.4\n{extra}\n")
+    };
+    let ids = |json: &serde_json::Value| -> Vec<String> {
+        json["tables"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|t| format!("{}-{}-{}", t["ndf"], t["masking"], t["quantity"]).replace('"', ""))
+            .collect()
+    };
+    let (_, one) = plan("one.toml", &material("steel", "ggx", ""));
+    assert_eq!(
+        ids(&one),
+        ["ggx-height-correlated-E", "ggx-height-correlated-E_avg"]
+    );
+    assert_eq!(one["materials"][0]["name"], "steel");
+    let (_, both) = plan(
+        "both.toml",
+        &(material("steel", "ggx", "") + &material("wood", "beckmann", "masking = \"separable\"")),
+    );
+    assert_eq!(
+        ids(&both),
+        [
+            "ggx-height-correlated-E",
+            "ggx-height-correlated-E_avg",
+            "beckmann-separable-E",
+            "beckmann-separable-E_avg"
+        ]
+    );
+    let (_, twins) = plan(
+        "twins.toml",
+        &(material("a", "ggx", "fresnel = { schlick = { f0 = 0.04 } }")
+            + &material("b", "ggx", "fresnel = { dielectric = { ior = 1.5 } }")),
+    );
+    assert_eq!(twins["tables"].as_array().unwrap().len(), 2);
+    assert_eq!(
+        twins["tables"][0]["materials"],
+        serde_json::json!(["a", "b"])
+    );
+    let f_avg = twins["materials"][1]["f_avg"][0].as_f64().unwrap();
+    assert!((f_avg - 0.091_777_959_3).abs() < 1e-9);
+    let (_, empty) = plan("empty.toml", "");
+    assert!(empty["tables"].as_array().unwrap().is_empty());
+    assert!(empty["materials"].as_array().unwrap().is_empty());
+
+    let (bad, _) = plan("bad.toml", &material("a", "ggx", "colour = 1"));
+    assert_eq!(bad.status.code(), Some(2));
+    let message = stderr(&bad);
+    assert!(
+        message.contains("line 5") && message.contains("colour"),
+        "{message}"
+    );
+    let (bad, _) = plan(
+        "rough.toml",
+        &material("a", "ggx", "").replace("0.4", "-0.1"),
+    );
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(stderr(&bad).contains("roughness -0.1"), "{}", stderr(&bad));
+}
+
 #[test]
 fn outputs_agree_with_each_other_and_round_trip() {
     let dir = tempfile::tempdir().unwrap();

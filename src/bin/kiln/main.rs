@@ -4,6 +4,7 @@ mod args;
 mod bake;
 mod eval;
 mod fresnel_args;
+mod plan;
 mod plot;
 mod study;
 mod verify;
@@ -25,6 +26,8 @@ enum Command {
     Bake(bake::BakeArgs),
     /// Evaluate E or E_avg at one point (QMC or the deterministic reference), or F_avg.
     Eval(eval::EvalArgs),
+    /// Show the minimal set of tables a scene file's materials need.
+    Plan(plan::PlanArgs),
     /// Audit a table (kiln's or an engine's) against the deterministic reference.
     Verify(verify::VerifyArgs),
     /// Measure what accuracy costs: error against time per estimator, lookup error against size.
@@ -69,6 +72,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Bake(args) => bake::run(args).map(|()| true),
         Command::Eval(args) => eval::run(args).map(|()| true),
+        Command::Plan(args) => plan::run(args).map(|()| true),
         Command::Verify(args) => verify::run(args),
         Command::Study(args) => study::run(args).map(|()| true),
     };

@@ -1,0 +1,410 @@
+//! Scene files: the materials a renderer uses, and the minimal set of tables they need (the plan).
+//!
+//! A scene is TOML (unknown keys rejected):
+//!
+//! ```toml
+//! [output]                      # optional
+//! dir = "tables"
+//! formats = ["exr", "rs", "json"]
+//! precision = "f16"
+//!
+//! [[material]]
+//! name = "brushed_steel"
+//! ndf = "ggx"                   # ggx | beckmann
+//! masking = "height-correlated" # optional, default height-correlated
+//! roughness = [0.2, 0.6]        # perceptual roughness: one value or a [min, max] range
+//! fresnel = { conductor = { eta = [2.9, 2.9, 2.4], k = [3.0, 2.9, 2.5] } }
+//!
+//! [[material]]
+//! name = "varnish"
+//! ndf = "beckmann"
+//! roughness = 0.3
+//! fresnel = { dielectric = { ior = 1.5 } }  # or { schlick = { f0 = 0.04 } }, or "none" (F = 1)
+//! ```
+//!
+//! The plan ([`Scene::plan`]) lists each table once, with the materials that need it: `E` and
+//! `E_avg` for every NDF and masking combination in use (the Kulla-Conty lobe needs both, whatever
+//! the Fresnel model), and per material the scalars it needs: `F_avg` per channel
+//! ([`crate::Fresnel::average`]) for the lobe's colour term.
+
+use crate::error::{Error, Result};
+use crate::format::{Format, Precision};
+use crate::model::fresnel::Rgb;
+use crate::model::{Fresnel, Masking, Model, Ndf};
+use crate::table::Quantity;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// A scene file.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    #[serde(default)]
+    pub output: Option<Output>,
+    #[serde(default, rename = "material")]
+    pub materials: Vec<Material>,
+}
+
+/// Where and how to write the tables.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Output {
+    pub dir: Option<String>,
+    pub formats: Option<Vec<Format>>,
+    pub precision: Option<Precision>,
+    /// The max error to bake to (default [`crate::BakeOptions::DEFAULT_MAX_ERROR`]).
+    pub max_error: Option<f64>,
+}
+
+/// One material.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Material {
+    pub name: String,
+    pub ndf: Ndf,
+    #[serde(default = "default_masking")]
+    pub masking: Masking,
+    pub roughness: Roughness,
+    #[serde(default)]
+    pub fresnel: FresnelSpec,
+}
+
+fn default_masking() -> Masking {
+    Masking::HeightCorrelated
+}
+
+/// Perceptual roughness used: one value or a `[min, max]` range.
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(untagged)]
+pub enum Roughness {
+    One(f64),
+    Range([f64; 2]),
+}
+
+impl Roughness {
+    /// `[min, max]`.
+    #[must_use]
+    pub fn range(self) -> [f64; 2] {
+        match self {
+            Roughness::One(r) => [r, r],
+            Roughness::Range(range) => range,
+        }
+    }
+}
+
+/// One value for every channel or three.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq)]
+#[serde(untagged)]
+pub enum Channels {
+    One(f64),
+    Rgb(Rgb),
+}
+
+impl Channels {
+    fn rgb(self) -> Rgb {
+        match self {
+            Channels::One(v) => [v; 3],
+            Channels::Rgb(v) => v,
+        }
+    }
+}
+
+/// A material's Fresnel model as the scene writes it.
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq)]
+#[serde(rename_all = "lowercase", deny_unknown_fields)]
+pub enum FresnelSpec {
+    /// `F = 1`.
+    #[default]
+    None,
+    Schlick {
+        f0: Channels,
+        f90: Option<Channels>,
+    },
+    Dielectric {
+        ior: f64,
+    },
+    Conductor {
+        eta: Channels,
+        k: Channels,
+    },
+}
+
+impl FresnelSpec {
+    /// The library's model.
+    #[must_use]
+    pub fn model(self) -> Fresnel {
+        match self {
+            FresnelSpec::None => Fresnel::None,
+            FresnelSpec::Schlick { f0, f90 } => Fresnel::Schlick {
+                f0: f0.rgb(),
+                f90: f90.map_or([1.0; 3], Channels::rgb),
+            },
+            FresnelSpec::Dielectric { ior } => Fresnel::Dielectric { eta: ior },
+            FresnelSpec::Conductor { eta, k } => Fresnel::Conductor {
+                eta: eta.rgb(),
+                k: k.rgb(),
+            },
+        }
+    }
+}
+
+impl Scene {
+    /// Parses and checks a scene. A syntax error or an unknown key names the line and column
+    /// and what was expected; an impossible value names the material and the value.
+    pub fn parse(text: &str, origin: &str) -> Result<Scene> {
+        let scene: Scene = toml::from_str(text)
+            .map_err(|e| Error::InvalidInput(format!("{origin}: {}", e.to_string().trim_end())))?;
+        scene.validate(origin)?;
+        Ok(scene)
+    }
+
+    /// Reads and parses a scene file.
+    pub fn read(path: &Path) -> Result<Scene> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::Io {
+            path: path.to_path_buf(),
+            action: "read the scene file",
+            source: e,
+        })?;
+        Scene::parse(&text, &path.display().to_string())
+    }
+
+    fn validate(&self, origin: &str) -> Result<()> {
+        let bad = |message: String| Error::InvalidInput(format!("{origin}: {message}"));
+        let mut names: Vec<&str> = Vec::new();
+        for m in &self.materials {
+            if m.name.trim().is_empty() {
+                return Err(bad("a material has an empty name".into()));
+            }
+            if names.contains(&m.name.as_str()) {
+                return Err(bad(format!(
+                    "material '{}' is named twice; names must be unique",
+                    m.name
+                )));
+            }
+            names.push(&m.name);
+            let [lo, hi] = m.roughness.range();
+            for r in [lo, hi] {
+                if !(0.0..=1.0).contains(&r) {
+                    return Err(bad(format!(
+                        "material '{}': roughness {r} is outside [0, 1] (perceptual roughness, \
+                         alpha = r^2)",
+                        m.name
+                    )));
+                }
+            }
+            if lo > hi {
+                return Err(bad(format!(
+                    "material '{}': roughness range [{lo}, {hi}] is reversed; write [min, max]",
+                    m.name
+                )));
+            }
+            m.fresnel
+                .model()
+                .validate()
+                .map_err(|e| bad(format!("material '{}': {e}", m.name)))?;
+        }
+        if let Some(x) = self.output.as_ref().and_then(|o| o.max_error)
+            && !(crate::BakeOptions::MIN_MAX_ERROR..=0.5).contains(&x)
+        {
+            return Err(bad(format!(
+                "output.max_error must be between {:e} and 0.5 (got {x})",
+                crate::BakeOptions::MIN_MAX_ERROR
+            )));
+        }
+        Ok(())
+    }
+
+    /// The minimal set of tables the scene needs and the scalars of each material.
+    #[must_use]
+    pub fn plan(&self) -> Plan {
+        let mut tables: Vec<PlannedTable> = Vec::new();
+        for m in &self.materials {
+            let model = Model {
+                ndf: m.ndf,
+                masking: m.masking,
+            };
+            for quantity in [Quantity::E, Quantity::EAvg] {
+                match tables
+                    .iter_mut()
+                    .find(|t| t.model() == model && t.quantity == quantity)
+                {
+                    Some(t) => t.materials.push(m.name.clone()),
+                    None => tables.push(PlannedTable {
+                        ndf: m.ndf,
+                        masking: m.masking,
+                        quantity,
+                        materials: vec![m.name.clone()],
+                    }),
+                }
+            }
+        }
+        let materials = self
+            .materials
+            .iter()
+            .map(|m| {
+                let fresnel = m.fresnel.model();
+                PlannedMaterial {
+                    name: m.name.clone(),
+                    ndf: m.ndf,
+                    masking: m.masking,
+                    roughness: m.roughness.range(),
+                    fresnel: fresnel.name().to_string(),
+                    f_avg: fresnel.average(),
+                }
+            })
+            .collect();
+        Plan { tables, materials }
+    }
+}
+
+/// What a scene needs.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct Plan {
+    pub tables: Vec<PlannedTable>,
+    pub materials: Vec<PlannedMaterial>,
+}
+
+/// One table of the plan and the materials that need it.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct PlannedTable {
+    pub ndf: Ndf,
+    pub masking: Masking,
+    pub quantity: Quantity,
+    pub materials: Vec<String>,
+}
+
+impl PlannedTable {
+    #[must_use]
+    pub fn model(&self) -> Model {
+        Model {
+            ndf: self.ndf,
+            masking: self.masking,
+        }
+    }
+}
+
+/// A material's needs beyond the tables.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct PlannedMaterial {
+    pub name: String,
+    pub ndf: Ndf,
+    pub masking: Masking,
+    /// `[min, max]` perceptual roughness.
+    pub roughness: [f64; 2],
+    pub fresnel: String,
+    /// `F_avg` per channel, for the Kulla-Conty colour term
+    /// ([`crate::model::kulla_conty::fresnel_colour`]).
+    pub f_avg: Rgb,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const EXAMPLE: &str = r#"
+[output]
+dir = "tables"
+formats = ["exr", "rs", "json"]
+precision = "f16"
+
+[[material]]
+name = "brushed_steel"
+ndf = "ggx"
+masking = "height-correlated"
+roughness = [0.2, 0.6]
+fresnel = { conductor = { eta = [2.9, 2.9, 2.4], k = [3.0, 2.9, 2.5] } }
+
+[[material]]
+name = "varnish"
+ndf = "beckmann"
+roughness = 0.3
+fresnel = { dielectric = { ior = 1.5 } }
+
+[[material]]
+name = "plastic"
+ndf = "ggx"
+roughness = 0.5
+fresnel = { schlick = { f0 = 0.04 } }
+"#;
+
+    #[test]
+    fn the_issue_example_parses_and_plans() {
+        let scene = Scene::parse(EXAMPLE, "example.toml").unwrap();
+        assert_eq!(scene.materials.len(), 3);
+        let output = scene.output.as_ref().unwrap();
+        assert_eq!(output.precision, Some(Precision::F16));
+        let plan = scene.plan();
+        // GGX height-correlated (steel, plastic) and Beckmann height-correlated (varnish): E and
+        // E_avg each, merged.
+        assert_eq!(plan.tables.len(), 4);
+        let ggx_e = &plan.tables[0];
+        assert_eq!((ggx_e.ndf, ggx_e.quantity), (Ndf::Ggx, Quantity::E));
+        assert_eq!(ggx_e.materials, ["brushed_steel", "plastic"]);
+        assert_eq!(plan.tables[2].materials, ["varnish"]);
+        let varnish = &plan.materials[1];
+        assert!((varnish.f_avg[0] - 0.091_777_959_3).abs() < 1e-9);
+        assert_eq!(plan.materials[2].f_avg, [(20.0 * 0.04 + 1.0) / 21.0; 3]);
+        assert_eq!(plan.materials[0].roughness, [0.2, 0.6]);
+    }
+
+    #[test]
+    fn empty_and_duplicate_needs() {
+        let empty = Scene::parse("", "empty.toml").unwrap();
+        assert!(empty.plan().tables.is_empty() && empty.plan().materials.is_empty());
+        let twins = Scene::parse(
+            "[[material]]\nname = \"a\"\nndf = \"ggx\"\nroughness = 0.1\n\n\
+             [[material]]\nname = \"b\"\nndf = \"ggx\"\nroughness = [0.0, 1.0]\n",
+            "twins.toml",
+        )
+        .unwrap();
+        let plan = twins.plan();
+        assert_eq!(plan.tables.len(), 2);
+        assert_eq!(plan.tables[1].materials, ["a", "b"]);
+        assert_eq!(plan.materials[0].f_avg, [1.0; 3]);
+    }
+
+    #[test]
+    fn bad_scenes_say_where_and_what() {
+        let cases: [(&str, &str); 8] = [
+            (
+                "[[material]]\nname = \"a\"\nndf = \"ggx\"\nroughness = 0.1\ncolour = 1\n",
+                "colour",
+            ),
+            (
+                "[[material]]\nname = \"a\"\nndf = \"phong\"\nroughness = 0.1\n",
+                "phong",
+            ),
+            (
+                "[[material]]\nname = \"a\"\nndf = \"ggx\"\nroughness = 1.5\n",
+                "roughness 1.5",
+            ),
+            (
+                "[[material]]\nname = \"a\"\nndf = \"ggx\"\nroughness = 0.1\nfresnel = { dielectric = { ior = 0 } }\n",
+                "ior must be > 0",
+            ),
+            (
+                "[[material]]\nname = \"a\"\nndf = \"ggx\"\nroughness = [0.5, 0.2]\n",
+                "reversed",
+            ),
+            (
+                "[[material]]\nname = \"a\"\nndf = \"ggx\"\nroughness = 0.1\n[[material]]\nname = \"a\"\nndf = \"ggx\"\nroughness = 0.2\n",
+                "named twice",
+            ),
+            ("[output]\ndir = \"x\"\nprecison = \"f16\"\n", "precison"),
+            (
+                "[[material]]\nname = \"a\"\nndf = \"ggx\"\nroughness = 0.1\nfresnel = { metal = {} }\n",
+                "metal",
+            ),
+        ];
+        for (text, needle) in cases {
+            let error = Scene::parse(text, "bad.toml").unwrap_err().to_string();
+            assert!(error.contains(needle), "{needle}: {error}");
+            assert!(error.contains("bad.toml"), "{error}");
+        }
+        // Syntax errors carry the line and column.
+        let error = Scene::parse("[[material]\nname = 1\n", "syntax.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(error.contains("line 1"), "{error}");
+    }
+}
