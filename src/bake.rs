@@ -4,6 +4,7 @@
 //! the texel's coordinates, summed in a fixed order inside one thread. Rayon spreads texels over
 //! cores and collects them in index order, so a table is byte-identical for any thread count.
 
+use crate::cache::{Cache, CacheKey};
 use crate::error::{Error, Result};
 use crate::integrate::albedo::weighted_albedo;
 use crate::integrate::average_quadrature::{quadrature_average_albedo, rule_average_albedo};
@@ -311,11 +312,27 @@ impl BakeOptions {
     /// error is measured (whatever the method) and a table whose measured error exceeds the
     /// bound is an error, not a file.
     pub fn bake(&self, progress: &(dyn Fn(u64) + Sync)) -> Result<Vec<Table>> {
+        Ok(self.bake_cached(None, progress)?.tables)
+    }
+
+    /// As [`BakeOptions::bake`], taking each table from `cache` when it holds one with the same
+    /// key ([`CacheKey`]: everything that changes the table's bytes) and storing each table baked.
+    pub fn bake_cached(
+        &self,
+        cache: Option<&Cache>,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> Result<BakeReport> {
         self.validate()?;
         let options = self.resolved();
-        let mut tables = Vec::new();
+        let mut report = BakeReport::default();
         for spec in options.specs() {
             let command = self.command_for(spec.model);
+            let key = CacheKey::new(&spec, self.max_error, &command);
+            if let Some(table) = cache.and_then(|c| c.load(&key)) {
+                report.reused.push(table.spec.id());
+                report.tables.push(table);
+                continue;
+            }
             let mut table = bake_table(spec, command, progress);
             table.requested_max_error = self.max_error;
             if let Some(bound) = self.max_error {
@@ -338,9 +355,13 @@ impl BakeOptions {
                     table.spec.method.describe()
                 )));
             }
-            tables.push(table);
+            if let Some(cache) = cache {
+                cache.store(&key, &table)?;
+            }
+            report.baked.push(table.spec.id());
+            report.tables.push(table);
         }
-        Ok(tables)
+        Ok(report)
     }
 
     /// The integrand evaluations [`BakeOptions::bake`] will spend, for a progress bar.
@@ -352,6 +373,15 @@ impl BakeOptions {
             .map(|s| s.len() as u64 * s.qmc.samples)
             .sum()
     }
+}
+
+/// What [`BakeOptions::bake_cached`] produced: the tables in spec order, and which were baked
+/// (integrated) and which reused from the cache, by table id.
+#[derive(Clone, Debug, Default)]
+pub struct BakeReport {
+    pub tables: Vec<Table>,
+    pub baked: Vec<String>,
+    pub reused: Vec<String>,
 }
 
 /// The texels a bake at a requested max error checks against the reference: for `E`, the first

@@ -34,6 +34,7 @@
 //! samples at texel centres `(i + 0.5) / N` (default) or at nodes `i / (N - 1)`.
 
 pub mod bake;
+pub mod cache;
 pub mod error;
 pub mod format;
 pub mod integrate;

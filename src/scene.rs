@@ -257,6 +257,78 @@ impl Scene {
     }
 }
 
+/// What [`Scene::bake`] did.
+#[derive(Clone, Debug)]
+pub struct SceneBake {
+    /// The tables, baked or reused, with which were which.
+    pub report: crate::bake::BakeReport,
+    /// The files written.
+    pub written: Vec<std::path::PathBuf>,
+}
+
+impl Scene {
+    /// The directory the scene asks for (`output.dir`, default `tables`).
+    #[must_use]
+    pub fn output_dir(&self) -> std::path::PathBuf {
+        self.output
+            .as_ref()
+            .and_then(|o| o.dir.clone())
+            .unwrap_or_else(|| "tables".into())
+            .into()
+    }
+
+    /// The bake options of each NDF and masking combination in the plan, in plan order.
+    #[must_use]
+    pub fn bake_options(&self) -> Vec<crate::BakeOptions> {
+        let mut models: Vec<Model> = Vec::new();
+        for t in self.plan().tables {
+            if !models.contains(&t.model()) {
+                models.push(t.model());
+            }
+        }
+        let max_error = self
+            .output
+            .as_ref()
+            .and_then(|o| o.max_error)
+            .unwrap_or(crate::BakeOptions::DEFAULT_MAX_ERROR);
+        models
+            .into_iter()
+            .map(|model| crate::BakeOptions {
+                ndfs: vec![model.ndf],
+                maskings: vec![model.masking],
+                max_error: Some(max_error),
+                ..crate::BakeOptions::default()
+            })
+            .collect()
+    }
+
+    /// Bakes the plan into `dir` in the scene's formats and precision (default: every format,
+    /// f32), through the content-addressed cache in `dir/.kiln-cache` ([`crate::cache`]): a
+    /// table whose key is unchanged is reused without integration. For a build script: no
+    /// command-line dependencies.
+    pub fn bake(&self, dir: &Path, progress: &(dyn Fn(u64) + Sync)) -> Result<SceneBake> {
+        crate::format::check_output_dir(dir)?;
+        let cache = crate::cache::Cache::new(&dir.join(".kiln-cache"));
+        let mut report = crate::bake::BakeReport::default();
+        for options in self.bake_options() {
+            let part = options.bake_cached(Some(&cache), progress)?;
+            report.tables.extend(part.tables);
+            report.baked.extend(part.baked);
+            report.reused.extend(part.reused);
+        }
+        let output = self.output.clone().unwrap_or(Output {
+            dir: None,
+            formats: None,
+            precision: None,
+            max_error: None,
+        });
+        let formats = output.formats.unwrap_or_else(|| Format::ALL.to_vec());
+        let precision = output.precision.unwrap_or(Precision::F32);
+        let written = crate::format::write_tables(dir, &report.tables, &formats, precision)?;
+        Ok(SceneBake { report, written })
+    }
+}
+
 /// What a scene needs.
 #[derive(Clone, Debug, Serialize, PartialEq)]
 pub struct Plan {

@@ -276,7 +276,7 @@ impl TableSpec {
 }
 
 /// A baked table: its spec, per-texel values and standard errors, and where it came from.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Table {
     pub spec: TableSpec,
     /// The quantity's value per texel, row-major with the slowest axis first.

@@ -59,8 +59,18 @@ pub struct BakeArgs {
     #[arg(long, default_value_t = 0)]
     seed: u64,
     /// Output directory, created if missing.
-    #[arg(long, default_value = "tables")]
-    out: PathBuf,
+    /// [default: tables, or the scene's output.dir]
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Bake what a scene file's materials need (see `kiln plan`), reusing unchanged tables from
+    /// the cache in OUT/.kiln-cache; the scene's [output] sets formats, precision and max_error.
+    #[arg(
+        long,
+        conflicts_with_all = ["ndf", "masking", "quantity", "size", "samples", "avg_samples",
+            "scrambles", "seed", "format", "precision", "roughness_axis", "mu_axis", "grid",
+            "method", "no_reference_check", "max_error"]
+    )]
+    scene: Option<PathBuf>,
     /// Output formats, comma-separated.
     #[arg(
         long,
@@ -110,6 +120,10 @@ pub struct BakeArgs {
 }
 
 pub fn run(args: BakeArgs) -> kiln::Result<()> {
+    if let Some(path) = &args.scene {
+        return bake_scene(path, args.out.as_deref(), args.quiet);
+    }
+    let out = args.out.clone().unwrap_or_else(|| PathBuf::from("tables"));
     // Naming a method or a sample count asks for that method; otherwise a max error decides.
     let explicit_method = args.method.is_some()
         || args.samples.is_some()
@@ -142,14 +156,14 @@ pub fn run(args: BakeArgs) -> kiln::Result<()> {
     formats.sort();
     formats.dedup();
     // Fail on an unusable output directory now, not after minutes of integration.
-    format::check_output_dir(&args.out)?;
+    format::check_output_dir(&out)?;
 
     let bar = crate::progress_bar(args.quiet, options.total_samples(), "integrating");
     let start = Instant::now();
     let tables = options.bake(&|samples| bar.inc(samples))?;
     bar.finish_and_clear();
     let seconds = start.elapsed().as_secs_f64();
-    let written = format::write_tables(&args.out, &tables, &formats, args.precision)?;
+    let written = format::write_tables(&out, &tables, &formats, args.precision)?;
     if !args.quiet {
         for table in &tables {
             let shape: Vec<String> = table.spec.shape().iter().map(|n| n.to_string()).collect();
@@ -171,7 +185,45 @@ pub fn run(args: BakeArgs) -> kiln::Result<()> {
             "baked {} tables in {seconds:.1} s; wrote {} files to {}",
             tables.len(),
             written.len(),
-            args.out.display()
+            out.display()
+        );
+    }
+    Ok(())
+}
+
+/// `kiln bake --scene FILE`.
+fn bake_scene(
+    path: &std::path::Path,
+    out: Option<&std::path::Path>,
+    quiet: bool,
+) -> kiln::Result<()> {
+    let scene = kiln::scene::Scene::read(path)?;
+    let dir = out.map_or_else(|| scene.output_dir(), std::path::Path::to_path_buf);
+    let total: u64 = scene
+        .bake_options()
+        .iter()
+        .map(BakeOptions::total_samples)
+        .sum();
+    let bar = crate::progress_bar(quiet, total, "integrating");
+    let start = Instant::now();
+    let result = scene.bake(&dir, &|samples| bar.inc(samples))?;
+    bar.finish_and_clear();
+    if !quiet {
+        let list = |ids: &[String]| {
+            if ids.is_empty() {
+                "none".to_string()
+            } else {
+                ids.join(", ")
+            }
+        };
+        println!("reused from the cache: {}", list(&result.report.reused));
+        println!("baked: {}", list(&result.report.baked));
+        println!(
+            "{} tables in {:.1} s; wrote {} files to {}",
+            result.report.tables.len(),
+            start.elapsed().as_secs_f64(),
+            result.written.len(),
+            dir.display()
         );
     }
     Ok(())

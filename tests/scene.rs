@@ -1,0 +1,78 @@
+//! `kiln bake --scene` through the library: the content-addressed cache reuses unchanged tables
+//! (checked through the bake report, not a timer) and rebakes only what a change touches.
+
+use kiln::scene::Scene;
+
+fn scene(materials: &str) -> Scene {
+    let text = format!("[output]\nformats = [\"json\", \"bin\"]\nmax_error = 1e-4\n\n{materials}");
+    Scene::parse(&text, "test.toml").unwrap()
+}
+
+const STEEL: &str = "[[material]]\nname = \"steel\"\nndf = \"ggx\"\nroughness = 0.4\n";
+const COAT: &str =
+    "[[material]]\nname = \"coat\"\nndf = \"ggx\"\nmasking = \"separable\"\nroughness = 0.1\n";
+
+#[test]
+fn second_bake_reuses_and_a_change_rebakes_only_its_tables() {
+    let dir = tempfile::tempdir().unwrap();
+    let first = scene(STEEL).bake(dir.path(), &|_| {}).unwrap();
+    assert_eq!(
+        first.report.baked,
+        ["ggx-height-correlated-E", "ggx-height-correlated-E_avg"]
+    );
+    assert!(first.report.reused.is_empty());
+    let bytes: Vec<Vec<u8>> = first
+        .written
+        .iter()
+        .map(|p| std::fs::read(p).unwrap())
+        .collect();
+
+    // Unchanged: nothing integrated (the progress callback never runs), identical files.
+    let calls = std::sync::atomic::AtomicU64::new(0);
+    let second = scene(STEEL)
+        .bake(dir.path(), &|_| {
+            calls.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        })
+        .unwrap();
+    assert!(second.report.baked.is_empty());
+    assert_eq!(second.report.reused, first.report.baked);
+    assert_eq!(calls.load(std::sync::atomic::Ordering::Relaxed), 0);
+    assert!(
+        second.report.tables == first.report.tables,
+        "reused tables differ"
+    );
+    for (path, before) in second.written.iter().zip(&bytes) {
+        assert_eq!(&std::fs::read(path).unwrap(), before, "{}", path.display());
+    }
+
+    // A new material with another masking: only its tables are baked.
+    let third = scene(&format!("{STEEL}\n{COAT}"))
+        .bake(dir.path(), &|_| {})
+        .unwrap();
+    assert_eq!(third.report.reused, first.report.baked);
+    assert_eq!(
+        third.report.baked,
+        ["ggx-separable-E", "ggx-separable-E_avg"]
+    );
+
+    // A different max error changes every key.
+    let text = format!("[output]\nformats = [\"json\"]\nmax_error = 1e-5\n\n{STEEL}");
+    let tighter = Scene::parse(&text, "t.toml")
+        .unwrap()
+        .bake(dir.path(), &|_| {})
+        .unwrap();
+    assert_eq!(tighter.report.baked.len(), 2);
+    assert!(tighter.report.reused.is_empty());
+}
+
+/// A corrupt cache entry is a miss, never an error or a wrong table.
+#[test]
+fn a_damaged_cache_entry_is_rebaked() {
+    let dir = tempfile::tempdir().unwrap();
+    scene(STEEL).bake(dir.path(), &|_| {}).unwrap();
+    for entry in std::fs::read_dir(dir.path().join(".kiln-cache")).unwrap() {
+        std::fs::write(entry.unwrap().path(), b"{ not json").unwrap();
+    }
+    let again = scene(STEEL).bake(dir.path(), &|_| {}).unwrap();
+    assert_eq!(again.report.baked.len(), 2);
+}
