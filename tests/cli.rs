@@ -366,6 +366,46 @@ fn plan_lists_each_needed_table_once() {
     assert!(stderr(&bad).contains("roughness -0.1"), "{}", stderr(&bad));
 }
 
+/// `kiln bake --scene`: says what it baked, then that it reused everything.
+#[test]
+fn scene_bake_reports_reuse() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("scene.toml");
+    std::fs::write(
+        &scene,
+        "[output]\nformats = [\"json\"]\nmax_error = 1e-4\n\n[[material]]\nname = \"a\"\n\
+         ndf = \"ggx\"\nroughness = 0.3\n",
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let bake = || {
+        let output = kiln(&[
+            "bake",
+            "--scene",
+            scene.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(output.status.success(), "{}", stderr(&output));
+        String::from_utf8(output.stdout).unwrap()
+    };
+    let first = bake();
+    assert!(first.contains("reused from the cache: none"), "{first}");
+    assert!(first.contains("baked: ggx-height-correlated-E, ggx-height-correlated-E_avg"));
+    let second = bake();
+    assert!(second.contains("baked: none"), "{second}");
+    assert_eq!(
+        files_in(&out),
+        [
+            "ggx-height-correlated-E.json",
+            "ggx-height-correlated-E_avg.json"
+        ]
+    );
+    // A scene flag with a table flag is a usage error.
+    let output = kiln(&["bake", "--scene", scene.to_str().unwrap(), "--size", "8"]);
+    assert_eq!(output.status.code(), Some(2));
+}
+
 #[test]
 fn outputs_agree_with_each_other_and_round_trip() {
     let dir = tempfile::tempdir().unwrap();
