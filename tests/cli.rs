@@ -397,6 +397,7 @@ fn scene_bake_reports_reuse() {
     assert_eq!(
         files_in(&out),
         [
+            ".kiln-cache",
             "ggx-height-correlated-E.json",
             "ggx-height-correlated-E_avg.json"
         ]
