@@ -11,7 +11,7 @@ use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use kiln::bake::confirmation_settings;
 use kiln::integrate::reference::{ReferenceSettings, reference_albedo};
 use kiln::study::yardstick::cycles_style_table;
-use kiln::verify::{node_errors_at, spread_indices};
+use kiln::verify::node_errors_at;
 use kiln::{BakeOptions, Masking, Model, Ndf, QmcSettings, Table, bake_table};
 use rayon::prelude::*;
 use std::hint::black_box;
@@ -36,7 +36,7 @@ fn full_check(tables: &[Table], max_error: f64) -> f64 {
     tables
         .iter()
         .map(|t| {
-            let all = spread_indices(t.spec.len(), t.spec.len());
+            let all: Vec<usize> = (0..t.spec.len()).collect();
             node_errors_at(t, &all, &confirmation_settings(max_error, &t.spec)).max
         })
         .fold(0.0, f64::max)

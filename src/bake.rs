@@ -7,13 +7,15 @@
 use crate::cache::{Cache, CacheKey};
 use crate::error::{Error, Result};
 use crate::integrate::albedo::weighted_albedo;
-use crate::integrate::average_quadrature::{quadrature_average_albedo, rule_average_albedo};
-use crate::integrate::reference::{ReferenceSettings, reference_albedo};
+use crate::integrate::average_quadrature::rule_average_albedo;
+use crate::integrate::reference::ReferenceSettings;
 use crate::integrate::{Estimate, QmcSettings, albedo, average_albedo};
 use crate::model::{Masking, Model, Ndf, RoughnessConvention};
 use crate::table::axis::{Axis, Grid, MuMapping};
 use crate::table::{Method, Quantity, Table, TableSpec};
-use crate::verify::{MAX_AVERAGE_ENTRIES_CHECKED, node_errors, node_errors_at, spread_indices};
+use crate::verify::{
+    MAX_AVERAGE_ENTRIES_CHECKED, node_errors, node_errors_at, reference_value, spread_indices,
+};
 use rayon::prelude::*;
 
 /// What `kiln bake` bakes: for each model, an `E` table and an `E_avg` table.
@@ -454,15 +456,11 @@ pub fn estimate_texel(spec: &TableSpec, index: usize) -> Estimate {
         Method::Reference => {
             let settings = spec.reference_settings();
             let r = match (mu, spec.average_rule_order()) {
-                (Some(mu), _) if spec.quantity.weight().is_some() => {
-                    crate::verify::reference_value(spec, alpha, Some(mu), &settings)
-                }
-                (Some(mu), _) => reference_albedo(spec.model, alpha, mu, &settings),
-                // A fixed rule whose measured error is a tenth of the tolerance.
+                // A fixed rule whose measured error bound is within the tolerance.
                 (None, Some(order)) => rule_average_albedo(spec.model, alpha, order, &settings),
-                // The composite rule in smooth variables: within 1e-10 of the nested reference
-                // (tested) at a fraction of its cost.
-                (None, None) => quadrature_average_albedo(spec.model, alpha, &settings),
+                // What the audit compares with, at the spec's tolerance: `E` and the split-sum
+                // channels by the reference, `E_avg` by the composite rule in smooth variables.
+                _ => reference_value(spec, alpha, mu, &settings),
             };
             Estimate {
                 value: r.value,

@@ -46,7 +46,7 @@ pub struct Scene {
 }
 
 /// Where and how to write the tables.
-#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Default, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct Output {
     pub dir: Option<String>,
@@ -67,6 +67,17 @@ pub struct Material {
     pub roughness: Roughness,
     #[serde(default)]
     pub fresnel: FresnelSpec,
+}
+
+impl Material {
+    /// The NDF and masking the material is evaluated with.
+    #[must_use]
+    pub fn model(&self) -> Model {
+        Model {
+            ndf: self.ndf,
+            masking: self.masking,
+        }
+    }
 }
 
 fn default_masking() -> Masking {
@@ -214,30 +225,39 @@ impl Scene {
         Ok(())
     }
 
+    /// The NDF and masking combinations in use, in order of first appearance.
+    #[must_use]
+    pub fn models(&self) -> Vec<Model> {
+        let mut models: Vec<Model> = Vec::new();
+        for m in &self.materials {
+            let model = m.model();
+            if !models.contains(&model) {
+                models.push(model);
+            }
+        }
+        models
+    }
+
     /// The minimal set of tables the scene needs and the scalars of each material.
     #[must_use]
     pub fn plan(&self) -> Plan {
-        let mut tables: Vec<PlannedTable> = Vec::new();
-        for m in &self.materials {
-            let model = Model {
-                ndf: m.ndf,
-                masking: m.masking,
-            };
-            for quantity in [Quantity::E, Quantity::EAvg] {
-                match tables
-                    .iter_mut()
-                    .find(|t| t.model() == model && t.quantity == quantity)
-                {
-                    Some(t) => t.materials.push(m.name.clone()),
-                    None => tables.push(PlannedTable {
-                        ndf: m.ndf,
-                        masking: m.masking,
-                        quantity,
-                        materials: vec![m.name.clone()],
-                    }),
-                }
-            }
-        }
+        let tables = self
+            .models()
+            .into_iter()
+            .flat_map(|model| {
+                [Quantity::E, Quantity::EAvg].map(|quantity| PlannedTable {
+                    ndf: model.ndf,
+                    masking: model.masking,
+                    quantity,
+                    materials: self
+                        .materials
+                        .iter()
+                        .filter(|m| m.model() == model)
+                        .map(|m| m.name.clone())
+                        .collect(),
+                })
+            })
+            .collect();
         let materials = self
             .materials
             .iter()
@@ -280,18 +300,12 @@ impl Scene {
     /// The bake options of each NDF and masking combination in the plan, in plan order.
     #[must_use]
     pub fn bake_options(&self) -> Vec<crate::BakeOptions> {
-        let mut models: Vec<Model> = Vec::new();
-        for t in self.plan().tables {
-            if !models.contains(&t.model()) {
-                models.push(t.model());
-            }
-        }
         let max_error = self
             .output
             .as_ref()
             .and_then(|o| o.max_error)
             .unwrap_or(crate::BakeOptions::DEFAULT_MAX_ERROR);
-        models
+        self.models()
             .into_iter()
             .map(|model| crate::BakeOptions {
                 ndfs: vec![model.ndf],
@@ -316,12 +330,7 @@ impl Scene {
             report.baked.extend(part.baked);
             report.reused.extend(part.reused);
         }
-        let output = self.output.clone().unwrap_or(Output {
-            dir: None,
-            formats: None,
-            precision: None,
-            max_error: None,
-        });
+        let output = self.output.clone().unwrap_or_default();
         let formats = output.formats.unwrap_or_else(|| Format::ALL.to_vec());
         let precision = output.precision.unwrap_or(Precision::F32);
         let written = crate::format::write_tables(dir, &report.tables, &formats, precision)?;

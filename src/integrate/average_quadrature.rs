@@ -62,6 +62,31 @@ impl Split {
     }
 }
 
+/// The inner `E(mu)` evaluations of an `E_avg` rule, tallied.
+struct Counted {
+    evaluations: u64,
+    converged: bool,
+}
+
+impl Default for Counted {
+    fn default() -> Self {
+        Self {
+            evaluations: 0,
+            converged: true,
+        }
+    }
+}
+
+impl Counted {
+    /// `[E, 1 - E]` at `mu` by [`reference_albedo`], counted.
+    fn albedo(&mut self, model: Model, alpha: f64, mu: f64, inner: &ReferenceSettings) -> [f64; 2] {
+        let r = reference_albedo(model, alpha, mu, inner);
+        self.evaluations += r.evaluations;
+        self.converged &= r.converged;
+        [r.value, r.one_minus_value]
+    }
+}
+
 /// `E_avg` and `1 - E_avg` (see the module docs), with the rule's error estimate plus the inner
 /// tolerance, and the `E` evaluations' integrand count.
 #[must_use]
@@ -76,14 +101,8 @@ pub fn quadrature_average_albedo(
     }
     // The weights integrate to 1, so the inner errors add at most their tolerance.
     let inner = *settings;
-    let mut evaluations = 0;
-    let mut converged = true;
-    let mut albedo = |mu: f64| {
-        let r = reference_albedo(model, alpha, mu, &inner);
-        evaluations += r.evaluations;
-        converged &= r.converged;
-        [r.value, r.one_minus_value]
-    };
+    let mut counted = Counted::default();
+    let mut albedo = |mu: f64| counted.albedo(model, alpha, mu, &inner);
     let split = Split::new(alpha);
     let panels = |a: f64, b: f64| -> Vec<f64> {
         (0..=PANELS)
@@ -115,8 +134,8 @@ pub fn quadrature_average_albedo(
         value: parts.iter().map(|q| q.value[0]).sum(),
         one_minus_value: parts.iter().map(|q| q.value[1]).sum(),
         error: parts.iter().map(|q| q.error).sum::<f64>() + inner.tolerance,
-        evaluations,
-        converged: converged && parts.iter().all(|q| q.converged),
+        evaluations: counted.evaluations,
+        converged: counted.converged && parts.iter().all(|q| q.converged),
     }
 }
 
@@ -179,14 +198,8 @@ pub fn rule_average_albedo(
         return MIRROR;
     }
     let rule = gauss_legendre::rule(order);
-    let mut evaluations = 0;
-    let mut converged = true;
-    let mut albedo = |mu: f64| {
-        let r = reference_albedo(model, alpha, mu, inner);
-        evaluations += r.evaluations;
-        converged &= r.converged;
-        [r.value, r.one_minus_value]
-    };
+    let mut counted = Counted::default();
+    let mut albedo = |mu: f64| counted.albedo(model, alpha, mu, inner);
     let split = Split::new(alpha);
     let mut total: [f64; 2] = gauss_legendre::integrate(
         &rule,
@@ -218,8 +231,8 @@ pub fn rule_average_albedo(
         value: 1.0 - total[1],
         one_minus_value: total[1],
         error: inner.tolerance + bound,
-        evaluations,
-        converged,
+        evaluations: counted.evaluations,
+        converged: counted.converged,
     }
 }
 

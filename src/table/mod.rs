@@ -183,15 +183,16 @@ impl TableSpec {
     /// rule.
     #[must_use]
     pub fn average_rule_order(&self) -> Option<usize> {
-        (self.method == Method::Reference && self.quantity == Quantity::EAvg)
-            .then_some(self.reference_digits)
-            .flatten()
-            .and_then(|_| {
-                crate::integrate::average_quadrature::rule_order_for(
-                    self.model.ndf,
-                    self.reference_settings().tolerance,
-                )
-            })
+        if self.method != Method::Reference
+            || self.quantity != Quantity::EAvg
+            || self.reference_digits.is_none()
+        {
+            return None;
+        }
+        crate::integrate::average_quadrature::rule_order_for(
+            self.model.ndf,
+            self.reference_settings().tolerance,
+        )
     }
 
     /// The axes, slowest-varying first: `[roughness, mu]` or `[roughness]`.
