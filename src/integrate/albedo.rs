@@ -79,6 +79,8 @@ impl Default for QmcSettings {
 const TAG_E: u64 = 0x45;
 const TAG_E_AVG: u64 = 0x4541;
 const TAG_WEIGHTED: u64 = 0x4548;
+pub(crate) const TAG_DIELECTRIC: u64 = 0x4544;
+pub(crate) const TAG_DIELECTRIC_AVG: u64 = 0x454441;
 
 /// `E(mu)` for the model at `alpha` (slope-space roughness), `mu = cos(theta_o)` in [0, 1].
 ///
@@ -233,17 +235,17 @@ pub fn average_albedo(model: Model, alpha: f64, settings: &QmcSettings) -> Estim
     })
 }
 
-fn model_key(model: Model) -> u64 {
+pub(crate) fn model_key(model: Model) -> u64 {
     (model.ndf as u64) << 8 | model.masking as u64
 }
 
 /// `sqrt(1 - mu^2)` computed as `sqrt((1 - mu)(1 + mu))`, accurate near `mu = 1`.
-fn sin_from_cos(mu: f64) -> f64 {
+pub(crate) fn sin_from_cos(mu: f64) -> f64 {
     ((1.0 - mu) * (1.0 + mu)).max(0.0).sqrt()
 }
 
 /// Runs the scrambles and combines their means of `1 - w`.
-fn replicates(
+pub(crate) fn replicates(
     settings: &QmcSettings,
     key: &[u64],
     mut sum_loss: impl FnMut(&OwenSobol, u32) -> f64,
@@ -278,7 +280,7 @@ const BATCH: usize = 256;
 /// leave the closure as a call inside the AVX2 loop, which then stops vectorising (measured: the
 /// GGX `E_avg` kernel ran 3x slower once an unrelated module was added to the crate).
 #[inline(always)]
-fn sum_over_block<const D: usize>(
+pub(crate) fn sum_over_block<const D: usize>(
     seq: &OwenSobol,
     log2_n: u32,
     loss: impl Fn([f64; D]) -> f64,

@@ -2,6 +2,7 @@
 
 pub mod albedo;
 pub mod average_quadrature;
+pub mod dielectric;
 pub mod estimate;
 pub mod gauss_kronrod;
 pub mod gauss_legendre;

@@ -235,15 +235,8 @@ fn albedo_quadrature<N: MicrofacetDistribution>(
     });
     // G1(o) / mu, finite at mu = 0.
     let inverse_area = 1.0 / ndf.projected_area(mu);
-    // The x range the tolerance needs. Below x the projected normals hold about exp(2 x) of
-    // the mass (tan^2 / alpha^2 near the peak's foot), above it GGX's tail holds about
-    // 2 alpha exp(-x) (Beckmann far less): cut where each is a hundredth of the tolerance, within
-    // the hard limits. At loose tolerances this spares the adaptive rule most of its splits
-    // (a 1e-6 table costs 40 % less); at 1e-11 the range is [-15, 30].
-    let x_min = (0.5 * (settings.tolerance * 0.01).ln()).max(X_MIN);
-    let x_max = (100.0 * alpha.max(1.0) / settings.tolerance)
-        .ln()
-        .min(X_MAX);
+    // The x range the tolerance needs ([`x_range`]).
+    let (x_min, x_max) = x_range(alpha, settings.tolerance);
     let x_of_tan = |tan: f64| (tan / alpha).ln().clamp(x_min, x_max);
 
     // The integrand at (x, phi): [E part, 1 - E part] per unit x, before the phi integral.
@@ -307,26 +300,11 @@ fn albedo_quadrature<N: MicrofacetDistribution>(
         all_converged &= a.converged && b.converged;
         [a.value[0], a.value[1] + b.value[1], a.error + b.error]
     };
-    // Near phi = pi / 2 both curves swing across the whole x range within |cos(phi)| ~ mu / so
-    // (the edge of visibility runs off to theta = pi/2 on one side; the horizon curve drops from
-    // near pi/2 to near mu/2). At grazing views that is a layer far narrower than the first
-    // intervals, which an error estimate can miss: break the phi range at a geometric ladder of
-    // distances from pi / 2, from mu / so up to 0.3, so every scale has intervals of its own.
-    let mut phi_breaks = vec![0.0, PI / 2.0, PI];
-    if so > 0.0 && mu > 0.0 {
-        let mut delta = mu / so;
-        while delta < 0.3 {
-            if delta > 1e-15 {
-                phi_breaks.push((-delta).acos());
-                phi_breaks.push(delta.acos());
-            }
-            delta *= 8.0;
-        }
-    }
-    phi_breaks.sort_by(f64::total_cmp);
+    // The azimuth breaks ([`phi_breaks`]) give the grazing layer near phi = pi / 2 its own
+    // intervals.
     let outer = integrate_pieces(
         &mut over_phi,
-        &phi_breaks,
+        &phi_breaks(mu, so),
         settings.tolerance / 4.0,
         settings.max_intervals,
     );
@@ -336,6 +314,40 @@ fn albedo_quadrature<N: MicrofacetDistribution>(
         evaluations: evaluations + outer.evaluations,
         converged: all_converged && outer.converged,
     }
+}
+
+/// The `x = ln(tan(theta_m) / alpha)` range a tolerance needs. Below `x` the projected normals
+/// hold about `exp(2 x)` of the mass (`tan^2 / alpha^2` near the peak's foot), above it GGX's tail
+/// holds about `2 alpha exp(-x)` (Beckmann far less): cut where each is a hundredth of the
+/// tolerance, within the hard limits. At loose tolerances this spares the adaptive rule most of
+/// its splits (a 1e-6 table costs 40 % less); at 1e-11 the range is [-15, 30].
+pub(crate) fn x_range(alpha: f64, tolerance: f64) -> (f64, f64) {
+    let x_min = (0.5 * (tolerance * 0.01).ln()).max(X_MIN);
+    let x_max = (100.0 * alpha.max(1.0) / tolerance).ln().min(X_MAX);
+    (x_min, x_max)
+}
+
+/// Breaks of the azimuth range `[0, pi]` for a view `(so, 0, mu)`. Near `phi = pi / 2` the
+/// horizon curves and the edge of visibility swing across the whole `x` range within
+/// `|cos(phi)| ~ mu / so` (the edge of visibility runs off to `theta = pi / 2` on one side; the
+/// horizon curve drops from near `pi / 2` to near `mu / 2`). At grazing views that is a layer far
+/// narrower than the first intervals, which an error estimate can miss: break the range at a
+/// geometric ladder of distances from `pi / 2`, from `mu / so` up to 0.3, so every scale has
+/// intervals of its own.
+pub(crate) fn phi_breaks(mu: f64, so: f64) -> Vec<f64> {
+    let mut breaks = vec![0.0, PI / 2.0, PI];
+    if so > 0.0 && mu > 0.0 {
+        let mut delta = mu / so;
+        while delta < 0.3 {
+            if delta > 1e-15 {
+                breaks.push((-delta).acos());
+                breaks.push(delta.acos());
+            }
+            delta *= 8.0;
+        }
+    }
+    breaks.sort_by(f64::total_cmp);
+    breaks
 }
 
 #[cfg(test)]

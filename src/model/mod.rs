@@ -3,6 +3,7 @@
 //! The reflection BRDF (`physics.md`) is `f(o, i) = F(o.h) D(h) G2(o, i) / (4 |n.i| |n.o|)`;
 //! the tables here are for `F = 1`.
 
+pub mod dielectric;
 pub mod fresnel;
 pub mod kulla_conty;
 pub mod masking;

@@ -268,6 +268,7 @@ fn fresnel_weighted(
     mu: f64,
 ) -> kiln::Result<()> {
     use kiln::integrate::albedo::weighted_albedo;
+    use kiln::integrate::dielectric::reference_dielectric_albedo;
     use kiln::integrate::reference::reference_weighted_albedo;
     let start = Instant::now();
     let channel = |j: usize| move |c: f64| fresnel.reflectance(c)[j];
@@ -287,6 +288,19 @@ fn fresnel_weighted(
             }
             Method::Reference => {
                 args.no_samples_for_reference()?;
+                if let Fresnel::Dielectric { eta } = fresnel {
+                    // The dielectric quadrature splits at the critical angle, where F has a
+                    // square-root kink that misleads the generic rule's error estimate.
+                    let r = reference_dielectric_albedo(
+                        model,
+                        alpha,
+                        mu,
+                        eta,
+                        &ReferenceSettings::default(),
+                    );
+                    channels.push((r.reflection, r.error, r.evaluations, r.converged));
+                    continue;
+                }
                 let r = reference_weighted_albedo(
                     model,
                     alpha,

@@ -1,0 +1,430 @@
+//! The energy albedo of a rough dielectric interface, reflection plus transmission
+//! ([`crate::model::dielectric`] for the model and its convention), by QMC and by the
+//! deterministic reference.
+//!
+//! `E_eta(mu) = R + T`: the fraction of the power arriving along a direction with
+//! `cos(theta) = mu` that a single scattering event at the interface of relative index `eta`
+//! (`n_other / n_view`) sends on, by reflection or by refraction. `E_avg,eta = 2 ∫ E_eta(mu) mu dmu`.
+//!
+//! QMC: visible-normal sampling as for `E` ([`super::albedo`]), each sample scoring both branches
+//! (no Russian roulette between them, so no variance from the choice); `1 - E` is accumulated.
+//!
+//! Reference: the parametrisation of [`super::reference`] (`phi in [0, pi]`, `x = ln(tan(theta_m)
+//! / alpha)`), integrating `[R, T, 1 - E]` together. Each `x` integral is split where the integrand
+//! has a kink: the peak (`x = 0`), the reflected direction's horizon (closed form), the critical
+//! angle of total internal reflection (`o.m = sqrt(1 - eta^2)` for `eta < 1`, closed form: `o.m =
+//! rho cos(theta - delta)` along the `phi` slice), the refracted direction's horizon (found by
+//! bisection between sign changes on a scan) and the edge of visibility.
+//!
+//! Limits: `alpha = 0` with `mu > 0` is the smooth interface, `R = F(mu)`, `T = 1 - F(mu)`,
+//! `E = 1` exactly. Unlike `E`, `E_eta(0)` is not 1 in general (for `eta < 1` refracted directions
+//! of a grazing view go up and are lost), so `mu = 0` is integrated like any other point. Between
+//! 0 and
+//! [`SMOOTH_ALPHA`] the interface is evaluated at `SMOOTH_ALPHA` (the boundary layer `mu ~ alpha`
+//! then lies below `mu = 1e-6`; the similarity [`crate::model::smooth_point`] uses for `E` does not
+//! hold once `F` depends on `mu`).
+
+use super::albedo::{
+    QmcSettings, TAG_DIELECTRIC, TAG_DIELECTRIC_AVG, model_key, replicates, sin_from_cos,
+    sum_over_block,
+};
+use super::estimate::Estimate;
+use super::gauss_kronrod::integrate_pieces;
+use super::reference::{ReferenceSettings, ReferenceValue, phi_breaks, x_range};
+use crate::model::dielectric::{refract, scattering};
+use crate::model::fresnel::dielectric;
+use crate::model::{
+    Beckmann, Ggx, Masking, MicrofacetDistribution, Model, Ndf, SMOOTH_ALPHA, Vec3,
+};
+use serde::Serialize;
+use std::f64::consts::PI;
+
+fn check(alpha: f64, mu: f64, eta: f64) {
+    assert!((0.0..=1.0).contains(&mu) && alpha >= 0.0 && alpha.is_finite());
+    assert!(
+        eta > 0.0 && eta.is_finite(),
+        "eta must be positive (got {eta})"
+    );
+}
+
+/// `E_eta(mu)` by QMC for the model at `alpha` (slope-space), `eta = n_other / n_view`.
+///
+/// # Panics
+/// If the settings are invalid or an argument is out of range; callers validate input first.
+#[must_use]
+pub fn dielectric_albedo(
+    model: Model,
+    alpha: f64,
+    mu: f64,
+    eta: f64,
+    settings: &QmcSettings,
+) -> Estimate {
+    check(alpha, mu, eta);
+    if alpha == 0.0 && mu > 0.0 {
+        return Estimate::exact(0.0);
+    }
+    let alpha = alpha.max(SMOOTH_ALPHA);
+    let key = [
+        TAG_DIELECTRIC,
+        model_key(model),
+        alpha.to_bits(),
+        mu.to_bits(),
+        eta.to_bits(),
+    ];
+    fn kernel<N: MicrofacetDistribution>(
+        ndf: N,
+        masking: Masking,
+        mu: f64,
+        eta: f64,
+        settings: &QmcSettings,
+        key: &[u64],
+    ) -> Estimate {
+        let o = Vec3::new(sin_from_cos(mu), 0.0, mu);
+        let lambda_o = ndf.lambda(o);
+        replicates(settings, key, |seq, log2_n| {
+            sum_over_block(
+                seq,
+                log2_n,
+                #[inline(always)]
+                |u: [f64; 2]| {
+                    let m = ndf.sample_visible_normal(o, u);
+                    scattering(ndf, masking, o, lambda_o, m, eta).loss
+                },
+            )
+        })
+    }
+    match model.ndf {
+        Ndf::Ggx => kernel(Ggx { alpha }, model.masking, mu, eta, settings, &key),
+        Ndf::Beckmann => kernel(Beckmann { alpha }, model.masking, mu, eta, settings, &key),
+    }
+}
+
+/// `E_avg,eta = 2 ∫ E_eta(mu) mu dmu` by QMC, with `s = mu^2` as a third dimension.
+///
+/// # Panics
+/// As [`dielectric_albedo`].
+#[must_use]
+pub fn dielectric_average_albedo(
+    model: Model,
+    alpha: f64,
+    eta: f64,
+    settings: &QmcSettings,
+) -> Estimate {
+    check(alpha, 0.5, eta);
+    if alpha == 0.0 {
+        return Estimate::exact(0.0);
+    }
+    let alpha = alpha.max(SMOOTH_ALPHA);
+    let key = [
+        TAG_DIELECTRIC_AVG,
+        model_key(model),
+        alpha.to_bits(),
+        eta.to_bits(),
+    ];
+    fn kernel<N: MicrofacetDistribution>(
+        ndf: N,
+        masking: Masking,
+        eta: f64,
+        settings: &QmcSettings,
+        key: &[u64],
+    ) -> Estimate {
+        replicates(settings, key, |seq, log2_n| {
+            sum_over_block(
+                seq,
+                log2_n,
+                #[inline(always)]
+                |[u0, u1, s]: [f64; 3]| {
+                    let o = Vec3::new((1.0 - s).sqrt(), 0.0, s.sqrt());
+                    let m = ndf.sample_visible_normal(o, [u0, u1]);
+                    scattering(ndf, masking, o, ndf.lambda(o), m, eta).loss
+                },
+            )
+        })
+    }
+    match model.ndf {
+        Ndf::Ggx => kernel(Ggx { alpha }, model.masking, eta, settings, &key),
+        Ndf::Beckmann => kernel(Beckmann { alpha }, model.masking, eta, settings, &key),
+    }
+}
+
+/// A reference value of the dielectric energy albedo, its two parts and the energy lost.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct DielectricReference {
+    /// The reflected part `R`.
+    pub reflection: f64,
+    /// The transmitted part `T` (energy; the radiance albedo's is `T / eta^2`).
+    pub transmission: f64,
+    /// `1 - R - T`, integrated directly.
+    pub one_minus_value: f64,
+    /// The quadrature's error estimate (absolute), for any of them.
+    pub error: f64,
+    /// Integrand evaluations spent.
+    pub evaluations: u64,
+    /// Whether every adaptive integral met its tolerance within its budget.
+    pub converged: bool,
+}
+
+impl DielectricReference {
+    /// `E = R + T`.
+    #[must_use]
+    pub fn value(&self) -> f64 {
+        (self.reflection + self.transmission).clamp(0.0, 1.0)
+    }
+
+    /// The radiance albedo `R + T / eta^2` for the relative index `eta` it was computed at
+    /// (see [`crate::model::dielectric`]).
+    #[must_use]
+    pub fn radiance_albedo(&self, eta: f64) -> f64 {
+        self.reflection + self.transmission / (eta * eta)
+    }
+
+    /// As a [`ReferenceValue`] of `E`.
+    #[must_use]
+    pub fn as_reference_value(&self) -> ReferenceValue {
+        ReferenceValue {
+            value: self.value(),
+            one_minus_value: self.one_minus_value.clamp(0.0, 1.0),
+            error: self.error,
+            evaluations: self.evaluations,
+            converged: self.converged,
+        }
+    }
+
+    fn exact(mu: f64, eta: f64) -> Self {
+        let reflection = dielectric(eta, mu);
+        Self {
+            reflection,
+            transmission: 1.0 - reflection,
+            one_minus_value: 0.0,
+            error: 0.0,
+            evaluations: 0,
+            converged: true,
+        }
+    }
+}
+
+/// `E_eta(mu)` with its parts, by quadrature (see the module docs).
+#[must_use]
+pub fn reference_dielectric_albedo(
+    model: Model,
+    alpha: f64,
+    mu: f64,
+    eta: f64,
+    settings: &ReferenceSettings,
+) -> DielectricReference {
+    check(alpha, mu, eta);
+    if alpha == 0.0 && mu > 0.0 {
+        return DielectricReference::exact(mu, eta);
+    }
+    let alpha = alpha.max(SMOOTH_ALPHA);
+    match model.ndf {
+        Ndf::Ggx => quadrature(Ggx { alpha }, model.masking, mu, eta, settings),
+        Ndf::Beckmann => quadrature(Beckmann { alpha }, model.masking, mu, eta, settings),
+    }
+}
+
+/// `E_avg,eta = 2 ∫ E_eta(mu) mu dmu` with its parts, by nested quadrature: the inner integrals at
+/// a tenth of the tolerance, the outer one broken at `alpha / 16, alpha / 4, alpha, 4 alpha` (the
+/// grazing layer) and, for `eta < 1`, at the critical angle's `mu = sqrt(1 - eta^2)`.
+#[must_use]
+pub fn reference_dielectric_average_albedo(
+    model: Model,
+    alpha: f64,
+    eta: f64,
+    settings: &ReferenceSettings,
+) -> DielectricReference {
+    check(alpha, 0.5, eta);
+    if alpha == 0.0 {
+        // Smooth: R_avg = F_avg(eta), T_avg = 1 - F_avg(eta).
+        let f_avg = crate::model::Fresnel::Dielectric { eta }.average_report();
+        return DielectricReference {
+            reflection: f_avg.value[0],
+            transmission: 1.0 - f_avg.value[0],
+            one_minus_value: 0.0,
+            error: f_avg.error,
+            evaluations: f_avg.evaluations,
+            converged: true,
+        };
+    }
+    let inner = ReferenceSettings {
+        tolerance: settings.tolerance / 10.0,
+        ..*settings
+    };
+    let mut evaluations = 0;
+    let mut converged = true;
+    let mut integrand = |mu: f64| {
+        let r = reference_dielectric_albedo(model, alpha, mu, eta, &inner);
+        evaluations += r.evaluations;
+        converged &= r.converged;
+        let w = 2.0 * mu;
+        [
+            w * r.reflection,
+            w * r.transmission,
+            w * r.one_minus_value,
+            w * r.error,
+        ]
+    };
+    let mut breaks = vec![0.0, 1.0];
+    for b in [alpha / 16.0, alpha / 4.0, alpha, 4.0 * alpha] {
+        breaks.push(b);
+    }
+    if eta < 1.0 {
+        breaks.push(((1.0 - eta) * (1.0 + eta)).sqrt());
+    }
+    breaks.retain(|&b| (0.0..=1.0).contains(&b));
+    breaks.sort_by(f64::total_cmp);
+    let outer = integrate_pieces(
+        &mut integrand,
+        &breaks,
+        settings.tolerance / 2.0,
+        settings.max_intervals,
+    );
+    DielectricReference {
+        reflection: outer.value[0],
+        transmission: outer.value[1],
+        one_minus_value: outer.value[2],
+        error: outer.error + outer.value[3],
+        evaluations: evaluations + outer.evaluations,
+        converged: converged && outer.converged,
+    }
+}
+
+/// `[R, T, 1 - E]` for one distribution (see the module docs).
+fn quadrature<N: MicrofacetDistribution>(
+    ndf: N,
+    masking: Masking,
+    mu: f64,
+    eta: f64,
+    settings: &ReferenceSettings,
+) -> DielectricReference {
+    let alpha = ndf.alpha();
+    let so = sin_from_cos(mu);
+    let o = Vec3::new(so, 0.0, mu);
+    let lambda_o = ndf.lambda_from_tan2(if mu == 0.0 {
+        f64::INFINITY
+    } else {
+        (so / mu) * (so / mu)
+    });
+    // G1(o) / mu, finite at mu = 0.
+    let inverse_area = 1.0 / ndf.projected_area(mu);
+    let (x_min, x_max) = x_range(alpha, settings.tolerance);
+    let x_of_theta = |theta: f64| (theta.tan() / alpha).ln().clamp(x_min, x_max);
+    let normal = |x: f64, cos_phi: f64, sin_phi: f64| {
+        let t = alpha * x.exp();
+        let cos_t = 1.0 / (1.0 + t * t).sqrt();
+        let sin_t = t * cos_t;
+        (Vec3::new(sin_t * cos_phi, sin_t * sin_phi, cos_t), t)
+    };
+    // [R, T, 1 - E] per unit x and phi.
+    let point = |x: f64, cos_phi: f64, sin_phi: f64| -> [f64; 3] {
+        let (m, t) = normal(x, cos_phi, sin_phi);
+        let om = o.dot(m);
+        if om <= 0.0 {
+            return [0.0; 3];
+        }
+        // dω_m = sin^2 cos dx dphi in these variables; G1(o) (o.m) D / mu is the visible density.
+        let sin_t = t * m.z;
+        let density = ndf.d_from_tan2(t * t) * sin_t * sin_t * m.z * om * inverse_area;
+        let s = scattering(ndf, masking, o, lambda_o, m, eta);
+        [
+            density * s.reflection,
+            density * s.transmission,
+            density * s.loss,
+        ]
+    };
+    // The z of the refracted direction, where there is one.
+    let refracted_z = |x: f64, cos_phi: f64, sin_phi: f64| -> Option<f64> {
+        let (m, _) = normal(x, cos_phi, sin_phi);
+        let om = o.dot(m);
+        (om > 0.0)
+            .then(|| refract(o, m, om, eta))
+            .flatten()
+            .map(|v| v.z)
+    };
+    let critical_cos = (eta < 1.0).then(|| ((1.0 - eta) * (1.0 + eta)).sqrt());
+
+    let inner_tolerance = settings.tolerance / (4.0 * PI);
+    let mut evaluations = 0;
+    let mut all_converged = true;
+    let mut over_phi = |phi: f64| -> [f64; 4] {
+        let (sin_phi, cos_phi) = phi.sin_cos();
+        // The reflected direction's horizon and the edge of visibility, as for E.
+        let theta_star = 0.5 * (PI - mu.atan2(so * cos_phi));
+        let x_visible = if cos_phi < 0.0 && so > 0.0 {
+            x_of_theta((mu / (so * -cos_phi)).atan())
+        } else {
+            x_max
+        };
+        let mut breaks = vec![x_min, x_visible, 0.0, x_of_theta(theta_star)];
+        // o.m = rho cos(theta - delta) along this slice.
+        let rho = (mu * mu + so * so * cos_phi * cos_phi).sqrt();
+        let delta = (so * cos_phi).atan2(mu);
+        if let Some(c) = critical_cos
+            && c < rho
+        {
+            let spread = (c / rho).acos();
+            for theta in [delta - spread, delta + spread] {
+                if theta > 0.0 && theta < PI / 2.0 {
+                    breaks.push(x_of_theta(theta));
+                }
+            }
+        }
+        // Sign changes of the refracted direction's z: a scan, then bisection.
+        const SCAN: usize = 48;
+        let step = (x_visible - x_min) / SCAN as f64;
+        let mut previous: Option<(f64, f64)> = None;
+        for k in 0..=SCAN {
+            let x = x_min + step * k as f64;
+            let z = refracted_z(x, cos_phi, sin_phi);
+            if let (Some((x0, z0)), Some(z1)) = (previous, z)
+                && (z0 < 0.0) != (z1 < 0.0)
+            {
+                let (mut lo, mut hi) = (x0, x);
+                for _ in 0..60 {
+                    let mid = 0.5 * (lo + hi);
+                    match refracted_z(mid, cos_phi, sin_phi) {
+                        Some(zm) if (zm < 0.0) == (z0 < 0.0) => lo = mid,
+                        _ => hi = mid,
+                    }
+                }
+                breaks.push(0.5 * (lo + hi));
+            }
+            previous = z.map(|z| (x, z));
+        }
+        evaluations += (SCAN as u64 + 1) * 2;
+        breaks.retain(|&b| b >= x_min && b <= x_visible);
+        breaks.sort_by(f64::total_cmp);
+        let mut f = |x: f64| point(x, cos_phi, sin_phi);
+        let q = integrate_pieces(&mut f, &breaks, inner_tolerance, settings.max_intervals);
+        evaluations += q.evaluations;
+        all_converged &= q.converged;
+        [q.value[0], q.value[1], q.value[2], q.error]
+    };
+    // Where the critical angle's curve leaves the slice (rho(phi) = critical cos), the inner
+    // integral has a square-root kink in phi: break there too.
+    let mut breaks = phi_breaks(mu, so);
+    if let Some(c) = critical_cos
+        && c > mu
+        && so > 0.0
+    {
+        let cos_phi = ((c - mu) * (c + mu)).sqrt() / so;
+        if cos_phi < 1.0 {
+            breaks.extend([cos_phi.acos(), (-cos_phi).acos()]);
+            breaks.sort_by(f64::total_cmp);
+        }
+    }
+    let outer = integrate_pieces(
+        &mut over_phi,
+        &breaks,
+        settings.tolerance / 4.0,
+        settings.max_intervals,
+    );
+    DielectricReference {
+        reflection: 2.0 * outer.value[0],
+        transmission: 2.0 * outer.value[1],
+        one_minus_value: 2.0 * outer.value[2],
+        error: 2.0 * (outer.error + outer.value[3]),
+        evaluations: evaluations + outer.evaluations,
+        converged: all_converged && outer.converged,
+    }
+}

@@ -1,0 +1,157 @@
+//! A rough dielectric interface: microfacet reflection plus transmission.
+//!
+//! Source: Walter, Marschner, Li and Torrance 2007, "Microfacet Models for Refraction through Rough
+//! Surfaces" (EGSR): the BTDF (eq. 21), the refraction Jacobian (eq. 17), the Fresnel term
+//! (eq. 22, [`super::fresnel::dielectric`]); Heitz 2014, "Understanding the Masking-Shadowing
+//! Function in Microfacet-Based BRDFs", for visible-normal sampling. The masking forms are the
+//! same as for reflection ([`Masking`]): `G2 = 1 / (1 + Lambda(o) + Lambda(i))` or
+//! `G1(o) G1(i)`, which is what pbrt-v4, Cycles and Mitsuba evaluate for transmission too (Heitz
+//! 2014 gives a Beta-function form for height-correlated transmission; no renderer kiln serves
+//! uses it, and a table is only right for the BSDF the renderer evaluates).
+//!
+//! ## Convention: energy albedo (the sample weight), not radiance albedo
+//!
+//! `eta = n_other / n_view` is the relative index of the medium across the interface from the view
+//! direction `o`. Light arriving along `o` is reflected with probability `F(o.m)` at a visible
+//! microfacet `m` and refracted otherwise. Drawing `m` from the visible normals of `o` (density
+//! `G1(o) (o.m)+ D(m) / mu_o`), the fraction of the incident *power* that leaves is the mean of
+//!
+//! - reflection: `F(o.m) G2(o, i_r) / G1(o)` when `i_r = reflect(o, m)` is above the surface,
+//! - transmission: `(1 - F(o.m)) G2(o, i_t) / G1(o)` when `i_t = refract(o, m)` is below it
+//!   (a refracted direction that ends on the incident side is rejected: it counts as lost),
+//!
+//! because Walter's Jacobian `dω_i / dω_m` cancels the BTDF's `(o.m + eta i.m)^2` denominator.
+//! kiln's dielectric tables hold this *energy albedo*, the quantity a path tracer's throughput
+//! multiplies by (the sample weight, Cycles and pbrt-v4's importance mode): with a smooth
+//! surface it is `R + T = F + (1 - F) = 1`, so `1 - E` is the energy that single scattering loses
+//! and `1 / E` is Turquin's compensation factor.
+//!
+//! The *radiance* albedo `∫ f(o, i) |mu_i| dω_i` of Walter's radiance BTDF differs by the solid
+//! angle compression of refraction: its transmitted part is `T / eta^2`, so it is `R + T / eta^2`
+//! (below 1 for `eta > 1` even when smooth, above 1 possible for `eta < 1`). Renderers that carry
+//! radiance with that factor (pbrt-v4's radiance mode) must scale kiln's transmission by
+//! `1 / eta^2`; the library returns `R` and `T` separately ([`Scattering`]) for that reason.
+//!
+//! Reciprocity in this convention: Walter's BTDF obeys `f(o, i) / n_i^2 = f(i, o) / n_o^2`, so the
+//! hemispherical averages of the transmitted energy from either side satisfy
+//! `T_avg(eta) = eta^2 T_avg(1 / eta)` (with a smooth surface: `1 - F_avg(eta) = eta^2 (1 -
+//! F_avg(1 / eta))`, the Fresnel reciprocity of `physics.md`).
+
+use super::masking::Masking;
+use super::ndf::MicrofacetDistribution;
+use super::vector::Vec3;
+
+/// What one visible microfacet normal contributes to the energy albedo of a dielectric
+/// interface: `reflection + transmission + loss = 1`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Scattering {
+    /// `F G2(o, i_r) / G1(o)`, or 0 when the reflected direction is below the surface.
+    pub reflection: f64,
+    /// `(1 - F) G2(o, i_t) / G1(o)`, or 0 under total internal reflection or when the refracted
+    /// direction is above the surface.
+    pub transmission: f64,
+    /// The rest, computed without cancellation ([`Masking::loss`]).
+    pub loss: f64,
+}
+
+/// Refracts the unit view direction `o` through the unit microfacet normal `m` with
+/// `c = o.m > 0`, into the medium of relative index `eta = n_other / n_view` (Walter 2007,
+/// eq. 40): `i_t = -o / eta + (c / eta - cos_t) m`, `cos_t = sqrt(1 - (1 - c^2) / eta^2)`, so
+/// that `i_t.m = -cos_t`. `None` under total internal reflection.
+#[must_use]
+#[inline]
+pub fn refract(o: Vec3, m: Vec3, c: f64, eta: f64) -> Option<Vec3> {
+    let sin2_t = (1.0 - c) * (1.0 + c) / (eta * eta);
+    if sin2_t >= 1.0 {
+        return None;
+    }
+    let cos_t = ((1.0 - sin2_t).max(0.0)).sqrt();
+    Some(m * (c / eta - cos_t) - o * (1.0 / eta))
+}
+
+/// The contributions of the visible microfacet normal `m` for the view `o` (see the module
+/// docs); `lambda_o = Lambda(o)`.
+#[must_use]
+#[inline]
+pub fn scattering<N: MicrofacetDistribution>(
+    ndf: N,
+    masking: Masking,
+    o: Vec3,
+    lambda_o: f64,
+    m: Vec3,
+    eta: f64,
+) -> Scattering {
+    let c = o.dot(m).clamp(0.0, 1.0);
+    let fresnel = super::fresnel::dielectric(eta, c);
+    let i_r = o.reflect(m);
+    let reflection_loss = if i_r.z > 0.0 {
+        masking.loss(lambda_o, ndf.lambda(i_r))
+    } else {
+        1.0
+    };
+    let transmission_loss = match refract(o, m, c, eta) {
+        Some(i_t) if i_t.z < 0.0 => masking.loss(lambda_o, ndf.lambda(i_t)),
+        _ => 1.0,
+    };
+    let transmitted = 1.0 - fresnel;
+    Scattering {
+        reflection: fresnel * (1.0 - reflection_loss),
+        transmission: transmitted * (1.0 - transmission_loss),
+        loss: fresnel * reflection_loss + transmitted * transmission_loss,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::Ggx;
+
+    #[test]
+    fn refraction_obeys_snell_and_stays_unit() {
+        let o = Vec3::new(0.6, 0.0, 0.8);
+        let m = Vec3::new(0.1, 0.2, (1.0f64 - 0.05).sqrt());
+        for eta in [1.0, 1.5, 1.0 / 1.5, 2.4] {
+            let c = o.dot(m);
+            let Some(t) = refract(o, m, c, eta) else {
+                assert!(eta < 1.0 && (1.0 - c * c) / (eta * eta) >= 1.0);
+                continue;
+            };
+            assert!((t.length_squared() - 1.0).abs() < 1e-14, "{eta}");
+            let sin_i = (1.0 - c * c).sqrt();
+            let cos_t = -t.dot(m);
+            let sin_t = (1.0 - cos_t * cos_t).sqrt();
+            assert!((sin_i - eta * sin_t).abs() < 1e-14, "{eta}");
+            // o, m and t lie in one plane.
+            let normal = Vec3::new(
+                o.y * m.z - o.z * m.y,
+                o.z * m.x - o.x * m.z,
+                o.x * m.y - o.y * m.x,
+            );
+            assert!(normal.dot(t).abs() < 1e-14, "{eta}");
+        }
+        // eta = 1: straight through.
+        let t = refract(o, m, o.dot(m), 1.0).unwrap();
+        assert!((t + o).length_squared() < 1e-28);
+        // Beyond the critical angle.
+        assert!(refract(o, Vec3::new(0.0, 0.0, 1.0), 0.8, 0.5).is_none());
+    }
+
+    #[test]
+    fn contributions_add_up_to_one() {
+        let ndf = Ggx { alpha: 0.4 };
+        let o = Vec3::from_mu(0.3);
+        let lambda_o = ndf.lambda(o);
+        for masking in Masking::ALL {
+            for eta in [1.0, 1.33, 1.0 / 1.33, 3.0] {
+                for k in 0..50 {
+                    let u = [(k as f64 + 0.5) / 50.0, ((k * 37) % 50) as f64 / 50.0];
+                    let m = ndf.sample_visible_normal(o, u);
+                    let s = scattering(ndf, masking, o, lambda_o, m, eta);
+                    let sum = s.reflection + s.transmission + s.loss;
+                    assert!((sum - 1.0).abs() < 1e-14, "{masking} {eta}: {s:?}");
+                    assert!(s.reflection >= 0.0 && s.transmission >= 0.0 && s.loss >= 0.0);
+                }
+            }
+        }
+    }
+}
