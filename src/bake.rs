@@ -8,10 +8,11 @@ use crate::cache::{Cache, CacheKey};
 use crate::error::{Error, Result};
 use crate::integrate::albedo::weighted_albedo;
 use crate::integrate::average_quadrature::rule_average_albedo;
+use crate::integrate::dielectric::{dielectric_albedo, dielectric_average_albedo};
 use crate::integrate::reference::ReferenceSettings;
 use crate::integrate::{Estimate, QmcSettings, albedo, average_albedo};
 use crate::model::{Masking, Model, Ndf, RoughnessConvention};
-use crate::table::axis::{Axis, Grid, MuMapping};
+use crate::table::axis::{Axis, Grid, IorBound, IorMapping, MuMapping};
 use crate::table::{Method, Quantity, Table, TableSpec};
 use crate::verify::{
     MAX_AVERAGE_ENTRIES_CHECKED, node_errors, node_errors_at, reference_value, spread_indices,
@@ -42,6 +43,13 @@ pub struct BakeOptions {
     pub roughness_convention: RoughnessConvention,
     pub mu_mapping: MuMapping,
     pub grid: Grid,
+    /// Samples on the index-of-refraction axis of the dielectric tables and `F_avg` (their
+    /// roughness and `mu` axes have `size` samples).
+    pub ior_size: usize,
+    /// How the IOR axis is spaced ([`IorMapping`]).
+    pub ior_mapping: IorMapping,
+    /// The IOR axis runs over `[1, ior_max]`.
+    pub ior_max: f64,
     /// Measure each table's node error against the deterministic reference after baking (only
     /// meaningful for [`Method::Qmc`]).
     pub check_against_reference: bool,
@@ -68,6 +76,9 @@ impl Default for BakeOptions {
             roughness_convention: RoughnessConvention::Perceptual,
             mu_mapping: MuMapping::Adaptive,
             grid: Grid::Nodes,
+            ior_size: Self::DEFAULT_IOR_SIZE,
+            ior_mapping: IorMapping::Cycles,
+            ior_max: Self::DEFAULT_IOR_MAX,
             check_against_reference: true,
             method: Method::Qmc,
             max_error: Some(Self::DEFAULT_MAX_ERROR),
@@ -85,6 +96,10 @@ impl BakeOptions {
     pub const DEFAULT_SIZE: usize = 32;
     /// The largest size accepted per axis.
     pub const MAX_SIZE: usize = 4096;
+    /// The default IOR axis size, 16 (Cycles' glass tables are 16 x 16 x 16).
+    pub const DEFAULT_IOR_SIZE: usize = 16;
+    /// The default top of the IOR axis, 3 (Unreal's glass table; diamond is 2.42).
+    pub const DEFAULT_IOR_MAX: f64 = 3.0;
 
     /// Checks every option, naming the bad value and the allowed range.
     pub fn validate(&self) -> Result<()> {
@@ -93,6 +108,20 @@ impl BakeOptions {
                 "size must be between 2 and {} (got {})",
                 Self::MAX_SIZE,
                 self.size
+            )));
+        }
+        if !(2..=Self::MAX_SIZE).contains(&self.ior_size) {
+            return Err(Error::InvalidInput(format!(
+                "ior-size must be between 2 and {} (got {})",
+                Self::MAX_SIZE,
+                self.ior_size
+            )));
+        }
+        if !(self.ior_max > 1.0 && self.ior_max <= 100.0) {
+            return Err(Error::InvalidInput(format!(
+                "ior-max must be above 1 and at most 100 (got {}): the IOR axis runs over \
+                 [1, ior-max], and inside tables use 1 / eta",
+                self.ior_max
             )));
         }
         if let Some(x) = self.max_error
@@ -189,9 +218,16 @@ impl BakeOptions {
         models
     }
 
-    /// The tables to bake: `E` then `E_avg` for each model.
+    /// The tables to bake: each quantity for each model, in order (`F_avg`, the same for every
+    /// model, once).
     #[must_use]
     pub fn specs(&self) -> Vec<TableSpec> {
+        let ior = Axis::Ior {
+            size: self.ior_size,
+            mapping: self.ior_mapping,
+            max: IorBound(self.ior_max),
+            grid: self.grid,
+        };
         let roughness = Axis::Roughness {
             size: self.size,
             convention: self.roughness_convention,
@@ -211,16 +247,20 @@ impl BakeOptions {
             scrambles: self.scrambles,
             seed: self.seed,
         };
-        self.models()
+        let models = self.models();
+        let first = models.first().copied();
+        models
             .into_iter()
             .flat_map(|model| {
                 self.quantities()
                     .into_iter()
+                    .filter(move |&q| q != Quantity::FAvg || Some(model) == first)
                     .map(move |quantity| TableSpec {
                         reference_digits,
                         model,
                         quantity,
-                        roughness,
+                        ior: quantity.has_ior().then_some(ior),
+                        roughness: quantity.has_roughness().then_some(roughness),
                         mu: quantity.has_mu().then_some(mu),
                         method: self.method,
                         qmc: qmc(if quantity.has_mu() {
@@ -245,14 +285,24 @@ impl BakeOptions {
         quantities
     }
 
-    /// ` --quantity ...` for a command line, empty for the default `e,e-avg`.
+    /// ` --quantity ...` for a command line, empty for the default `e,e-avg`, with the IOR axis
+    /// flags when a quantity has that axis.
     fn quantity_flag(&self) -> String {
         let quantities = self.quantities();
         if quantities == [Quantity::E, Quantity::EAvg] {
             return String::new();
         }
         let names: Vec<&str> = quantities.iter().map(|q| q.cli_name()).collect();
-        format!(" --quantity {}", names.join(","))
+        let mut flag = format!(" --quantity {}", names.join(","));
+        if quantities.iter().any(|q| q.has_ior()) {
+            flag += &format!(
+                " --ior-size {} --ior-axis {} --ior-max {}",
+                self.ior_size,
+                self.ior_mapping.name(),
+                self.ior_max
+            );
+        }
+        flag
     }
 
     /// The `kiln bake` command that reproduces the tables of `model` with these options, with
@@ -447,20 +497,36 @@ pub fn bake_table(spec: TableSpec, command: String, progress: &(dyn Fn(u64) + Sy
 #[must_use]
 pub fn estimate_texel(spec: &TableSpec, index: usize) -> Estimate {
     let (alpha, mu) = spec.texel_coordinates(index);
-    match spec.method {
-        Method::Qmc => match (mu, spec.quantity.weight()) {
+    let eta = spec.texel_eta(index);
+    match (spec.method, eta) {
+        // F_avg is a 1-D integral: always the quadrature.
+        (_, Some(eta)) if spec.quantity == Quantity::FAvg => {
+            let f = crate::model::Fresnel::Dielectric { eta }.average_report();
+            Estimate {
+                value: f.value[0],
+                one_minus_value: 1.0 - f.value[0],
+                std_error: f.error,
+                samples: f.evaluations,
+            }
+        }
+        (Method::Qmc, Some(eta)) => match mu {
+            Some(mu) => dielectric_albedo(spec.model, alpha, mu, eta, &spec.qmc),
+            None => dielectric_average_albedo(spec.model, alpha, eta, &spec.qmc),
+        },
+        (Method::Qmc, None) => match (mu, spec.quantity.weight()) {
             (Some(mu), None) => albedo(spec.model, alpha, mu, &spec.qmc),
             (Some(mu), Some(h)) => weighted_albedo(spec.model, alpha, mu, h, &spec.qmc),
             (None, _) => average_albedo(spec.model, alpha, &spec.qmc),
         },
-        Method::Reference => {
+        (Method::Reference, eta) => {
             let settings = spec.reference_settings();
             let r = match (mu, spec.average_rule_order()) {
                 // A fixed rule whose measured error bound is within the tolerance.
                 (None, Some(order)) => rule_average_albedo(spec.model, alpha, order, &settings),
                 // What the audit compares with, at the spec's tolerance: `E` and the split-sum
-                // channels by the reference, `E_avg` by the composite rule in smooth variables.
-                _ => reference_value(spec, alpha, mu, &settings),
+                // channels by the reference, `E_avg` by the composite rule in smooth variables,
+                // the dielectric tables by their own quadrature.
+                _ => reference_value(spec, alpha, mu, eta, &settings),
             };
             Estimate {
                 value: r.value,

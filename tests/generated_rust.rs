@@ -71,7 +71,7 @@ fn generated_lookups_match_the_library_lookup() {
     let close = |got: f32, want: f64| (f64::from(got) - want).abs() < 2e-6;
     let points = lookup_coordinates(&e.spec, &AuditSettings::default());
     assert!(points.len() > 4000);
-    for (alpha, mu) in points {
+    for kiln::verify::Coordinates { alpha, mu, .. } in points {
         let (r, mu) = (alpha.sqrt(), mu.unwrap());
         let got =
             ggx::ggx_height_correlated_e_lookup(&ggx::GGX_HEIGHT_CORRELATED_E, mu as f32, r as f32);
@@ -87,7 +87,9 @@ fn generated_lookups_match_the_library_lookup() {
         );
     }
     let avg = read("ggx-height-correlated-E_avg");
-    for (alpha, _) in lookup_coordinates(&avg.spec, &AuditSettings::default()) {
+    for kiln::verify::Coordinates { alpha, .. } in
+        lookup_coordinates(&avg.spec, &AuditSettings::default())
+    {
         let r = alpha.sqrt();
         let got =
             ggx::ggx_height_correlated_e_avg_lookup(&ggx::GGX_HEIGHT_CORRELATED_E_AVG, r as f32);

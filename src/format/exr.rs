@@ -16,11 +16,14 @@ use std::io::Cursor;
 /// The name of the header attribute holding the metadata JSON.
 pub const METADATA_ATTRIBUTE: &str = "kiln";
 
-/// Encodes a table as an EXR file in memory. A 2-D table is `mu` wide and `roughness` high; a
-/// 1-D table is one row.
+/// Encodes a table as an EXR file in memory. A 2-D table is `mu` (or roughness) wide and
+/// `roughness` (or `eta`) high; a 1-D table is one row; a 3-D table `(eta, roughness, mu)` is its
+/// `eta` slices stacked top to bottom, `mu` wide and `eta x roughness` high (image row
+/// `eta_index * R + r_index`).
 pub fn encode(table: &Table, precision: Precision) -> std::result::Result<Vec<u8>, String> {
     let shape = table.spec.shape();
     let (width, height) = match shape[..] {
+        [slices, rows, columns] => (columns, slices * rows),
         [rows, columns] => (columns, rows),
         [n] => (n, 1),
         _ => {

@@ -31,6 +31,7 @@ impl AxisMetadata {
         let mapping = match *axis {
             Axis::Mu { mapping, .. } => mapping.name().to_string(),
             Axis::Roughness { convention, .. } => convention.describe().to_string(),
+            Axis::Ior { mapping, .. } => mapping.name().to_string(),
         };
         Self {
             name: axis.name().to_string(),
@@ -104,14 +105,25 @@ impl Metadata {
     pub fn new(table: &Table, precision: &str) -> Self {
         let spec = &table.spec;
         let axes: Vec<AxisMetadata> = spec.axes().iter().map(AxisMetadata::new).collect();
-        let layout = match spec.mu {
-            Some(_) => format!(
-                "row-major, slowest axis first: value[{r}_index * {n} + mu_index]; as an image, \
-                 x (columns) = mu, y (rows, top to bottom) = {r}",
-                r = axes[0].name,
-                n = axes[1].size
+        let layout = match &axes[..] {
+            [e, r, m] => format!(
+                "row-major, slowest axis first: value[({e}_index * {nr} + {r}_index) * {nm} + \
+                 {m}_index]; as an image, x (columns) = {m}, y (rows, top to bottom) = \
+                 {e}_index * {nr} + {r}_index (one {r} x {m} slice per {e}, stacked)",
+                e = e.name,
+                r = r.name,
+                m = m.name,
+                nr = r.size,
+                nm = m.size
             ),
-            None => format!("value[{}_index]", axes[0].name),
+            [slow, fast] => format!(
+                "row-major, slowest axis first: value[{s}_index * {n} + {f}_index]; as an image, \
+                 x (columns) = {f}, y (rows, top to bottom) = {s}",
+                s = slow.name,
+                f = fast.name,
+                n = fast.size
+            ),
+            _ => format!("value[{}_index]", axes[0].name),
         };
         Self {
             kiln_version: KILN_VERSION.to_string(),
@@ -119,12 +131,25 @@ impl Metadata {
             description: spec.quantity.describe().to_string(),
             ndf: spec.model.ndf.name().to_string(),
             masking: spec.model.masking.name().to_string(),
-            fresnel: match spec.quantity.weight() {
-                None => "none (F = 1)".to_string(),
-                Some(_) => "Schlick weight Fc = (1 - o.h)^5 (or 1 - Fc) on F = 1; see description"
-                    .to_string(),
+            fresnel: match (spec.quantity.weight(), spec.quantity.has_ior()) {
+                (None, false) => "none (F = 1)".to_string(),
+                (Some(_), _) => {
+                    "Schlick weight Fc = (1 - o.h)^5 (or 1 - Fc) on F = 1; see description"
+                        .to_string()
+                }
+                (None, true) => format!(
+                    "exact dielectric, relative index {} (eta from the eta axis)",
+                    if spec.quantity.from_inside() {
+                        "1 / eta"
+                    } else {
+                        "eta"
+                    }
+                ),
             },
-            roughness_convention: spec.roughness_convention().name().to_string(),
+            roughness_convention: match spec.roughness {
+                Some(_) => spec.roughness_convention().name().to_string(),
+                None => "none (no roughness axis)".to_string(),
+            },
             shape: spec.shape(),
             layout,
             axes,

@@ -1,6 +1,7 @@
 //! PNG heat map of a 2-D table, for a person to look at: each texel drawn as a square of
 //! [`SCALE`] pixels in the viridis colour map, stretched between the table's minimum and maximum.
-//! Rows are roughness (top: smallest), columns `mu` (left: smallest), as in the EXR.
+//! Rows are roughness (top: smallest), columns `mu` (left: smallest), as in the EXR; a 3-D table's
+//! `eta` slices are stacked top to bottom, as in the EXR.
 
 use crate::table::Table;
 
@@ -29,8 +30,10 @@ fn colour(t: f64) -> [u8; 3] {
 
 /// Encodes the table's value channel as a heat map; `None` for a 1-D table.
 pub fn encode(table: &Table) -> Option<std::result::Result<Vec<u8>, String>> {
-    let [rows, columns] = table.spec.shape()[..] else {
-        return None;
+    let (rows, columns) = match table.spec.shape()[..] {
+        [slices, rows, columns] => (slices * rows, columns),
+        [rows, columns] => (rows, columns),
+        _ => return None,
     };
     let (lo, hi) = table
         .value

@@ -7,7 +7,7 @@
 use super::metadata::{KILN_VERSION, Metadata};
 use crate::model::RoughnessConvention;
 use crate::table::Table;
-use crate::table::axis::{ADAPTIVE_POWER, ADAPTIVE_SCALE, Axis, Grid, MuMapping};
+use crate::table::axis::{ADAPTIVE_POWER, ADAPTIVE_SCALE, Axis, Grid, IorMapping, MuMapping};
 use std::fmt::Write as _;
 
 /// On every generated array: a measured value may happen to print like a mathematical constant
@@ -23,6 +23,9 @@ pub fn const_prefix(table: &Table) -> String {
 /// The constant name of a table's `1 - value` channel: `GGX_HEIGHT_CORRELATED_ONE_MINUS_E`.
 #[must_use]
 pub fn one_minus_name(table: &Table) -> String {
+    if table.spec.quantity == crate::table::Quantity::FAvg {
+        return "DIELECTRIC_ONE_MINUS_F_AVG".to_string();
+    }
     let model = format!("{}_{}", table.spec.model.ndf, table.spec.model.masking);
     format!(
         "{}_ONE_MINUS_{}",
@@ -46,6 +49,22 @@ fn write_array(out: &mut String, values: &[f64], shape: &[usize]) {
             }
             out.push_str("\n]");
         }
+        [slices, rows, columns] => {
+            out.push('[');
+            let slice = rows * columns;
+            for k in 0..*slices {
+                let mut inner = String::new();
+                write_array(
+                    &mut inner,
+                    &values[k * slice..(k + 1) * slice],
+                    &[*rows, *columns],
+                );
+                out.push('\n');
+                out.push_str(&inner.replace('\n', "\n    "));
+                out.push(',');
+            }
+            out.push_str("\n]");
+        }
         [rows, columns] => {
             out.push('[');
             for r in 0..*rows {
@@ -62,7 +81,7 @@ fn write_array(out: &mut String, values: &[f64], shape: &[usize]) {
             }
             out.push_str("\n]");
         }
-        _ => unreachable!("tables are 1-D or 2-D"),
+        _ => unreachable!("tables are 1-D, 2-D or 3-D"),
     }
 }
 
@@ -84,6 +103,16 @@ fn coordinate_code(axis: &Axis) -> String {
             ),
         },
         Axis::Roughness { .. } => "roughness".to_string(),
+        Axis::Ior { mapping, max, .. } => match mapping {
+            IorMapping::Linear => format!("(eta - 1.0) / ({:?}_f32 - 1.0)", max.0 as f32),
+            IorMapping::Cycles => {
+                let z_max = ((max.0 - 1.0) / (max.0 + 1.0)).sqrt();
+                format!(
+                    "((eta - 1.0) / (eta + 1.0)).max(0.0).sqrt() / {:?}_f32",
+                    z_max as f32
+                )
+            }
+        },
     }
 }
 
@@ -100,13 +129,17 @@ fn position_code(grid: Grid, t: &str, n: usize) -> String {
 /// arithmetic as [`Table::lookup`] in f32.
 fn write_lookup(out: &mut String, table: &Table, prefix: &str, ty: &str) {
     let spec = &table.spec;
+    if spec.ior.is_some() {
+        write_ior_lookup(out, table, prefix, ty);
+        return;
+    }
     let name = lookup_name(table);
     let roughness_name = spec.roughness_convention().name();
     let alpha = match spec.roughness_convention() {
         RoughnessConvention::Perceptual => "roughness * roughness",
         RoughnessConvention::Alpha => "roughness",
     };
-    let n_r = spec.roughness.size();
+    let n_r = spec.roughness_axis().size();
     let _ = writeln!(out);
     let _ = writeln!(
         out,
@@ -128,7 +161,7 @@ fn write_lookup(out: &mut String, table: &Table, prefix: &str, ty: &str) {
         }
     );
     let _ = writeln!(out, "#[allow(clippy::all)]");
-    let t_r = position_code(spec.roughness.grid(), "roughness", n_r);
+    let t_r = position_code(spec.roughness_axis().grid(), "roughness", n_r);
     match spec.mu {
         None => {
             let _ = writeln!(out, "pub fn {name}(table: &{ty}, roughness: f32) -> f32 {{");
@@ -175,11 +208,126 @@ fn write_lookup(out: &mut String, table: &Table, prefix: &str, ty: &str) {
     }
 }
 
+/// The generated lookup of a table with an IOR axis (`F_avg`, the dielectric tables): the same
+/// blend order as [`Table::lookup_eta`] (fastest axis first), in f32; `eta < 1` (an inside
+/// table's relative index) is looked up at `1 / eta`.
+fn write_ior_lookup(out: &mut String, table: &Table, prefix: &str, ty: &str) {
+    let spec = &table.spec;
+    let name = lookup_name(table);
+    let ior = spec.ior.expect("an IOR axis");
+    let n_eta = ior.size();
+    let mut params = Vec::new();
+    if spec.mu.is_some() {
+        params.push("mu: f32");
+    }
+    if spec.roughness.is_some() {
+        params.push("roughness: f32");
+    }
+    params.push("eta: f32");
+    let _ = writeln!(out);
+    let _ = writeln!(
+        out,
+        "/// Lookup of [`{prefix}`] (or its `ONE_MINUS` and `STD_ERROR` twins) the way kiln's \
+         `Table::lookup_eta`\n/// does it, in f32, clamp to edge: {}.",
+        spec.axes()
+            .iter()
+            .map(|a| format!("`{}` axis {}", a.name(), a.formula()))
+            .collect::<Vec<_>>()
+            .join("; ")
+    );
+    let _ = writeln!(
+        out,
+        "/// `eta` is the index of refraction as listed on the axis (an `eta < 1` is read at \
+         `1 / eta`){}.",
+        match spec.roughness {
+            Some(_) => format!(", `roughness` is `{}`", spec.roughness_convention().name()),
+            None => String::new(),
+        }
+    );
+    let _ = writeln!(out, "#[allow(clippy::all)]");
+    let _ = writeln!(
+        out,
+        "pub fn {name}(table: &{ty}, {}) -> f32 {{",
+        params.join(", ")
+    );
+    let _ = writeln!(
+        out,
+        "    let eta = if eta < 1.0 {{ 1.0 / eta }} else {{ eta }};"
+    );
+    let _ = writeln!(out, "    let t_eta = {};", coordinate_code(&ior));
+    let _ = writeln!(
+        out,
+        "    let p_eta = {};",
+        position_code(ior.grid(), "t_eta", n_eta)
+    );
+    let _ = writeln!(out, "    let k = (p_eta as usize).min({});", n_eta - 2);
+    let _ = writeln!(out, "    let h = p_eta - k as f32;");
+    match (spec.roughness, spec.mu) {
+        (None, _) => {
+            let _ = writeln!(out, "    table[k] * (1.0 - h) + table[k + 1] * h");
+        }
+        (Some(roughness), mu) => {
+            let n_r = roughness.size();
+            let alpha = match spec.roughness_convention() {
+                RoughnessConvention::Perceptual => "roughness * roughness",
+                RoughnessConvention::Alpha => "roughness",
+            };
+            let _ = writeln!(
+                out,
+                "    let p_r = {};",
+                position_code(roughness.grid(), "roughness", n_r)
+            );
+            let _ = writeln!(out, "    let i = (p_r as usize).min({});", n_r - 2);
+            let _ = writeln!(out, "    let f = p_r - i as f32;");
+            match mu {
+                None => {
+                    let _ = writeln!(
+                        out,
+                        "    let slice = |s: &[f32; {n_r}]| s[i] * (1.0 - f) + s[i + 1] * f;"
+                    );
+                }
+                Some(mu_axis) => {
+                    let n_mu = mu_axis.size();
+                    if matches!(mu_axis, Axis::Mu { mapping, .. } if mapping.depends_on_roughness())
+                    {
+                        let _ = writeln!(out, "    let alpha = {alpha};");
+                    }
+                    let _ = writeln!(out, "    let t_mu = {};", coordinate_code(&mu_axis));
+                    let _ = writeln!(
+                        out,
+                        "    let p_mu = {};",
+                        position_code(mu_axis.grid(), "t_mu", n_mu)
+                    );
+                    let _ = writeln!(out, "    let j = (p_mu as usize).min({});", n_mu - 2);
+                    let _ = writeln!(out, "    let g = p_mu - j as f32;");
+                    let _ = writeln!(out, "    let slice = |s: &[[f32; {n_mu}]; {n_r}]| {{");
+                    let _ = writeln!(
+                        out,
+                        "        let row0 = s[i][j] * (1.0 - g) + s[i][j + 1] * g;"
+                    );
+                    let _ = writeln!(
+                        out,
+                        "        let row1 = s[i + 1][j] * (1.0 - g) + s[i + 1][j + 1] * g;"
+                    );
+                    let _ = writeln!(out, "        row0 * (1.0 - f) + row1 * f");
+                    let _ = writeln!(out, "    }};");
+                }
+            }
+            let _ = writeln!(
+                out,
+                "    slice(&table[k]) * (1.0 - h) + slice(&table[k + 1]) * h"
+            );
+        }
+    }
+    let _ = writeln!(out, "}}");
+}
+
 fn array_type(shape: &[usize]) -> String {
     match shape {
         [n] => format!("[f32; {n}]"),
         [rows, columns] => format!("[[f32; {columns}]; {rows}]"),
-        _ => unreachable!("tables are 1-D or 2-D"),
+        [slices, rows, columns] => format!("[[[f32; {columns}]; {rows}]; {slices}]"),
+        _ => unreachable!("tables are 1-D, 2-D or 3-D"),
     }
 }
 
@@ -192,6 +340,10 @@ pub fn encode(table: &Table) -> String {
     let ty = array_type(&shape);
     let q = &meta.quantity;
     let index = match &meta.axes[..] {
+        [e, r, mu] => format!(
+            "`{prefix}[{}_index][{}_index][{}_index]`",
+            e.name, r.name, mu.name
+        ),
         [r, mu] => format!("`{prefix}[{}_index][{}_index]`", r.name, mu.name),
         [r] => format!("`{prefix}[{}_index]`", r.name),
         _ => unreachable!(),

@@ -61,6 +61,11 @@ pub struct Scattering {
 #[must_use]
 #[inline]
 pub fn refract(o: Vec3, m: Vec3, c: f64, eta: f64) -> Option<Vec3> {
+    if eta == 1.0 {
+        // Index-matched: straight through, exactly (the general formula leaves rounding noise
+        // of 1e-16 in `c - cos_t`, which decides the side of a grazing direction).
+        return Some(o * -1.0);
+    }
     let sin2_t = (1.0 - c) * (1.0 + c) / (eta * eta);
     if sin2_t >= 1.0 {
         return None;
@@ -90,6 +95,10 @@ pub fn scattering<N: MicrofacetDistribution>(
         1.0
     };
     let transmission_loss = match refract(o, m, c, eta) {
+        // Index-matched, i_t = -o: Lambda(i_t) = Lambda(o), and at a grazing view the loss takes
+        // its limit along the view (1/2 height-correlated, 1 separable), not the value at
+        // Lambda(o) = infinity with Lambda(i) finite that `Masking::loss` gives.
+        _ if eta == 1.0 => masking.loss_index_matched(lambda_o),
         Some(i_t) if i_t.z < 0.0 => masking.loss(lambda_o, ndf.lambda(i_t)),
         _ => 1.0,
     };

@@ -65,6 +65,22 @@ impl Masking {
     }
 }
 
+impl Masking {
+    /// [`Masking::loss`] for a direction and its opposite, `Lambda(i) = Lambda(o)` (light passing
+    /// straight through an index-matched interface): `L / (1 + 2 L)` height-correlated,
+    /// `L / (1 + L)` separable, with their limits 1/2 and 1 as `L -> infinity` (a grazing view).
+    #[must_use]
+    pub fn loss_index_matched(self, lambda: f64) -> f64 {
+        if lambda == 0.0 {
+            return 0.0;
+        }
+        match self {
+            Masking::HeightCorrelated => 1.0 / (2.0 + 1.0 / lambda),
+            Masking::Separable => 1.0 / (1.0 + 1.0 / lambda),
+        }
+    }
+}
+
 impl std::fmt::Display for Masking {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(self.name())
@@ -93,5 +109,15 @@ mod tests {
         assert_eq!(Masking::HeightCorrelated.loss(f64::INFINITY, 3.0), 0.0);
         assert_eq!(Masking::HeightCorrelated.loss(2.0, f64::INFINITY), 1.0);
         assert_eq!(Masking::Separable.loss(2.0, f64::INFINITY), 1.0);
+        for m in Masking::ALL {
+            for l in [0.0, 1e-9, 0.3, 4.0] {
+                assert!((m.loss_index_matched(l) - m.loss(l, l)).abs() < 1e-15);
+            }
+        }
+        assert_eq!(
+            Masking::HeightCorrelated.loss_index_matched(f64::INFINITY),
+            0.5
+        );
+        assert_eq!(Masking::Separable.loss_index_matched(f64::INFINITY), 1.0);
     }
 }

@@ -363,7 +363,7 @@ pub fn run(settings: &StudySettings, progress: &(dyn Fn(u64) + Sync)) -> StudyRe
         size: settings.size,
         table: format!(
             "{n} x {n} E, kiln's default axes: r {}; mu {}",
-            spec.roughness.formula(),
+            spec.roughness_axis().formula(),
             spec.mu.expect("an E table").formula(),
             n = settings.size
         ),

@@ -15,7 +15,14 @@
 //!   (Unity HDRP), which puts more samples near grazing; `adaptive` (kiln's default): the texture
 //!   coordinate depends on the roughness too, `t = (mu (1 + c alpha) / (mu + c alpha))^p` with
 //!   `c = 4`, `p = 0.4` ([`MuMapping::Adaptive`]);
-//! - roughness `r` (perceptual): `r = t`, `alpha = r^2`; roughness `alpha`: `alpha = t`.
+//! - roughness `r` (perceptual): `r = t`, `alpha = r^2`; roughness `alpha`: `alpha = t`;
+//! - index of refraction `eta` in `[1, eta_max]` (the dielectric tables): `linear`,
+//!   `eta = 1 + t (eta_max - 1)` (Unreal's glass table, over [1, 3]); `cycles`, linear in
+//!   `z = sqrt((eta - 1) / (eta + 1))` (the fourth root of the normal-incidence reflectance `F0`),
+//!   `z = t z_max`, `eta = (1 + z^2) / (1 - z^2)`: Cycles' glass tables. `z` puts more samples
+//!   near `eta = 1`, where the critical angle of light arriving from inside opens as
+//!   `sqrt(2 (eta - 1))` and the inside tables change fastest. The axis always lists `eta >= 1`;
+//!   a table of light arriving from inside is computed at the relative index `1 / eta`.
 //!
 //! Why `adaptive`: at small `alpha`, `E` has a boundary layer at `mu ~ alpha` (`physics.md`,
 //! "Hard cases"): `E(mu, alpha)` is, to `O(alpha^2)`, a function of `x = mu / alpha` alone that
@@ -163,6 +170,81 @@ impl MuMapping {
     }
 }
 
+/// How an index-of-refraction axis is spaced (see the module docs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+pub enum IorMapping {
+    /// `eta = 1 + t (eta_max - 1)`.
+    Linear,
+    /// Linear in `z = sqrt((eta - 1) / (eta + 1))` (Cycles' glass tables). The default.
+    Cycles,
+}
+
+impl IorMapping {
+    /// The name used on the command line and in files.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            IorMapping::Linear => "linear",
+            IorMapping::Cycles => "cycles",
+        }
+    }
+
+    fn z(eta: f64) -> f64 {
+        ((eta - 1.0) / (eta + 1.0)).max(0.0).sqrt()
+    }
+
+    /// `eta` at texture coordinate `t` on an axis up to `max`.
+    #[must_use]
+    pub fn eta(self, t: f64, max: f64) -> f64 {
+        match self {
+            IorMapping::Linear => 1.0 + t * (max - 1.0),
+            IorMapping::Cycles => {
+                let z = t * Self::z(max);
+                (1.0 + z * z) / (1.0 - z * z)
+            }
+        }
+    }
+
+    /// The texture coordinate of `eta` (the inverse of [`IorMapping::eta`]); an `eta < 1` is
+    /// looked up at `1 / eta`, as the axis lists indices from 1 up.
+    #[must_use]
+    pub fn coordinate(self, eta: f64, max: f64) -> f64 {
+        let eta = if eta < 1.0 { 1.0 / eta } else { eta };
+        match self {
+            IorMapping::Linear => (eta - 1.0) / (max - 1.0),
+            IorMapping::Cycles => Self::z(eta) / Self::z(max),
+        }
+    }
+
+    /// The formula, for metadata.
+    #[must_use]
+    pub fn formula(self) -> &'static str {
+        match self {
+            IorMapping::Linear => "eta = 1 + t (eta_max - 1)",
+            IorMapping::Cycles => {
+                "z = t z_max with z = sqrt((eta - 1) / (eta + 1)), z_max = z(eta_max); \
+                 eta = (1 + z^2) / (1 - z^2)"
+            }
+        }
+    }
+}
+
+/// An index of refraction as an axis bound: an f64 that compares and hashes by its bits, so that
+/// axes stay `Eq` and `Hash`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(transparent)]
+pub struct IorBound(pub f64);
+
+impl Eq for IorBound {}
+
+impl std::hash::Hash for IorBound {
+    fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
+        self.0.to_bits().hash(state);
+    }
+}
+
 /// One axis of a table.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(tag = "quantity", rename_all = "kebab-case")]
@@ -179,6 +261,14 @@ pub enum Axis {
         convention: RoughnessConvention,
         grid: Grid,
     },
+    /// The index of refraction `eta` in `[1, max]` (listed from 1 up whichever side the light
+    /// arrives from).
+    Ior {
+        size: usize,
+        mapping: IorMapping,
+        max: IorBound,
+        grid: Grid,
+    },
 }
 
 impl Axis {
@@ -186,7 +276,7 @@ impl Axis {
     #[must_use]
     pub fn size(&self) -> usize {
         match *self {
-            Axis::Mu { size, .. } | Axis::Roughness { size, .. } => size,
+            Axis::Mu { size, .. } | Axis::Roughness { size, .. } | Axis::Ior { size, .. } => size,
         }
     }
 
@@ -194,15 +284,16 @@ impl Axis {
     #[must_use]
     pub fn grid(&self) -> Grid {
         match *self {
-            Axis::Mu { grid, .. } | Axis::Roughness { grid, .. } => grid,
+            Axis::Mu { grid, .. } | Axis::Roughness { grid, .. } | Axis::Ior { grid, .. } => grid,
         }
     }
 
-    /// The axis name: `mu`, `r` or `alpha`.
+    /// The axis name: `mu`, `r`, `alpha` or `eta`.
     #[must_use]
     pub fn name(&self) -> &'static str {
         match *self {
             Axis::Mu { .. } => "mu",
+            Axis::Ior { .. } => "eta",
             Axis::Roughness { convention, .. } => convention.name(),
         }
     }
@@ -220,6 +311,7 @@ impl Axis {
         match *self {
             Axis::Mu { mapping, .. } => mapping.mu(self.coordinate(i), alpha),
             Axis::Roughness { .. } => self.coordinate(i),
+            Axis::Ior { mapping, max, .. } => mapping.eta(self.coordinate(i), max.0),
         }
     }
 
@@ -244,7 +336,7 @@ impl Axis {
     pub fn alpha(&self, i: usize) -> f64 {
         match *self {
             Axis::Roughness { convention, .. } => convention.to_alpha(self.coordinate(i)),
-            Axis::Mu { .. } => panic!("alpha asked of a mu axis"),
+            Axis::Mu { .. } | Axis::Ior { .. } => panic!("alpha asked of a {} axis", self.name()),
         }
     }
 
@@ -267,6 +359,14 @@ impl Axis {
             } => {
                 format!("{}, alpha = t_i", grid.formula())
             }
+            Axis::Ior {
+                mapping, grid, max, ..
+            } => format!(
+                "{}, {}, eta_max = {}",
+                grid.formula(),
+                mapping.formula(),
+                max.0
+            ),
         }
     }
 
@@ -278,6 +378,7 @@ impl Axis {
         let t = match *self {
             Axis::Mu { mapping, .. } => mapping.coordinate(x, alpha),
             Axis::Roughness { .. } => x,
+            Axis::Ior { mapping, max, .. } => mapping.coordinate(x, max.0),
         };
         let n = self.size() as f64;
         let p = match self.grid() {
@@ -311,6 +412,30 @@ mod tests {
         };
         assert_eq!(r.listed_values(), [0.25, 0.75]);
         assert_eq!(r.alpha(1), 0.5625);
+    }
+
+    #[test]
+    fn ior_mappings_invert() {
+        for mapping in [IorMapping::Linear, IorMapping::Cycles] {
+            let axis = Axis::Ior {
+                size: 16,
+                mapping,
+                max: IorBound(3.0),
+                grid: Grid::Nodes,
+            };
+            assert_eq!(axis.value_at(0, 1.0), 1.0);
+            assert!((axis.value_at(15, 1.0) - 3.0).abs() < 1e-14);
+            for i in 0..16 {
+                let eta = axis.value_at(i, 1.0);
+                assert!((axis.position(eta, 1.0) - i as f64).abs() < 1e-9);
+                // From inside: 1 / eta sits at the same place.
+                assert!((axis.position(1.0 / eta, 1.0) - i as f64).abs() < 1e-9);
+            }
+        }
+        // Cycles' z: F0 = z^4.
+        let eta = IorMapping::Cycles.eta(0.5, 1.5);
+        let z = 0.5 * (0.5f64 / 2.5).sqrt();
+        assert!((((eta - 1.0) / (eta + 1.0)).powi(2) - z.powi(4)).abs() < 1e-15);
     }
 
     #[test]

@@ -31,6 +31,30 @@ pub enum Quantity {
     #[serde(rename = "E_bias")]
     #[cfg_attr(feature = "cli", value(name = "e-bias"))]
     EBias,
+    /// The energy albedo `R + T` of a rough dielectric interface (reflection plus transmission,
+    /// [`crate::model::dielectric`]) for light arriving from outside, at relative index `eta`
+    /// from the IOR axis: a 3-D table over (eta, roughness, mu).
+    #[serde(rename = "E_dielectric")]
+    #[cfg_attr(feature = "cli", value(name = "e-dielectric"))]
+    EDielectric,
+    /// As [`Quantity::EDielectric`], for light arriving from inside: relative index `1 / eta`.
+    #[serde(rename = "E_dielectric_inside")]
+    #[cfg_attr(feature = "cli", value(name = "e-dielectric-inside"))]
+    EDielectricInside,
+    /// `2 ∫ E_dielectric(mu) mu dmu`, a 2-D table over (eta, roughness).
+    #[serde(rename = "E_avg_dielectric")]
+    #[cfg_attr(feature = "cli", value(name = "e-avg-dielectric"))]
+    EAvgDielectric,
+    /// `2 ∫ E_dielectric_inside(mu) mu dmu`, a 2-D table over (eta, roughness).
+    #[serde(rename = "E_avg_dielectric_inside")]
+    #[cfg_attr(feature = "cli", value(name = "e-avg-dielectric-inside"))]
+    EAvgDielectricInside,
+    /// The exact dielectric Fresnel average `F_avg(eta) = 2 ∫ F(mu) mu dmu` for light arriving
+    /// from outside, a 1-D table over the IOR axis; from inside it is
+    /// `1 - (1 - F_avg(eta)) / eta^2` (reciprocity, `physics.md`). The same for every model.
+    #[serde(rename = "F_avg")]
+    #[cfg_attr(feature = "cli", value(name = "f-avg"))]
+    FAvg,
 }
 
 impl Quantity {
@@ -42,6 +66,11 @@ impl Quantity {
             Quantity::EAvg => "E_avg",
             Quantity::EScale => "E_scale",
             Quantity::EBias => "E_bias",
+            Quantity::EDielectric => "E_dielectric",
+            Quantity::EDielectricInside => "E_dielectric_inside",
+            Quantity::EAvgDielectric => "E_avg_dielectric",
+            Quantity::EAvgDielectricInside => "E_avg_dielectric_inside",
+            Quantity::FAvg => "F_avg",
         }
     }
 
@@ -53,6 +82,11 @@ impl Quantity {
             Quantity::EAvg => "e-avg",
             Quantity::EScale => "e-scale",
             Quantity::EBias => "e-bias",
+            Quantity::EDielectric => "e-dielectric",
+            Quantity::EDielectricInside => "e-dielectric-inside",
+            Quantity::EAvgDielectric => "e-avg-dielectric",
+            Quantity::EAvgDielectricInside => "e-avg-dielectric-inside",
+            Quantity::FAvg => "f-avg",
         }
     }
 
@@ -77,22 +111,82 @@ impl Quantity {
                  directions i, Fc = (1 - o.h)^5, F = 1 inside f; E_scale + E_bias = E; \
                  one_minus_E_bias is 1 - E_bias"
             }
+            Quantity::EDielectric => {
+                "energy albedo R + T of a rough dielectric interface (Walter et al. 2007 \
+                 reflection and transmission, exact Fresnel), light arriving from outside at \
+                 relative index eta (the eta axis): the fraction of the incident power a single \
+                 scattering sends on, i.e. the path tracer's sample weight; the radiance albedo \
+                 is R + T / eta^2; 1 = smooth; one_minus_E_dielectric is the energy lost"
+            }
+            Quantity::EDielectricInside => {
+                "energy albedo R + T of a rough dielectric interface, light arriving from \
+                 inside: relative index 1 / eta (eta from the eta axis); as E_dielectric \
+                 otherwise (radiance albedo R + T eta^2)"
+            }
+            Quantity::EAvgDielectric => {
+                "average energy albedo 2 * integral of E_dielectric(mu) mu dmu over [0, 1], light \
+                 arriving from outside at relative index eta"
+            }
+            Quantity::EAvgDielectricInside => {
+                "average energy albedo 2 * integral of E_dielectric_inside(mu) mu dmu over \
+                 [0, 1], light arriving from inside at relative index 1 / eta"
+            }
+            Quantity::FAvg => {
+                "average dielectric Fresnel reflectance F_avg(eta) = 2 * integral of F(mu) mu dmu \
+                 over [0, 1], exact unpolarised Fresnel, light arriving from outside at relative \
+                 index eta; from inside: 1 - (1 - F_avg(eta)) / eta^2; one_minus_F_avg is \
+                 1 - F_avg"
+            }
         }
     }
 
-    /// Whether the table has a `mu` axis (every quantity but `E_avg`).
+    /// Whether the table has a `mu` axis (every quantity but the averages).
     #[must_use]
     pub fn has_mu(self) -> bool {
-        self != Quantity::EAvg
+        !matches!(
+            self,
+            Quantity::EAvg
+                | Quantity::EAvgDielectric
+                | Quantity::EAvgDielectricInside
+                | Quantity::FAvg
+        )
+    }
+
+    /// Whether the table has a roughness axis (every quantity but `F_avg`).
+    #[must_use]
+    pub fn has_roughness(self) -> bool {
+        self != Quantity::FAvg
+    }
+
+    /// Whether the table has an index-of-refraction axis (the dielectric tables and `F_avg`).
+    #[must_use]
+    pub fn has_ior(self) -> bool {
+        matches!(
+            self,
+            Quantity::EDielectric
+                | Quantity::EDielectricInside
+                | Quantity::EAvgDielectric
+                | Quantity::EAvgDielectricInside
+                | Quantity::FAvg
+        )
+    }
+
+    /// Whether the light arrives from inside (relative index `1 / eta`).
+    #[must_use]
+    pub fn from_inside(self) -> bool {
+        matches!(
+            self,
+            Quantity::EDielectricInside | Quantity::EAvgDielectricInside
+        )
     }
 
     /// The weight `h(o.h)` a split-sum quantity puts on the albedo integrand (`None`: `h = 1`).
     #[must_use]
     pub fn weight(self) -> Option<fn(f64) -> f64> {
         match self {
-            Quantity::E | Quantity::EAvg => None,
             Quantity::EScale => Some(|c| 1.0 - schlick_weight(c)),
             Quantity::EBias => Some(schlick_weight),
+            _ => None,
         }
     }
 }
@@ -150,9 +244,13 @@ impl Method {
 pub struct TableSpec {
     pub model: Model,
     pub quantity: Quantity,
-    /// The roughness axis (rows of a 2-D table; the only axis of a 1-D table).
-    pub roughness: Axis,
-    /// The `mu` axis (columns, the fastest-varying index) of a 2-D table; `None` for `E_avg`.
+    /// The index-of-refraction axis, the slowest-varying, of the dielectric tables and `F_avg`;
+    /// `None` otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ior: Option<Axis>,
+    /// The roughness axis (rows of a 2-D table; the only axis of `E_avg`); `None` for `F_avg`.
+    pub roughness: Option<Axis>,
+    /// The `mu` axis (columns, the fastest-varying index); `None` for the averages.
     pub mu: Option<Axis>,
     /// How the values are computed.
     #[serde(default)]
@@ -195,10 +293,14 @@ impl TableSpec {
         )
     }
 
-    /// The axes, slowest-varying first: `[roughness, mu]` or `[roughness]`.
+    /// The axes, slowest-varying first: `[eta, roughness, mu]` with the absent ones left out.
     #[must_use]
     pub fn axes(&self) -> Vec<Axis> {
-        std::iter::once(self.roughness).chain(self.mu).collect()
+        self.ior
+            .into_iter()
+            .chain(self.roughness)
+            .chain(self.mu)
+            .collect()
     }
 
     /// The shape, slowest-varying first.
@@ -219,18 +321,29 @@ impl TableSpec {
         self.len() == 0
     }
 
-    /// The roughness convention of the roughness axis.
+    /// The roughness convention of the roughness axis (`r` for `F_avg`, which has none).
     #[must_use]
     pub fn roughness_convention(&self) -> RoughnessConvention {
         match self.roughness {
-            Axis::Roughness { convention, .. } => convention,
-            Axis::Mu { .. } => unreachable!("the roughness axis is a roughness axis"),
+            Some(Axis::Roughness { convention, .. }) => convention,
+            _ => RoughnessConvention::Perceptual,
         }
     }
 
-    /// A file-name stem naming the table: `ggx-height-correlated-E`.
+    /// The roughness axis. Panics for `F_avg`, the only table without one.
+    #[must_use]
+    pub fn roughness_axis(&self) -> Axis {
+        self.roughness
+            .expect("every table but F_avg has a roughness axis")
+    }
+
+    /// A file-name stem naming the table: `ggx-height-correlated-E` (`dielectric-F_avg` for
+    /// `F_avg`, which is the same for every model).
     #[must_use]
     pub fn id(&self) -> String {
+        if self.quantity == Quantity::FAvg {
+            return "dielectric-F_avg".to_string();
+        }
         format!(
             "{}-{}-{}",
             self.model.ndf,
@@ -239,20 +352,53 @@ impl TableSpec {
         )
     }
 
+    /// Texel `index` (row-major, slowest axis first) split into its `[eta, roughness, mu]`
+    /// indices, each `None` where the axis is absent.
+    #[must_use]
+    pub fn texel_indices(&self, index: usize) -> [Option<usize>; 3] {
+        let mut rest = index;
+        let mut out = [None; 3];
+        // Fastest axis first.
+        for (slot, axis) in [(2, self.mu), (1, self.roughness), (0, self.ior)] {
+            if let Some(axis) = axis {
+                out[slot] = Some(rest % axis.size());
+                rest /= axis.size();
+            }
+        }
+        out
+    }
+
     /// The `(alpha, mu)` at which texel `index` (row-major, slowest axis first) is computed;
-    /// `mu` is `None` for `E_avg`.
+    /// `mu` is `None` for the averages, `alpha` is 0 for `F_avg`.
     #[must_use]
     pub fn texel_coordinates(&self, index: usize) -> (f64, Option<f64>) {
-        match self.mu {
-            Some(mu) => {
-                let n = mu.size();
-                let (alpha, mu) = self.point(
-                    self.roughness.coordinate(index / n),
-                    mu.coordinate(index % n),
-                );
-                (alpha, mu)
-            }
-            None => (self.roughness.alpha(index), None),
+        let [_, r, m] = self.texel_indices(index);
+        let (Some(roughness), Some(r)) = (self.roughness, r) else {
+            return (0.0, None);
+        };
+        match (self.mu, m) {
+            (Some(mu), Some(m)) => self.point(roughness.coordinate(r), mu.coordinate(m)),
+            _ => (roughness.alpha(r), None),
+        }
+    }
+
+    /// The relative index of refraction at which texel `index` is computed: the IOR axis' `eta`,
+    /// or `1 / eta` for light arriving from inside; `None` without an IOR axis.
+    #[must_use]
+    pub fn texel_eta(&self, index: usize) -> Option<f64> {
+        let [i, _, _] = self.texel_indices(index);
+        let eta = self.ior?.value_at(i?, 1.0);
+        Some(self.relative_eta(eta))
+    }
+
+    /// The relative index a table of this quantity is computed at for the IOR axis value `eta`
+    /// (`1 / eta` from inside).
+    #[must_use]
+    pub fn relative_eta(&self, eta: f64) -> f64 {
+        if self.quantity.from_inside() {
+            1.0 / eta
+        } else {
+            eta
         }
     }
 
@@ -261,6 +407,7 @@ impl TableSpec {
     /// boundary layer's limit, taken at [`axis::LAYER_LIMIT_ALPHA`] (see [`axis`]).
     #[must_use]
     pub fn point(&self, t_roughness: f64, t_mu: f64) -> (f64, Option<f64>) {
+        debug_assert!(self.roughness.is_some(), "F_avg has no roughness axis");
         let alpha = self.roughness_convention().to_alpha(t_roughness);
         match self.mu {
             Some(Axis::Mu { mapping, .. }) => {
@@ -326,6 +473,7 @@ impl Table {
 
     /// The value a renderer's bilinear lookup returns at `(mu, roughness)` (roughness in the
     /// table's convention; `mu` is ignored for a 1-D table), with clamp-to-edge.
+    /// For a dielectric table, [`Table::lookup_eta`] names the IOR too (here it is 1).
     #[must_use]
     pub fn lookup(&self, mu: f64, roughness: f64) -> f64 {
         self.lookup_channel(&self.value, mu, roughness)
@@ -340,25 +488,63 @@ impl Table {
     /// As [`Table::lookup`], of any channel laid out like the table (one of [`Table::channels`]).
     #[must_use]
     pub fn lookup_channel(&self, channel: &[f64], mu: f64, roughness: f64) -> f64 {
+        self.lookup_channel_eta(channel, mu, roughness, 1.0)
+    }
+
+    /// The bilinear (trilinear with an IOR axis) lookup of `channel` at `(mu, roughness, eta)`,
+    /// clamp-to-edge; `eta` may be given as listed on the axis or as the relative index of an
+    /// inside table (`eta < 1` is looked up at `1 / eta`). Absent axes ignore their coordinate.
+    #[must_use]
+    pub fn lookup_channel_eta(&self, channel: &[f64], mu: f64, roughness: f64, eta: f64) -> f64 {
         let alpha = self.spec.roughness_convention().to_alpha(roughness);
-        let lerp_axis = |axis: &Axis, x: f64| {
+        let shape = self.spec.shape();
+        // Per axis, slowest first: the two samples to blend, the second's weight, the stride.
+        let corners: Vec<Corner> = [
+            (self.spec.ior, eta),
+            (self.spec.roughness, roughness),
+            (self.spec.mu, mu),
+        ]
+        .into_iter()
+        .filter_map(|(axis, x)| axis.map(|axis| (axis, x)))
+        .enumerate()
+        .map(|(k, (axis, x))| {
             let p = axis.position(x, alpha);
             let i = (p.floor() as usize).min(axis.size().saturating_sub(2));
-            (i, p - i as f64)
-        };
-        let (ri, rf) = lerp_axis(&self.spec.roughness, roughness);
-        let r1 = (ri + 1).min(self.spec.roughness.size() - 1);
-        match self.spec.mu {
-            None => channel[ri] * (1.0 - rf) + channel[r1] * rf,
-            Some(mu_axis) => {
-                let n = mu_axis.size();
-                let (mi, mf) = lerp_axis(&mu_axis, mu);
-                let m1 = (mi + 1).min(n - 1);
-                let at = |r: usize, m: usize| channel[r * n + m];
-                let row0 = at(ri, mi) * (1.0 - mf) + at(ri, m1) * mf;
-                let row1 = at(r1, mi) * (1.0 - mf) + at(r1, m1) * mf;
-                row0 * (1.0 - rf) + row1 * rf
+            Corner {
+                low: i,
+                high: (i + 1).min(axis.size() - 1),
+                weight: p - i as f64,
+                stride: shape[k + 1..].iter().product(),
             }
+        })
+        .collect();
+        blend(channel, &corners, 0)
+    }
+
+    /// As [`Table::lookup`] with the IOR coordinate of a dielectric table.
+    #[must_use]
+    pub fn lookup_eta(&self, mu: f64, roughness: f64, eta: f64) -> f64 {
+        self.lookup_channel_eta(&self.value, mu, roughness, eta)
+    }
+}
+
+/// One axis of a lookup: the two samples blended, the second's weight, the index stride.
+struct Corner {
+    low: usize,
+    high: usize,
+    weight: f64,
+    stride: usize,
+}
+
+/// Blends the fastest axis first, then each slower one, as a GPU's filter does (for a 2-D table:
+/// two rows along `mu`, then between the rows).
+fn blend(channel: &[f64], corners: &[Corner], base: usize) -> f64 {
+    match corners.split_first() {
+        None => channel[base],
+        Some((c, rest)) => {
+            let a = blend(channel, rest, base + c.low * c.stride);
+            let b = blend(channel, rest, base + c.high * c.stride);
+            a * (1.0 - c.weight) + b * c.weight
         }
     }
 }
@@ -379,11 +565,12 @@ mod tests {
             },
             quantity: Quantity::E,
             method: Method::Qmc,
-            roughness: Axis::Roughness {
+            ior: None,
+            roughness: Some(Axis::Roughness {
                 size: 5,
                 convention: RoughnessConvention::Perceptual,
                 grid,
-            },
+            }),
             mu: Some(Axis::Mu {
                 size: 4,
                 mapping,
@@ -409,7 +596,7 @@ mod tests {
         for grid in [Grid::Centers, Grid::Nodes] {
             for mapping in [MuMapping::Linear, MuMapping::Sqrt, MuMapping::Adaptive] {
                 let t = synthetic(grid, mapping);
-                let (r_axis, mu_axis) = (t.spec.roughness, t.spec.mu.unwrap());
+                let (r_axis, mu_axis) = (t.spec.roughness_axis(), t.spec.mu.unwrap());
                 // At alpha = 0 the adaptive mapping sends every mu > 0 to the last column.
                 let first_row = usize::from(grid == Grid::Nodes && mapping == MuMapping::Adaptive);
                 for row in first_row..5 {

@@ -80,9 +80,9 @@ pub fn furnace(e: &Table, e_avg: &Table, density: usize) -> Result<FurnaceReport
     let convention = e.spec.roughness_convention();
     let avg_convention = e_avg.spec.roughness_convention();
     let steps = |n: usize| density.max(1) * n;
-    let rows: Vec<FurnaceRow> = (0..=steps(e.spec.roughness.size()))
+    let rows: Vec<FurnaceRow> = (0..=steps(e.spec.roughness_axis().size()))
         .map(|j| {
-            let roughness = j as f64 / steps(e.spec.roughness.size()) as f64;
+            let roughness = j as f64 / steps(e.spec.roughness_axis().size()) as f64;
             let alpha = convention.to_alpha(roughness);
             let loss = |mu: f64| e.lookup_one_minus(mu, roughness);
             // The E lookup is smooth between the mu of its nodes (and of the clamp edges).

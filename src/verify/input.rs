@@ -284,7 +284,8 @@ fn spec_and_values(
         reference_digits: None,
         model: layout.model,
         quantity: layout.quantity,
-        roughness,
+        ior: None,
+        roughness: Some(roughness),
         mu,
         method: crate::table::Method::Qmc,
         qmc: QmcSettings::default(),
@@ -300,6 +301,14 @@ fn spec_and_values(
         return Err(format!(
             "every axis needs at least 2 samples (shape {:?})",
             layout.shape
+        ));
+    }
+    if layout.quantity.has_ior() {
+        return Err(format!(
+            "--quantity {}: only kiln's own dielectric and F_avg tables can be audited (their \
+             sidecar or header describes the IOR axis); external layouts with an IOR axis are \
+             not supported yet",
+            layout.quantity.cli_name()
         ));
     }
     let two_d = layout.quantity.has_mu();

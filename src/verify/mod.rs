@@ -6,10 +6,15 @@ pub mod furnace;
 pub mod input;
 
 use crate::integrate::average_quadrature::quadrature_average_albedo;
+use crate::integrate::dielectric::{
+    reference_dielectric_albedo, reference_dielectric_average_albedo,
+};
 use crate::integrate::reference::{
     ReferenceSettings, ReferenceValue, reference_albedo, reference_weighted_albedo,
 };
-use crate::table::{Table, TableSpec};
+use crate::model::Fresnel;
+use crate::table::axis::Axis;
+use crate::table::{Quantity, Table, TableSpec};
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -44,8 +49,11 @@ impl Default for AuditSettings {
 /// One compared point.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Point {
-    /// `mu` (absent for `E_avg`).
+    /// `mu` (absent for the averages).
     pub mu: Option<f64>,
+    /// The relative index of refraction (tables with an IOR axis only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub eta: Option<f64>,
     /// Roughness in the table's own convention (`r` or `alpha`).
     pub roughness: f64,
     pub alpha: f64,
@@ -88,16 +96,41 @@ pub struct Report {
     pub reference_converged: bool,
 }
 
-/// The reference value of `spec`'s quantity at `(alpha, mu)`: `E` by the reference, `E_avg` by
+/// The reference value of `spec`'s quantity at `(alpha, mu)` and, for the tables with an IOR
+/// axis, the relative index `eta` ([`TableSpec::texel_eta`]): `E` by the reference, `E_avg` by
 /// the composite rule ([`quadrature_average_albedo`], within 1e-10 of the nested reference), the
-/// split-sum channels by the reference with their weight.
+/// split-sum channels by the reference with their weight, the dielectric tables by their own
+/// quadrature ([`crate::integrate::dielectric`]), `F_avg` by Gauss-Kronrod to 1e-14.
+///
+/// # Panics
+/// If a table with an IOR axis is given no `eta`.
 #[must_use]
 pub fn reference_value(
     spec: &TableSpec,
     alpha: f64,
     mu: Option<f64>,
+    eta: Option<f64>,
     settings: &ReferenceSettings,
 ) -> ReferenceValue {
+    if spec.quantity.has_ior() {
+        let eta = eta.expect("a table with an IOR axis needs eta");
+        return match (spec.quantity, mu) {
+            (Quantity::FAvg, _) => {
+                let f = Fresnel::Dielectric { eta }.average_report();
+                ReferenceValue {
+                    value: f.value[0],
+                    one_minus_value: 1.0 - f.value[0],
+                    error: f.error,
+                    evaluations: f.evaluations,
+                    converged: true,
+                }
+            }
+            (_, Some(mu)) => reference_dielectric_albedo(spec.model, alpha, mu, eta, settings)
+                .as_reference_value(),
+            (_, None) => reference_dielectric_average_albedo(spec.model, alpha, eta, settings)
+                .as_reference_value(),
+        };
+    }
     match (mu, spec.quantity.weight()) {
         (Some(mu), None) => reference_albedo(spec.model, alpha, mu, settings),
         (Some(mu), Some(h)) => reference_weighted_albedo(spec.model, alpha, mu, h, settings),
@@ -105,18 +138,31 @@ pub fn reference_value(
     }
 }
 
-/// The truth at `(mu, alpha)`: value, error estimate and whether it converged.
-fn truth(against: &Against, table: &Table, mu: Option<f64>, alpha: f64) -> (f64, f64, bool) {
+/// The truth at `(mu, alpha, eta)`: value, error estimate and whether it converged.
+fn truth(against: &Against, table: &Table, at: Coordinates) -> (f64, f64, bool) {
     match against {
         Against::Reference(settings) => {
-            let r = reference_value(&table.spec, alpha, mu, settings);
+            let r = reference_value(&table.spec, at.alpha, at.mu, at.eta, settings);
             (r.value, r.error, r.converged)
         }
         Against::Table(other) => {
-            let theirs = other.spec.roughness_convention().from_alpha(alpha);
-            (other.lookup(mu.unwrap_or(1.0), theirs), 0.0, true)
+            let theirs = other.spec.roughness_convention().from_alpha(at.alpha);
+            let eta = at.eta.unwrap_or(1.0);
+            (
+                other.lookup_eta(at.mu.unwrap_or(1.0), theirs, eta),
+                0.0,
+                true,
+            )
         }
     }
+}
+
+/// Where a value is compared: `alpha`, and `mu` and the relative `eta` where the table has them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Coordinates {
+    pub alpha: f64,
+    pub mu: Option<f64>,
+    pub eta: Option<f64>,
 }
 
 /// Compares the stored values with the truth at the nodes ([`node_errors`]) and the table's
@@ -135,14 +181,16 @@ pub fn audit(
     let clamp = |x: f64| x.max(settings.clamp_min);
 
     // One table value against the truth at (mu, alpha), with the truth's error estimate.
-    let compare = |mu: Option<f64>, alpha: f64, value: f64| {
-        let (reference, error_estimate, converged) = truth(against, table, mu, alpha);
+    let compare = |at: Coordinates, value: f64| {
+        let (reference, error_estimate, converged) = truth(against, table, at);
         progress();
         let error = (value - reference).abs();
+        let Coordinates { alpha, mu, eta } = at;
         let roughness = convention.from_alpha(alpha);
         (
             Point {
                 mu,
+                eta,
                 roughness,
                 alpha,
                 table: value,
@@ -167,8 +215,12 @@ pub fn audit(
         .into_par_iter()
         .map(|k| {
             let (alpha, mu) = spec.texel_coordinates(k);
-            let alpha = convention.to_alpha(clamp(convention.from_alpha(alpha)));
-            let (mut point, estimate, converged) = compare(mu.map(clamp), alpha, table.value[k]);
+            let at = Coordinates {
+                alpha: convention.to_alpha(clamp(convention.from_alpha(alpha))),
+                mu: mu.map(clamp),
+                eta: spec.texel_eta(k),
+            };
+            let (mut point, estimate, converged) = compare(at, table.value[k]);
             if let (true, Against::Table(other)) = (same_layout, against) {
                 point.reference = other.value[k];
                 point.error = (point.table - point.reference).abs();
@@ -180,9 +232,13 @@ pub fn audit(
     // Lookups at every point of `lookup_coordinates`.
     let lookups: Vec<(Point, f64, bool)> = lookup_coordinates(spec, settings)
         .into_par_iter()
-        .map(|(alpha, mu)| {
-            let value = table.lookup(mu.unwrap_or(1.0), convention.from_alpha(alpha));
-            compare(mu, alpha, value)
+        .map(|at| {
+            let value = table.lookup_eta(
+                at.mu.unwrap_or(1.0),
+                convention.from_alpha(at.alpha),
+                at.eta.unwrap_or(1.0),
+            );
+            compare(at, value)
         })
         .collect();
 
@@ -208,12 +264,15 @@ pub fn audit(
         quantity: spec.quantity.symbol().to_string(),
         ndf: spec.model.ndf.name().to_string(),
         masking: spec.model.masking.name().to_string(),
-        roughness_axis: convention.name().to_string(),
+        roughness_axis: match spec.roughness {
+            Some(_) => convention.name().to_string(),
+            None => "none".to_string(),
+        },
         mu_axis: spec.mu.map(|axis| match axis {
             crate::table::axis::Axis::Mu { mapping, .. } => mapping.name().to_string(),
             _ => unreachable!(),
         }),
-        grid: spec.roughness.grid().name().to_string(),
+        grid: spec.axes()[0].grid().name().to_string(),
         shape: spec.shape(),
         clamp_min: settings.clamp_min,
         against: match against {
@@ -243,27 +302,45 @@ pub(crate) fn grazing_probes() -> Vec<f64> {
     probes
 }
 
-/// The `(alpha, mu)` at which [`audit`] compares lookups: a ladder over each axis' texture
-/// coordinate `t` in [0, 1], in steps of `1 / (density N)` (texel centres or nodes, the points
-/// halfway between, and the axis ends), and for a 2-D table the grazing probes on every rung
-/// of the roughness ladder.
+/// The points at which [`audit`] compares lookups: a ladder over each axis' texture coordinate
+/// `t` in [0, 1], in steps of `1 / (density N)` (texel centres or nodes, the points halfway
+/// between, and the axis ends), and for a table with a `mu` axis the grazing probes on every
+/// rung of the roughness ladder.
 #[must_use]
-pub fn lookup_coordinates(spec: &TableSpec, settings: &AuditSettings) -> Vec<(f64, Option<f64>)> {
+pub fn lookup_coordinates(spec: &TableSpec, settings: &AuditSettings) -> Vec<Coordinates> {
     let ladder = |n: usize| -> Vec<f64> {
         let steps = settings.density.max(1) * n;
         (0..=steps).map(|j| j as f64 / steps as f64).collect()
     };
+    let etas: Vec<Option<f64>> = match spec.ior {
+        Some(axis @ Axis::Ior { mapping, max, .. }) => ladder(axis.size())
+            .into_iter()
+            .map(|t| Some(spec.relative_eta(mapping.eta(t, max.0))))
+            .collect(),
+        _ => vec![None],
+    };
     let mut points = Vec::new();
-    for t_r in ladder(spec.roughness.size()) {
-        match spec.mu {
-            Some(axis) => {
-                for t_mu in ladder(axis.size()) {
-                    points.push(spec.point(t_r, t_mu));
+    for eta in etas {
+        let Some(roughness) = spec.roughness else {
+            points.push(Coordinates {
+                alpha: 0.0,
+                mu: None,
+                eta,
+            });
+            continue;
+        };
+        for t_r in ladder(roughness.size()) {
+            let at = |(alpha, mu): (f64, Option<f64>)| Coordinates { alpha, mu, eta };
+            match spec.mu {
+                Some(axis) => {
+                    for t_mu in ladder(axis.size()) {
+                        points.push(at(spec.point(t_r, t_mu)));
+                    }
+                    let alpha = spec.roughness_convention().to_alpha(t_r);
+                    points.extend(grazing_probes().into_iter().map(|mu| at((alpha, Some(mu)))));
                 }
-                let alpha = spec.roughness_convention().to_alpha(t_r);
-                points.extend(grazing_probes().into_iter().map(|mu| (alpha, Some(mu))));
+                None => points.push(at(spec.point(t_r, 0.0))),
             }
-            None => points.push(spec.point(t_r, 0.0)),
         }
     }
     points
@@ -319,7 +396,7 @@ pub fn node_errors_at(
         .par_iter()
         .map(|&k| {
             let (alpha, mu) = spec.texel_coordinates(k);
-            let reference = reference_value(spec, alpha, mu, settings);
+            let reference = reference_value(spec, alpha, mu, spec.texel_eta(k), settings);
             // `1 - E` where both carry it directly; the split-sum channels by value.
             if spec.quantity.weight().is_some() {
                 (table.value[k] - reference.value).abs()

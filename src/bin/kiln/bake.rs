@@ -4,7 +4,8 @@ use crate::args::{CONVENTIONS, parse_samples, parse_size};
 use clap::Args;
 use kiln::format::{self, Format, Precision};
 use kiln::{
-    BakeOptions, Grid, Masking, Method, MuMapping, Ndf, QmcSettings, Quantity, RoughnessConvention,
+    BakeOptions, Grid, IorMapping, Masking, Method, MuMapping, Ndf, QmcSettings, Quantity,
+    RoughnessConvention,
 };
 use std::path::PathBuf;
 use std::time::Instant;
@@ -12,7 +13,8 @@ use std::time::Instant;
 /// Bake E(mu, roughness) and E_avg(roughness) tables and write them to a directory.
 #[derive(Args, Debug)]
 #[command(
-    long_about = "Bake E(mu, roughness) and E_avg(roughness) tables and write them as EXR, \
+    long_about = "Bake E(mu, roughness) and E_avg(roughness) tables (and on request split-sum, \
+                  dielectric and F_avg(eta) tables: see --quantity) and write them as EXR, \
                   raw binary, Rust source, JSON and PNG. By default to a max error of 1e-7: \
                   kiln picks the cheapest method that meets --max-error (the deterministic \
                   quadrature below 1e-3, quasi-Monte Carlo with visible-normal sampling and \
@@ -39,12 +41,27 @@ pub struct BakeArgs {
     /// Tables to bake per model, comma-separated: e (E), e-avg (E_avg), and the split-sum
     /// channels e-scale (integral of (1 - Fc) f mu_i) and e-bias (integral of Fc f mu_i),
     /// Fc = (1 - o.h)^5: Schlick's E_F = F0 * E_scale + F90 * E_bias. The multiscatter layout
-    /// of Filament and Godot is e-bias with e.
+    /// of Filament and Godot is e-bias with e. Dielectric (glass) tables over (eta, roughness,
+    /// mu): e-dielectric and e-dielectric-inside (energy albedo R + T for light arriving from
+    /// outside, relative index eta, and from inside, 1 / eta), e-avg-dielectric and
+    /// e-avg-dielectric-inside over (eta, roughness), and f-avg, the exact dielectric F_avg(eta).
     #[arg(long, value_enum, value_delimiter = ',', default_value = "e,e-avg")]
     quantity: Vec<Quantity>,
     /// Samples per axis: E is SIZE x SIZE, E_avg has SIZE entries. 2 to 4096.
     #[arg(long, default_value_t = BakeOptions::DEFAULT_SIZE, value_parser = parse_size, allow_negative_numbers = true)]
     size: usize,
+    /// Samples on the IOR axis of the dielectric tables and f-avg (their roughness and mu
+    /// axes have --size samples; Cycles' glass tables are 16 x 16 x 16). 2 to 4096.
+    #[arg(long, default_value_t = BakeOptions::DEFAULT_IOR_SIZE, value_parser = parse_size, allow_negative_numbers = true)]
+    ior_size: usize,
+    /// Spacing of the IOR axis over [1, --ior-max]: cycles (linear in sqrt((eta - 1) /
+    /// (eta + 1)), denser near eta = 1 where the inside tables change fastest) or linear.
+    /// The axis lists eta >= 1; inside tables are computed at 1 / eta.
+    #[arg(long, value_enum, default_value = "cycles")]
+    ior_axis: IorMapping,
+    /// The top of the IOR axis, above 1 (Unreal's glass table goes to 3; diamond is 2.42).
+    #[arg(long, default_value_t = BakeOptions::DEFAULT_IOR_MAX, allow_negative_numbers = true)]
+    ior_max: f64,
     /// QMC samples per E texel, a power of two (split over the scrambles); implies --method qmc
     /// [default: 2^16].
     #[arg(long, value_parser = parse_samples, allow_negative_numbers = true)]
@@ -68,6 +85,7 @@ pub struct BakeArgs {
         long,
         conflicts_with_all = ["ndf", "masking", "quantity", "size", "samples", "avg_samples",
             "scrambles", "seed", "format", "precision", "roughness_axis", "mu_axis", "grid",
+            "ior_size", "ior_axis", "ior_max",
             "method", "no_reference_check", "max_error"]
     )]
     scene: Option<PathBuf>,
@@ -147,6 +165,9 @@ pub fn run(args: BakeArgs) -> kiln::Result<()> {
         roughness_convention: args.roughness_axis,
         mu_mapping: args.mu_axis,
         grid: args.grid,
+        ior_size: args.ior_size,
+        ior_mapping: args.ior_axis,
+        ior_max: args.ior_max,
         check_against_reference: !args.no_reference_check,
         method: args.method.unwrap_or(Method::Qmc),
         max_error,
@@ -175,7 +196,7 @@ pub fn run(args: BakeArgs) -> kiln::Result<()> {
                 None => String::new(),
             };
             println!(
-                "{:<32} {:>9} max std error {:.1e}{measured}",
+                "{:<44} {:>9} max std error {:.1e}{measured}",
                 table.spec.id(),
                 shape.join("x"),
                 table.max_std_error()

@@ -170,10 +170,22 @@ impl VerifyArgs {
 }
 
 fn describe(point: &Point, convention: &str) -> String {
-    let at = match point.mu {
+    let mut at = match point.mu {
         Some(mu) => format!("mu = {mu:.6}, "),
         None => String::new(),
     };
+    if let Some(eta) = point.eta {
+        at += &format!("eta = {eta:.6}, ");
+    }
+    if convention == "none" {
+        // F_avg: no roughness axis.
+        return format!(
+            "eta = {:.6}: table {:.7}, reference {:.7}",
+            point.eta.unwrap_or(1.0),
+            point.table,
+            point.reference
+        );
+    }
     format!(
         "{at}{convention} = {:.6} (alpha {:.3e}): table {:.7}, reference {:.7}",
         point.roughness, point.alpha, point.table, point.reference
