@@ -20,12 +20,25 @@
 //! ndf = "beckmann"
 //! roughness = 0.3
 //! fresnel = { dielectric = { ior = 1.5 } }  # or { schlick = { f0 = 0.04 } }, or "none" (F = 1)
+//!
+//! [[material]]
+//! name = "window"
+//! ndf = "ggx"
+//! roughness = 0.1
+//! fresnel = { dielectric = { ior = 1.5 } }
+//! transmission = true           # glass: light refracts through (needs a dielectric fresnel)
 //! ```
 //!
 //! The plan ([`Scene::plan`]) lists each table once, with the materials that need it: `E` and
 //! `E_avg` for every NDF and masking combination in use (the Kulla-Conty lobe needs both, whatever
-//! the Fresnel model), and per material the scalars it needs: `F_avg` per channel
-//! ([`crate::Fresnel::average`]) for the lobe's colour term.
+//! the Fresnel model), for the combinations a transmissive material uses the dielectric tables
+//! `E_dielectric`, `E_dielectric_inside` and their averages over (eta, roughness[, mu]) (energy
+//! compensation of glass, [`crate::model::dielectric`]), and per material the scalars it needs:
+//! `F_avg` per channel ([`crate::Fresnel::average`]) for the lobe's colour term.
+//!
+//! The dielectric tables are [`DIELECTRIC_SIZE`] samples per axis (Cycles' 16 x 16 x 16), with an
+//! IOR axis from 1 to the larger of 3 and the scene's highest `max(ior, 1 / ior)`; they are baked
+//! as a bake of their own, so adding a glass material never re-bakes the `E` tables.
 
 use crate::error::{Error, Result};
 use crate::format::{Format, Precision};
@@ -34,6 +47,17 @@ use crate::model::{Fresnel, Masking, Model, Ndf};
 use crate::table::Quantity;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
+
+/// Samples per axis of a scene's dielectric tables (IOR, roughness and `mu`).
+pub const DIELECTRIC_SIZE: usize = 16;
+
+/// The dielectric tables a transmissive material's model needs.
+pub const DIELECTRIC_QUANTITIES: [Quantity; 4] = [
+    Quantity::EDielectric,
+    Quantity::EDielectricInside,
+    Quantity::EAvgDielectric,
+    Quantity::EAvgDielectricInside,
+];
 
 /// A scene file.
 #[derive(Clone, Debug, Deserialize, PartialEq)]
@@ -67,6 +91,10 @@ pub struct Material {
     pub roughness: Roughness,
     #[serde(default)]
     pub fresnel: FresnelSpec,
+    /// Whether light refracts through the material (glass): its model then needs the
+    /// dielectric tables. Needs a dielectric Fresnel.
+    #[serde(default)]
+    pub transmission: bool,
 }
 
 impl Material {
@@ -213,6 +241,14 @@ impl Scene {
                 .model()
                 .validate()
                 .map_err(|e| bad(format!("material '{}': {e}", m.name)))?;
+            if m.transmission && !matches!(m.fresnel, FresnelSpec::Dielectric { .. }) {
+                return Err(bad(format!(
+                    "material '{}': transmission = true needs a dielectric fresnel, e.g. \
+                     fresnel = {{ dielectric = {{ ior = 1.5 }} }} (light refracts only through \
+                     a dielectric interface)",
+                    m.name
+                )));
+            }
         }
         if let Some(x) = self.output.as_ref().and_then(|o| o.max_error)
             && !(crate::BakeOptions::MIN_MAX_ERROR..=0.5).contains(&x)
@@ -238,24 +274,59 @@ impl Scene {
         models
     }
 
+    /// The combinations a transmissive material uses, in order of first appearance.
+    #[must_use]
+    pub fn transmissive_models(&self) -> Vec<Model> {
+        let mut models: Vec<Model> = Vec::new();
+        for m in self.materials.iter().filter(|m| m.transmission) {
+            if !models.contains(&m.model()) {
+                models.push(m.model());
+            }
+        }
+        models
+    }
+
+    /// The top of the dielectric tables' IOR axis: 3, or the scene's highest
+    /// `max(ior, 1 / ior)` of a transmissive material if that is higher.
+    #[must_use]
+    pub fn ior_max(&self) -> f64 {
+        self.materials
+            .iter()
+            .filter(|m| m.transmission)
+            .filter_map(|m| match m.fresnel {
+                FresnelSpec::Dielectric { ior } => Some(ior.max(1.0 / ior)),
+                _ => None,
+            })
+            .fold(crate::BakeOptions::DEFAULT_IOR_MAX, f64::max)
+    }
+
     /// The minimal set of tables the scene needs and the scalars of each material.
     #[must_use]
     pub fn plan(&self) -> Plan {
+        let planned = |model: Model, quantity, glass_only: bool| PlannedTable {
+            ndf: model.ndf,
+            masking: model.masking,
+            quantity,
+            materials: self
+                .materials
+                .iter()
+                .filter(|m| m.model() == model && (m.transmission || !glass_only))
+                .map(|m| m.name.clone())
+                .collect(),
+        };
+        let transmissive = self.transmissive_models();
         let tables = self
             .models()
             .into_iter()
             .flat_map(|model| {
-                [Quantity::E, Quantity::EAvg].map(|quantity| PlannedTable {
-                    ndf: model.ndf,
-                    masking: model.masking,
-                    quantity,
-                    materials: self
-                        .materials
-                        .iter()
-                        .filter(|m| m.model() == model)
-                        .map(|m| m.name.clone())
-                        .collect(),
-                })
+                let mut tables = vec![
+                    planned(model, Quantity::E, false),
+                    planned(model, Quantity::EAvg, false),
+                ];
+                if transmissive.contains(&model) {
+                    tables.extend(DIELECTRIC_QUANTITIES.map(|q| planned(model, q, true)));
+                }
+                tables
             })
             .collect();
         let materials = self
@@ -269,6 +340,7 @@ impl Scene {
                     masking: m.masking,
                     roughness: m.roughness.range(),
                     fresnel: fresnel.name().to_string(),
+                    transmission: m.transmission,
                     f_avg: fresnel.average(),
                 }
             })
@@ -297,7 +369,9 @@ impl Scene {
             .into()
     }
 
-    /// The bake options of each NDF and masking combination in the plan, in plan order.
+    /// The bake options of each NDF and masking combination in the plan, in plan order: its
+    /// `E` and `E_avg`, then (a bake of their own, so that their options never change the `E`
+    /// tables' cache keys) its dielectric tables if a transmissive material uses it.
     #[must_use]
     pub fn bake_options(&self) -> Vec<crate::BakeOptions> {
         let max_error = self
@@ -305,13 +379,25 @@ impl Scene {
             .as_ref()
             .and_then(|o| o.max_error)
             .unwrap_or(crate::BakeOptions::DEFAULT_MAX_ERROR);
+        let transmissive = self.transmissive_models();
+        let ior_max = self.ior_max();
         self.models()
             .into_iter()
-            .map(|model| crate::BakeOptions {
-                ndfs: vec![model.ndf],
-                maskings: vec![model.masking],
-                max_error: Some(max_error),
-                ..crate::BakeOptions::default()
+            .flat_map(|model| {
+                let base = crate::BakeOptions {
+                    ndfs: vec![model.ndf],
+                    maskings: vec![model.masking],
+                    max_error: Some(max_error),
+                    ..crate::BakeOptions::default()
+                };
+                let glass = transmissive.contains(&model).then(|| crate::BakeOptions {
+                    quantities: DIELECTRIC_QUANTITIES.to_vec(),
+                    size: DIELECTRIC_SIZE,
+                    ior_size: DIELECTRIC_SIZE,
+                    ior_max,
+                    ..base.clone()
+                });
+                std::iter::once(base).chain(glass)
             })
             .collect()
     }
@@ -373,6 +459,8 @@ pub struct PlannedMaterial {
     /// `[min, max]` perceptual roughness.
     pub roughness: [f64; 2],
     pub fresnel: String,
+    /// Whether light refracts through it (it then uses the dielectric tables).
+    pub transmission: bool,
     /// `F_avg` per channel, for the Kulla-Conty colour term
     /// ([`crate::model::kulla_conty::fresnel_colour`]).
     pub f_avg: Rgb,
@@ -429,6 +517,55 @@ fresnel = { schlick = { f0 = 0.04 } }
     }
 
     #[test]
+    fn glass_adds_the_dielectric_tables_for_its_model_only() {
+        let scene = Scene::parse(
+            "[[material]]\nname = \"steel\"\nndf = \"ggx\"\nroughness = 0.3\n\n\
+             [[material]]\nname = \"window\"\nndf = \"ggx\"\nroughness = 0.1\n\
+             fresnel = { dielectric = { ior = 1.5 } }\ntransmission = true\n\n\
+             [[material]]\nname = \"gem\"\nndf = \"ggx\"\nroughness = 0.0\n\
+             fresnel = { dielectric = { ior = 3.4 } }\ntransmission = true\n\n\
+             [[material]]\nname = \"tile\"\nndf = \"beckmann\"\nroughness = 0.3\n\
+             fresnel = { dielectric = { ior = 1.5 } }\n",
+            "glass.toml",
+        )
+        .unwrap();
+        let plan = scene.plan();
+        let quantities: Vec<(Ndf, Quantity)> =
+            plan.tables.iter().map(|t| (t.ndf, t.quantity)).collect();
+        assert_eq!(
+            quantities,
+            [
+                (Ndf::Ggx, Quantity::E),
+                (Ndf::Ggx, Quantity::EAvg),
+                (Ndf::Ggx, Quantity::EDielectric),
+                (Ndf::Ggx, Quantity::EDielectricInside),
+                (Ndf::Ggx, Quantity::EAvgDielectric),
+                (Ndf::Ggx, Quantity::EAvgDielectricInside),
+                (Ndf::Beckmann, Quantity::E),
+                (Ndf::Beckmann, Quantity::EAvg),
+            ]
+        );
+        assert_eq!(plan.tables[0].materials, ["steel", "window", "gem"]);
+        assert_eq!(plan.tables[2].materials, ["window", "gem"]);
+        assert!(plan.materials[1].transmission && !plan.materials[3].transmission);
+        // The IOR axis reaches the gem's 3.4; the E tables' options are those of a scene
+        // without glass (their cache keys do not change when glass is added).
+        assert_eq!(scene.ior_max(), 3.4);
+        let options = scene.bake_options();
+        assert_eq!(options.len(), 3);
+        assert_eq!(options[0], {
+            let no_glass = Scene {
+                materials: vec![scene.materials[0].clone()],
+                output: None,
+            };
+            no_glass.bake_options()[0].clone()
+        });
+        assert_eq!(options[1].quantities, DIELECTRIC_QUANTITIES);
+        assert_eq!(options[1].ior_max, 3.4);
+        assert_eq!(options[1].size, DIELECTRIC_SIZE);
+    }
+
+    #[test]
     fn empty_and_duplicate_needs() {
         let empty = Scene::parse("", "empty.toml").unwrap();
         assert!(empty.plan().tables.is_empty() && empty.plan().materials.is_empty());
@@ -446,7 +583,11 @@ fresnel = { schlick = { f0 = 0.04 } }
 
     #[test]
     fn bad_scenes_say_where_and_what() {
-        let cases: [(&str, &str); 8] = [
+        let cases: [(&str, &str); 9] = [
+            (
+                "[[material]]\nname = \"a\"\nndf = \"ggx\"\nroughness = 0.1\ntransmission = true\n",
+                "needs a dielectric fresnel",
+            ),
             (
                 "[[material]]\nname = \"a\"\nndf = \"ggx\"\nroughness = 0.1\ncolour = 1\n",
                 "colour",

@@ -43,13 +43,23 @@ pub fn run(args: PlanArgs) -> kiln::Result<()> {
     );
     for t in &plan.tables {
         let id = format!("{}-{}-{}", t.ndf, t.masking, t.quantity.symbol());
-        println!("  {id:<34} for {}", t.materials.join(", "));
+        println!("  {id:<46} for {}", t.materials.join(", "));
     }
     for m in &plan.materials {
         let [r, g, b] = m.f_avg;
         println!(
-            "  material {}: {} {}, roughness {}..{}, fresnel {}, F_avg [{r:.6}, {g:.6}, {b:.6}]",
-            m.name, m.ndf, m.masking, m.roughness[0], m.roughness[1], m.fresnel
+            "  material {}: {} {}, roughness {}..{}, fresnel {}{}, F_avg [{r:.6}, {g:.6}, {b:.6}]",
+            m.name,
+            m.ndf,
+            m.masking,
+            m.roughness[0],
+            m.roughness[1],
+            m.fresnel,
+            if m.transmission {
+                " (transmission)"
+            } else {
+                ""
+            }
         );
     }
     Ok(())
