@@ -50,6 +50,8 @@ pub struct BakeOptions {
     pub ior_mapping: IorMapping,
     /// The IOR axis runs over `[1, ior_max]`.
     pub ior_max: f64,
+    /// The Fresnel model of the `E_F` tables (a grey one; required with [`Quantity::EF`]).
+    pub fresnel: Option<crate::model::Fresnel>,
     /// Measure each table's node error against the deterministic reference after baking (only
     /// meaningful for [`Method::Qmc`]).
     pub check_against_reference: bool,
@@ -79,6 +81,7 @@ impl Default for BakeOptions {
             ior_size: Self::DEFAULT_IOR_SIZE,
             ior_mapping: IorMapping::Cycles,
             ior_max: Self::DEFAULT_IOR_MAX,
+            fresnel: None,
             check_against_reference: true,
             method: Method::Qmc,
             max_error: Some(Self::DEFAULT_MAX_ERROR),
@@ -133,14 +136,45 @@ impl BakeOptions {
             )));
         }
         if self.mu_mapping == MuMapping::Adaptive
-            && let Some(q) = self.quantities.iter().find(|q| q.weight().is_some())
+            && let Some(q) = self.quantities.iter().find(|q| q.varies_on_a_mirror())
         {
             return Err(Error::InvalidInput(format!(
                 "--quantity {} needs --mu-axis linear or sqrt: the adaptive mu axis follows E's \
-                 grazing layer and maps every mu > 0 to t = 1 at roughness 0, where a split-sum \
-                 channel still varies as Fc(mu) = (1 - mu)^5",
-                q.cli_name()
+                 grazing layer and maps every mu > 0 to t = 1 at roughness 0, where {} still \
+                 varies with mu",
+                q.cli_name(),
+                if *q == Quantity::EF {
+                    "E_F = F(mu)"
+                } else {
+                    "a split-sum channel, Fc(mu) = (1 - mu)^5 or 1 - Fc(mu),"
+                }
             )));
+        }
+        match (self.quantities.contains(&Quantity::EF), self.fresnel) {
+            (true, None) => {
+                return Err(Error::InvalidInput(
+                    "--quantity e-f needs a Fresnel model: --fresnel with its parameters, e.g. \
+                     --f0 0.04 or --ior 1.5"
+                        .into(),
+                ));
+            }
+            (true, Some(fresnel)) if !fresnel.is_grey() => {
+                return Err(Error::InvalidInput(
+                    "--quantity e-f bakes one channel: give one value per parameter (a coloured \
+                     model differs per channel; bake one table per channel with that channel's \
+                     values)"
+                        .into(),
+                ));
+            }
+            (false, Some(_)) => {
+                return Err(Error::InvalidInput(
+                    "a Fresnel model applies to the Fresnel-weighted table: add --quantity e-f \
+                     (the other tables are for F = 1, or over the IOR for glass)"
+                        .into(),
+                ));
+            }
+            (true, Some(fresnel)) => fresnel.validate().map_err(Error::InvalidInput)?,
+            (false, None) => {}
         }
         if self.ndfs.is_empty() || self.maskings.is_empty() || self.quantities.is_empty() {
             return Err(Error::InvalidInput(
@@ -260,6 +294,7 @@ impl BakeOptions {
                         model,
                         quantity,
                         ior: quantity.has_ior().then_some(ior),
+                        fresnel: self.fresnel.filter(|_| quantity == Quantity::EF),
                         roughness: quantity.has_roughness().then_some(roughness),
                         mu: quantity.has_mu().then_some(mu),
                         method: self.method,
@@ -294,6 +329,9 @@ impl BakeOptions {
         }
         let names: Vec<&str> = quantities.iter().map(|q| q.cli_name()).collect();
         let mut flag = format!(" --quantity {}", names.join(","));
+        if let Some(fresnel) = self.fresnel {
+            flag += &format!(" {}", fresnel.flags());
+        }
         if quantities.iter().any(|q| q.has_ior()) {
             flag += &format!(
                 " --ior-size {} --ior-axis {} --ior-max {}",
@@ -513,6 +551,17 @@ pub fn estimate_texel(spec: &TableSpec, index: usize) -> Estimate {
             Some(mu) => dielectric_albedo(spec.model, alpha, mu, eta, &spec.qmc),
             None => dielectric_average_albedo(spec.model, alpha, eta, &spec.qmc),
         },
+        (Method::Qmc, None) if spec.fresnel.is_some() => {
+            let fresnel = spec.fresnel.expect("checked");
+            let mu = mu.expect("E_F has a mu axis");
+            weighted_albedo(
+                spec.model,
+                alpha,
+                mu,
+                move |c| fresnel.reflectance(c)[0],
+                &spec.qmc,
+            )
+        }
         (Method::Qmc, None) => match (mu, spec.quantity.weight()) {
             (Some(mu), None) => albedo(spec.model, alpha, mu, &spec.qmc),
             (Some(mu), Some(h)) => weighted_albedo(spec.model, alpha, mu, h, &spec.qmc),

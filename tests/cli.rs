@@ -749,3 +749,87 @@ fn study_quick_writes_consistent_files_and_a_summary() {
         "{stdout}"
     );
 }
+
+/// `kiln bake --f0 0.04` writes an `E_F` table for that model; `kiln verify --quantity e-f
+/// --f0 0.04` audits the same numbers as an external table, and refuses without the model.
+#[test]
+fn fresnel_flags_on_bake_and_verify() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().to_str().unwrap();
+    let baked = kiln(&[
+        "bake",
+        "--f0",
+        "0.04",
+        "--mu-axis",
+        "linear",
+        "--size",
+        "4",
+        "--max-error",
+        "1e-6",
+        "--format",
+        "json",
+        "--out",
+        out,
+        "-q",
+    ]);
+    assert!(baked.status.success(), "{}", stderr(&baked));
+    let sidecar: Sidecar = serde_json::from_slice(
+        &std::fs::read(
+            dir.path()
+                .join("ggx-height-correlated-E_F-schlick-0.04-1.json"),
+        )
+        .unwrap(),
+    )
+    .unwrap();
+    assert_eq!(sidecar.metadata.quantity, "E_F");
+    assert!(
+        sidecar.metadata.fresnel.contains("schlick"),
+        "{}",
+        sidecar.metadata.fresnel
+    );
+    let text: Vec<String> = sidecar.data["E_F"]
+        .iter()
+        .map(|v| format!("{v:e}"))
+        .collect();
+    let external = dir.path().join("theirs.txt");
+    std::fs::write(&external, text.join("\n")).unwrap();
+    let layout = [
+        "--shape",
+        "4x4",
+        "--order",
+        "r,mu",
+        "--grid",
+        "nodes",
+        "--mu-axis",
+        "linear",
+        "--quantity",
+        "e-f",
+        "--density",
+        "1",
+        "--json",
+        "-q",
+    ];
+    let mut args = vec!["verify", external.to_str().unwrap()];
+    args.extend(layout);
+    args.extend(["--f0", "0.04"]);
+    let audited = kiln(&args);
+    assert!(audited.status.success(), "{}", stderr(&audited));
+    let report: serde_json::Value = serde_json::from_slice(&audited.stdout).unwrap();
+    let node_max = report["node_max_error"].as_f64().unwrap();
+    assert!(node_max <= 1e-6, "{report}");
+    // The same numbers read as a different model's E_F are far off.
+    args.truncate(args.len() - 2);
+    args.extend(["--f0", "0.5"]);
+    let wrong = kiln(&args);
+    let report: serde_json::Value = serde_json::from_slice(&wrong.stdout).unwrap();
+    assert!(report["node_max_error"].as_f64().unwrap() > 0.1, "{report}");
+    // Without the model: one line, status 2.
+    args.truncate(args.len() - 2);
+    let refused = kiln(&args);
+    assert_eq!(refused.status.code(), Some(2));
+    assert!(
+        stderr(&refused).contains("needs the Fresnel model"),
+        "{}",
+        stderr(&refused)
+    );
+}

@@ -201,3 +201,108 @@ fn split_sum_qmc_tables_match_the_reference() {
         );
     }
 }
+
+/// `kiln bake --f0 ... / --ior ...`: a Fresnel-weighted `E_F` table for that model. Schlick's
+/// equals `F0 E_scale + F90 E_bias` from the split-sum tables (separate quadratures), the
+/// dielectric's is confirmed against its reference, and the options that cannot make one fail.
+#[test]
+fn fresnel_weighted_tables_bake_for_the_model_named() {
+    use kiln::{BakeOptions, MuMapping, Quantity};
+    let base = BakeOptions {
+        size: 6,
+        mu_mapping: MuMapping::Sqrt,
+        max_error: Some(1e-6),
+        ..BakeOptions::default()
+    };
+    let split = BakeOptions {
+        quantities: vec![Quantity::EScale, Quantity::EBias],
+        ..base.clone()
+    }
+    .bake(&|_| {})
+    .unwrap();
+    for (f0, f90) in [(0.04, 1.0), (0.5, 0.8)] {
+        let fresnel = Fresnel::Schlick {
+            f0: [f0; 3],
+            f90: [f90; 3],
+        };
+        let table = &BakeOptions {
+            quantities: vec![Quantity::EF],
+            fresnel: Some(fresnel),
+            ..base.clone()
+        }
+        .bake(&|_| {})
+        .unwrap()[0];
+        assert_eq!(table.spec.fresnel, Some(fresnel));
+        assert_eq!(
+            table.spec.id(),
+            format!("ggx-height-correlated-E_F-schlick-{f0}-{f90}")
+        );
+        assert!(table.node_errors.unwrap().max <= 1e-6);
+        for k in 0..table.spec.len() {
+            let combined = f0 * split[0].value[k] + f90 * split[1].value[k];
+            assert!(
+                (table.value[k] - combined).abs() <= 3e-6,
+                "texel {k}: {} vs {combined}",
+                table.value[k]
+            );
+        }
+    }
+    let glass = &BakeOptions {
+        quantities: vec![Quantity::EF],
+        fresnel: Some(Fresnel::Dielectric { eta: 1.0 / 1.5 }),
+        ..base.clone()
+    }
+    .bake(&|_| {})
+    .unwrap()[0];
+    assert!(glass.node_errors.unwrap().max <= 1e-6);
+    // The mirror row: E_F = F(mu), exactly for mu > 0 (at mu = 0, the limit alpha -> 0 of a
+    // grazing view, F = 1, to the max error).
+    for k in 0..6 {
+        let mu = glass.spec.texel_coordinates(k).1.unwrap();
+        let f = kiln::model::fresnel::dielectric(1.0 / 1.5, mu);
+        if mu > 0.0 {
+            assert_eq!(glass.value[k], f);
+        } else {
+            assert!((glass.value[k] - f).abs() <= 1e-6);
+        }
+    }
+    for (options, needle) in [
+        (
+            BakeOptions {
+                quantities: vec![Quantity::EF],
+                ..base.clone()
+            },
+            "needs a Fresnel model",
+        ),
+        (
+            BakeOptions {
+                fresnel: Some(Fresnel::Dielectric { eta: 1.5 }),
+                ..base.clone()
+            },
+            "add --quantity e-f",
+        ),
+        (
+            BakeOptions {
+                quantities: vec![Quantity::EF],
+                fresnel: Some(Fresnel::Conductor {
+                    eta: [0.2, 0.9, 1.1],
+                    k: [3.1; 3],
+                }),
+                ..base.clone()
+            },
+            "one table per channel",
+        ),
+        (
+            BakeOptions {
+                quantities: vec![Quantity::EF],
+                fresnel: Some(Fresnel::Dielectric { eta: 1.5 }),
+                mu_mapping: MuMapping::Adaptive,
+                ..base.clone()
+            },
+            "E_F = F(mu)",
+        ),
+    ] {
+        let error = options.validate().unwrap_err().to_string();
+        assert!(error.contains(needle), "{needle}: {error}");
+    }
+}

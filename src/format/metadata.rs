@@ -132,7 +132,11 @@ impl Metadata {
             ndf: spec.model.ndf.name().to_string(),
             masking: spec.model.masking.name().to_string(),
             fresnel: match (spec.quantity.weight(), spec.quantity.has_ior()) {
-                (None, false) => "none (F = 1)".to_string(),
+                (None, false) => match spec.fresnel {
+                    Some(fresnel) => serde_json::to_string(&fresnel)
+                        .unwrap_or_else(|_| fresnel.name().to_string()),
+                    None => "none (F = 1)".to_string(),
+                },
                 (Some(_), _) => {
                     "Schlick weight Fc = (1 - o.h)^5 (or 1 - Fc) on F = 1; see description"
                         .to_string()

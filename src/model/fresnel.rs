@@ -37,7 +37,57 @@ pub enum Fresnel {
     Conductor { eta: Rgb, k: Rgb },
 }
 
+/// Models compare equal only with identical parameters (no NaN passes [`Fresnel::validate`]), so
+/// a model can be part of a table's identity ([`crate::TableSpec`]).
+impl Eq for Fresnel {}
+
+impl std::hash::Hash for Fresnel {
+    fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
+        let bits = |state: &mut H, values: &[f64]| {
+            for v in values {
+                v.to_bits().hash(state);
+            }
+        };
+        std::mem::discriminant(self).hash(state);
+        match *self {
+            Fresnel::None => {}
+            Fresnel::Schlick { f0, f90 } => {
+                bits(state, &f0);
+                bits(state, &f90);
+            }
+            Fresnel::Dielectric { eta } => bits(state, &[eta]),
+            Fresnel::Conductor { eta, k } => {
+                bits(state, &eta);
+                bits(state, &k);
+            }
+        }
+    }
+}
+
 impl Fresnel {
+    /// A short file-name tag with the parameters of channel 0 (grey models; see
+    /// [`Fresnel::is_grey`]): `none`, `schlick-0.04-1`, `dielectric-1.5`, `conductor-0.2-3.1`.
+    #[must_use]
+    pub fn tag(&self) -> String {
+        match *self {
+            Fresnel::None => "none".to_string(),
+            Fresnel::Schlick { f0, f90 } => format!("schlick-{}-{}", f0[0], f90[0]),
+            Fresnel::Dielectric { eta } => format!("dielectric-{eta}"),
+            Fresnel::Conductor { eta, k } => format!("conductor-{}-{}", eta[0], k[0]),
+        }
+    }
+
+    /// The flags that name this model on the command line (channel 0 of a grey model).
+    #[must_use]
+    pub fn flags(&self) -> String {
+        match *self {
+            Fresnel::None => "--fresnel none".to_string(),
+            Fresnel::Schlick { f0, f90 } => format!("--f0 {} --f90 {}", f0[0], f90[0]),
+            Fresnel::Dielectric { eta } => format!("--ior {eta}"),
+            Fresnel::Conductor { eta, k } => format!("--eta {} --k {}", eta[0], k[0]),
+        }
+    }
+
     /// The model's name on the command line and in files.
     #[must_use]
     pub fn name(&self) -> &'static str {

@@ -55,6 +55,11 @@ pub enum Quantity {
     #[serde(rename = "F_avg")]
     #[cfg_attr(feature = "cli", value(name = "f-avg"))]
     FAvg,
+    /// The Fresnel-weighted albedo `E_F(mu, roughness) = ∫ F(o.h) f mu_i dω_i` for the table's
+    /// own Fresnel model ([`TableSpec::fresnel`], a grey one), a 2-D table.
+    #[serde(rename = "E_F")]
+    #[cfg_attr(feature = "cli", value(name = "e-f"))]
+    EF,
 }
 
 impl Quantity {
@@ -71,6 +76,7 @@ impl Quantity {
             Quantity::EAvgDielectric => "E_avg_dielectric",
             Quantity::EAvgDielectricInside => "E_avg_dielectric_inside",
             Quantity::FAvg => "F_avg",
+            Quantity::EF => "E_F",
         }
     }
 
@@ -87,6 +93,7 @@ impl Quantity {
             Quantity::EAvgDielectric => "e-avg-dielectric",
             Quantity::EAvgDielectricInside => "e-avg-dielectric-inside",
             Quantity::FAvg => "f-avg",
+            Quantity::EF => "e-f",
         }
     }
 
@@ -137,6 +144,11 @@ impl Quantity {
                  index eta; from inside: 1 - (1 - F_avg(eta)) / eta^2; one_minus_F_avg is \
                  1 - F_avg"
             }
+            Quantity::EF => {
+                "Fresnel-weighted albedo E_F(mu) = integral of F(o.h) f(o, i) mu_i over incoming \
+                 directions i, F the table's Fresnel model (see fresnel), F = 1 inside f; \
+                 one_minus_E_F is 1 - E_F"
+            }
         }
     }
 
@@ -169,6 +181,14 @@ impl Quantity {
                 | Quantity::EAvgDielectricInside
                 | Quantity::FAvg
         )
+    }
+
+    /// Whether the table still varies with `mu` on a mirror (`roughness = 0`), so that it needs a
+    /// `mu` axis independent of the roughness (not the adaptive one): the split-sum channels
+    /// and `E_F`, which equal `h(mu)` and `F(mu)` there.
+    #[must_use]
+    pub fn varies_on_a_mirror(self) -> bool {
+        self.weight().is_some() || self == Quantity::EF
     }
 
     /// Whether the light arrives from inside (relative index `1 / eta`).
@@ -252,6 +272,9 @@ pub struct TableSpec {
     pub roughness: Option<Axis>,
     /// The `mu` axis (columns, the fastest-varying index); `None` for the averages.
     pub mu: Option<Axis>,
+    /// The Fresnel model of an `E_F` table; `None` for every other quantity.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fresnel: Option<crate::model::Fresnel>,
     /// How the values are computed.
     #[serde(default)]
     pub method: Method,
@@ -343,6 +366,15 @@ impl TableSpec {
     pub fn id(&self) -> String {
         if self.quantity == Quantity::FAvg {
             return "dielectric-F_avg".to_string();
+        }
+        if let Some(fresnel) = self.fresnel {
+            return format!(
+                "{}-{}-{}-{}",
+                self.model.ndf,
+                self.model.masking,
+                self.quantity.symbol(),
+                fresnel.tag()
+            );
         }
         format!(
             "{}-{}-{}",
@@ -566,6 +598,7 @@ mod tests {
             quantity: Quantity::E,
             method: Method::Qmc,
             ior: None,
+            fresnel: None,
             roughness: Some(Axis::Roughness {
                 size: 5,
                 convention: RoughnessConvention::Perceptual,

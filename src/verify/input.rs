@@ -26,6 +26,8 @@ pub enum AxisName {
 pub struct Layout {
     pub model: Model,
     pub quantity: Quantity,
+    /// The Fresnel model of an `E_F` table (`None` otherwise).
+    pub fresnel: Option<crate::model::Fresnel>,
     /// Sizes, slowest-varying axis first (one size for `E_avg`).
     pub shape: Vec<usize>,
     /// The axes in the same order as `shape` (`[Mu, R]` when mu varies slowest).
@@ -284,6 +286,7 @@ fn spec_and_values(
         reference_digits: None,
         model: layout.model,
         quantity: layout.quantity,
+        fresnel: layout.fresnel,
         ior: None,
         roughness: Some(roughness),
         mu,
@@ -347,6 +350,7 @@ mod tests {
                 masking: Masking::HeightCorrelated,
             },
             quantity: Quantity::E,
+            fresnel: None,
             shape: vec![3, 2],
             order: vec![AxisName::Mu, AxisName::R],
             grid: Grid::Nodes,

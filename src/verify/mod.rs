@@ -131,11 +131,39 @@ pub fn reference_value(
                 .as_reference_value(),
         };
     }
+    if let (Some(fresnel), Some(mu)) = (spec.fresnel, mu) {
+        return fresnel_weighted_reference(spec.model, fresnel, alpha, mu, settings);
+    }
     match (mu, spec.quantity.weight()) {
         (Some(mu), None) => reference_albedo(spec.model, alpha, mu, settings),
         (Some(mu), Some(h)) => reference_weighted_albedo(spec.model, alpha, mu, h, settings),
         (None, _) => quadrature_average_albedo(spec.model, alpha, settings),
     }
+}
+
+/// The reference Fresnel-weighted albedo `E_F(mu)` of channel 0 of `fresnel`: for a dielectric
+/// the reflected part of [`reference_dielectric_albedo`] (its quadrature splits at the critical
+/// angle, where `F` has a square-root kink that misleads the generic rule's error estimate),
+/// otherwise the reference with the weight `F(o.h)`. `one_minus_value` is `1 - E_F`.
+#[must_use]
+pub fn fresnel_weighted_reference(
+    model: crate::model::Model,
+    fresnel: Fresnel,
+    alpha: f64,
+    mu: f64,
+    settings: &ReferenceSettings,
+) -> ReferenceValue {
+    if let Fresnel::Dielectric { eta } = fresnel {
+        let r = reference_dielectric_albedo(model, alpha, mu, eta, settings);
+        return ReferenceValue {
+            value: r.reflection,
+            one_minus_value: 1.0 - r.reflection,
+            error: r.error,
+            evaluations: r.evaluations,
+            converged: r.converged,
+        };
+    }
+    reference_weighted_albedo(model, alpha, mu, |c| fresnel.reflectance(c)[0], settings)
 }
 
 /// The truth at `(mu, alpha, eta)`: value, error estimate and whether it converged.
@@ -397,8 +425,8 @@ pub fn node_errors_at(
         .map(|&k| {
             let (alpha, mu) = spec.texel_coordinates(k);
             let reference = reference_value(spec, alpha, mu, spec.texel_eta(k), settings);
-            // `1 - E` where both carry it directly; the split-sum channels by value.
-            if spec.quantity.weight().is_some() {
+            // `1 - E` where both carry it directly; the split-sum channels and `E_F` by value.
+            if spec.quantity.varies_on_a_mirror() {
                 (table.value[k] - reference.value).abs()
             } else {
                 (table.one_minus_value[k] - reference.one_minus_value).abs()

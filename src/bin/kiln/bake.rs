@@ -1,6 +1,7 @@
 //! `kiln bake`.
 
 use crate::args::{CONVENTIONS, parse_samples, parse_size};
+use crate::fresnel_args::FresnelArgs;
 use clap::Args;
 use kiln::format::{self, Format, Precision};
 use kiln::{
@@ -45,8 +46,13 @@ pub struct BakeArgs {
     /// mu): e-dielectric and e-dielectric-inside (energy albedo R + T for light arriving from
     /// outside, relative index eta, and from inside, 1 / eta), e-avg-dielectric and
     /// e-avg-dielectric-inside over (eta, roughness), and f-avg, the exact dielectric F_avg(eta).
-    #[arg(long, value_enum, value_delimiter = ',', default_value = "e,e-avg")]
-    quantity: Vec<Quantity>,
+    /// e-f: the Fresnel-weighted albedo E_F = integral of F(o.h) f mu_i for the model the
+    /// Fresnel flags name (one channel: one value per parameter) [default: e,e-avg, or e-f when
+    /// a Fresnel flag is given].
+    #[arg(long, value_enum, value_delimiter = ',')]
+    quantity: Option<Vec<Quantity>>,
+    #[command(flatten)]
+    fresnel: FresnelArgs,
     /// Samples per axis: E is SIZE x SIZE, E_avg has SIZE entries. 2 to 4096.
     #[arg(long, default_value_t = BakeOptions::DEFAULT_SIZE, value_parser = parse_size, allow_negative_numbers = true)]
     size: usize,
@@ -85,7 +91,7 @@ pub struct BakeArgs {
         long,
         conflicts_with_all = ["ndf", "masking", "quantity", "size", "samples", "avg_samples",
             "scrambles", "seed", "format", "precision", "roughness_axis", "mu_axis", "grid",
-            "ior_size", "ior_axis", "ior_max",
+            "ior_size", "ior_axis", "ior_max", "fresnel", "f0", "f90", "ior", "eta", "k",
             "method", "no_reference_check", "max_error"]
     )]
     scene: Option<PathBuf>,
@@ -156,7 +162,18 @@ pub fn run(args: BakeArgs) -> kiln::Result<()> {
     let options = BakeOptions {
         ndfs: args.ndf,
         maskings: args.masking,
-        quantities: args.quantity,
+        quantities: args.quantity.unwrap_or_else(|| {
+            if args.fresnel.given() {
+                vec![Quantity::EF]
+            } else {
+                vec![Quantity::E, Quantity::EAvg]
+            }
+        }),
+        fresnel: if args.fresnel.given() {
+            Some(args.fresnel.model()?)
+        } else {
+            None
+        },
         size: args.size,
         samples,
         average_samples: args.avg_samples.unwrap_or(16 * samples),

@@ -1,6 +1,7 @@
 //! `kiln verify`.
 
 use crate::args::{CONVENTIONS, parse_error_bound, parse_number};
+use crate::fresnel_args::FresnelArgs;
 use clap::Args;
 use kiln::format::Precision;
 use kiln::integrate::reference::ReferenceSettings;
@@ -78,9 +79,12 @@ pub struct VerifyArgs {
     /// External tables: the Smith G2 form.
     #[arg(long, value_enum, default_value = "height-correlated")]
     masking: Masking,
-    /// External tables: what the numbers are.
+    /// External tables: what the numbers are (e-f: the Fresnel-weighted albedo of the model
+    /// the Fresnel flags name).
     #[arg(long, value_enum, default_value = "e")]
     quantity: Quantity,
+    #[command(flatten)]
+    fresnel: FresnelArgs,
     /// No progress bar.
     #[arg(long, short)]
     quiet: bool,
@@ -130,12 +134,40 @@ impl VerifyArgs {
         } else {
             vec![AxisName::R]
         });
+        let fresnel = match (self.quantity, self.fresnel.given()) {
+            (Quantity::EF, true) => {
+                let model = self.fresnel.model()?;
+                if !model.is_grey() {
+                    return Err(kiln::Error::InvalidInput(
+                        "--quantity e-f audits one channel: give one value per Fresnel \
+                         parameter (that channel's)"
+                            .into(),
+                    ));
+                }
+                Some(model)
+            }
+            (Quantity::EF, false) => {
+                return Err(kiln::Error::InvalidInput(
+                    "--quantity e-f needs the Fresnel model the table was computed for, e.g. \
+                     --f0 0.04 or --ior 1.5"
+                        .into(),
+                ));
+            }
+            (_, true) => {
+                return Err(kiln::Error::InvalidInput(format!(
+                    "the Fresnel flags apply to --quantity e-f only (a {} table is for F = 1)",
+                    self.quantity.symbol()
+                )));
+            }
+            (_, false) => None,
+        };
         Ok(Layout {
             model: Model {
                 ndf: self.ndf,
                 masking: self.masking,
             },
             quantity: self.quantity,
+            fresnel,
             shape,
             order,
             grid: self.grid,
