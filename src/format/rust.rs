@@ -194,15 +194,7 @@ fn write_lookup(out: &mut String, table: &Table, prefix: &str, ty: &str) {
                 n_mu - 2
             );
             let _ = writeln!(out, "    let (f, g) = (p_r - i as f32, p_mu - j as f32);");
-            let _ = writeln!(
-                out,
-                "    let row0 = table[i][j] * (1.0 - g) + table[i][j + 1] * g;"
-            );
-            let _ = writeln!(
-                out,
-                "    let row1 = table[i + 1][j] * (1.0 - g) + table[i + 1][j + 1] * g;"
-            );
-            let _ = writeln!(out, "    row0 * (1.0 - f) + row1 * f");
+            write_bilinear(out, "table", "    ");
             let _ = writeln!(out, "}}");
         }
     }
@@ -301,15 +293,7 @@ fn write_ior_lookup(out: &mut String, table: &Table, prefix: &str, ty: &str) {
                     let _ = writeln!(out, "    let j = (p_mu as usize).min({});", n_mu - 2);
                     let _ = writeln!(out, "    let g = p_mu - j as f32;");
                     let _ = writeln!(out, "    let slice = |s: &[[f32; {n_mu}]; {n_r}]| {{");
-                    let _ = writeln!(
-                        out,
-                        "        let row0 = s[i][j] * (1.0 - g) + s[i][j + 1] * g;"
-                    );
-                    let _ = writeln!(
-                        out,
-                        "        let row1 = s[i + 1][j] * (1.0 - g) + s[i + 1][j + 1] * g;"
-                    );
-                    let _ = writeln!(out, "        row0 * (1.0 - f) + row1 * f");
+                    write_bilinear(out, "s", "        ");
                     let _ = writeln!(out, "    }};");
                 }
             }
@@ -320,6 +304,21 @@ fn write_ior_lookup(out: &mut String, table: &Table, prefix: &str, ty: &str) {
         }
     }
     let _ = writeln!(out, "}}");
+}
+
+/// The bilinear blend of `array[i..=i + 1][j..=j + 1]` with weights `f` (rows) and `g`
+/// (columns), `mu` first as in [`Table::lookup`].
+fn write_bilinear(out: &mut String, array: &str, indent: &str) {
+    let a = array;
+    let _ = writeln!(
+        out,
+        "{indent}let row0 = {a}[i][j] * (1.0 - g) + {a}[i][j + 1] * g;"
+    );
+    let _ = writeln!(
+        out,
+        "{indent}let row1 = {a}[i + 1][j] * (1.0 - g) + {a}[i + 1][j + 1] * g;"
+    );
+    let _ = writeln!(out, "{indent}row0 * (1.0 - f) + row1 * f");
 }
 
 fn array_type(shape: &[usize]) -> String {

@@ -29,7 +29,7 @@ use super::albedo::{
     sum_over_block,
 };
 use super::estimate::Estimate;
-use super::gauss_kronrod::integrate_pieces;
+use super::gauss_kronrod::{integrate, integrate_pieces};
 use super::reference::{ReferenceSettings, ReferenceValue, phi_breaks, x_range};
 use crate::model::dielectric::{refract, scattering};
 use crate::model::fresnel::dielectric;
@@ -356,6 +356,7 @@ fn quadrature<N: MicrofacetDistribution>(
             x_max
         };
         let mut breaks = vec![x_min, x_visible, 0.0, x_of_theta(theta_star)];
+        let mut critical = Vec::new();
         // o.m = rho cos(theta - delta) along this slice.
         let rho = (mu * mu + so * so * cos_phi * cos_phi).sqrt();
         let delta = (so * cos_phi).atan2(mu);
@@ -365,12 +366,12 @@ fn quadrature<N: MicrofacetDistribution>(
             let spread = (c / rho).acos();
             for theta in [delta - spread, delta + spread] {
                 if theta > 0.0 && theta < PI / 2.0 {
-                    breaks.push(x_of_theta(theta));
+                    critical.push(x_of_theta(theta));
                 }
             }
         }
         // Sign changes of the refracted direction's z: a scan, then bisection.
-        const SCAN: usize = 48;
+        const SCAN: usize = 16;
         let step = (x_visible - x_min) / SCAN as f64;
         let mut previous: Option<(f64, f64)> = None;
         for k in 0..=SCAN {
@@ -380,7 +381,7 @@ fn quadrature<N: MicrofacetDistribution>(
                 && (z0 < 0.0) != (z1 < 0.0)
             {
                 let (mut lo, mut hi) = (x0, x);
-                for _ in 0..60 {
+                for _ in 0..40 {
                     let mid = 0.5 * (lo + hi);
                     match refracted_z(mid, cos_phi, sin_phi) {
                         Some(zm) if (zm < 0.0) == (z0 < 0.0) => lo = mid,
@@ -392,13 +393,49 @@ fn quadrature<N: MicrofacetDistribution>(
             previous = z.map(|z| (x, z));
         }
         evaluations += (SCAN as u64 + 1) * 2;
+        breaks.extend(&critical);
         breaks.retain(|&b| b >= x_min && b <= x_visible);
         breaks.sort_by(f64::total_cmp);
-        let mut f = |x: f64| point(x, cos_phi, sin_phi);
-        let q = integrate_pieces(&mut f, &breaks, inner_tolerance, settings.max_intervals);
-        evaluations += q.evaluations;
-        all_converged &= q.converged;
-        [q.value[0], q.value[1], q.value[2], q.error]
+        breaks.dedup();
+        // Beside the critical angle 1 - F and the refracted direction go as sqrt(distance):
+        // integrate those pieces in s with x = edge +- s^2, which makes them smooth.
+        let pieces = breaks.len().saturating_sub(1).max(1) as f64;
+        let mut total = [0.0; 4];
+        for pair in breaks.windows(2) {
+            let (a, b) = (pair[0], pair[1]);
+            let q = if critical.contains(&a) {
+                integrate(
+                    |s: f64| point(a + s * s, cos_phi, sin_phi).map(|v| 2.0 * s * v),
+                    0.0,
+                    (b - a).sqrt(),
+                    inner_tolerance / pieces,
+                    settings.max_intervals,
+                )
+            } else if critical.contains(&b) {
+                integrate(
+                    |s: f64| point(b - s * s, cos_phi, sin_phi).map(|v| 2.0 * s * v),
+                    0.0,
+                    (b - a).sqrt(),
+                    inner_tolerance / pieces,
+                    settings.max_intervals,
+                )
+            } else {
+                integrate(
+                    |x: f64| point(x, cos_phi, sin_phi),
+                    a,
+                    b,
+                    inner_tolerance / pieces,
+                    settings.max_intervals,
+                )
+            };
+            evaluations += q.evaluations;
+            all_converged &= q.converged;
+            for (sum, value) in total.iter_mut().zip(q.value) {
+                *sum += value;
+            }
+            total[3] += q.error;
+        }
+        total
     };
     // Where the critical angle's curve leaves the slice (rho(phi) = critical cos), the inner
     // integral has a square-root kink in phi: break there too.
