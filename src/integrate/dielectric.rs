@@ -247,7 +247,7 @@ pub fn reference_dielectric_average_albedo(
         };
     }
     let inner = ReferenceSettings {
-        tolerance: settings.tolerance / 10.0,
+        tolerance: settings.tolerance / 4.0,
         ..*settings
     };
     let mut evaluations = 0;
@@ -269,7 +269,12 @@ pub fn reference_dielectric_average_albedo(
         breaks.push(b);
     }
     if eta < 1.0 {
-        breaks.push(((1.0 - eta) * (1.0 + eta)).sqrt());
+        // The critical angle, smoothed over a width ~alpha: a ladder on either side.
+        let critical = ((1.0 - eta) * (1.0 + eta)).sqrt();
+        breaks.push(critical);
+        for b in [alpha / 4.0, alpha, 4.0 * alpha] {
+            breaks.extend([critical - b, critical + b]);
+        }
     }
     breaks.retain(|&b| (0.0..=1.0).contains(&b));
     breaks.sort_by(f64::total_cmp);
