@@ -5,12 +5,16 @@
 //! removes the temporaries; a reader never sees a half-written table.
 
 pub mod binary;
+pub mod c_header;
+pub mod dds;
 pub mod exr;
 pub mod f16;
 pub mod json;
+pub mod ktx2;
 pub mod metadata;
 pub mod png;
 pub mod rust;
+pub mod texture;
 
 use crate::error::{Error, Result};
 use crate::table::Table;
@@ -34,10 +38,17 @@ pub enum Format {
     Json,
     /// PNG heat map (2-D tables only).
     Png,
+    /// KTX2 texture: R = value, G = 1 - value, `R16G16_SFLOAT` (`--precision f16`) or
+    /// `R32G32_SFLOAT`, metadata as key/value data ([`ktx2`]).
+    Ktx2,
+    /// DDS texture with the DX10 header: `R16G16_FLOAT` or `R32G32_FLOAT` ([`dds`]).
+    Dds,
+    /// C/C++ header: float arrays and interleaved half-float bits ([`c_header`]).
+    H,
 }
 
 impl Format {
-    /// Every format, in the order they are written.
+    /// The formats written by default, in the order they are written.
     pub const ALL: [Format; 5] = [
         Format::Exr,
         Format::Bin,
@@ -55,6 +66,9 @@ impl Format {
             Format::Rs => "rs",
             Format::Json => "json",
             Format::Png => "png",
+            Format::Ktx2 => "ktx2",
+            Format::Dds => "dds",
+            Format::H => "h",
         }
     }
 }
@@ -132,6 +146,11 @@ pub fn encode_all(
                     None => continue,
                     Some(result) => result.map_err(|m| fail(format, m))?,
                 },
+                Format::Ktx2 => ktx2::encode(&texture::Texture::of_table(table), precision)
+                    .map_err(|m| fail(format, m))?,
+                Format::Dds => dds::encode(&texture::Texture::of_table(table), precision)
+                    .map_err(|m| fail(format, m))?,
+                Format::H => c_header::encode(table).into_bytes(),
                 Format::Json => continue, // last, once the others are known
             };
             let name = format!("{id}.{}", format.name());

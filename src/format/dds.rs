@@ -1,0 +1,54 @@
+//! DDS (DirectDraw Surface) output with the DX10 header, through the `ddsfile` crate: DXGI
+//! `R16_FLOAT`, `R16G16_FLOAT`, `R32_FLOAT` or `R32G32_FLOAT`, a 1-D, 2-D or (IOR tables) 3-D
+//! texture with one mip level, rows top to bottom. DDS has no room for metadata: the JSON sidecar
+//! or the KTX2 file carries it.
+
+use super::Precision;
+use super::texture::Texture;
+use ddsfile::{AlphaMode, Caps2, D3D10ResourceDimension, Dds, DxgiFormat, NewDxgiParams};
+
+/// The DXGI format of a texture with `channels` float channels of `precision`.
+#[must_use]
+pub fn dxgi_format(channels: usize, precision: Precision) -> Option<DxgiFormat> {
+    match (channels, precision) {
+        (1, Precision::F16) => Some(DxgiFormat::R16_Float),
+        (2, Precision::F16) => Some(DxgiFormat::R16G16_Float),
+        (1, Precision::F32) => Some(DxgiFormat::R32_Float),
+        (2, Precision::F32) => Some(DxgiFormat::R32G32_Float),
+        _ => None,
+    }
+}
+
+/// Encodes a texture of one or two channels.
+pub fn encode(texture: &Texture, precision: Precision) -> std::result::Result<Vec<u8>, String> {
+    let channels = texture.channels.len();
+    let format = dxgi_format(channels, precision)
+        .ok_or_else(|| format!("DDS output takes one or two channels (got {channels})"))?;
+    let (width, height, depth) = texture.extent();
+    let (dimension, depth, caps2) = match (height, depth) {
+        (0, _) => (D3D10ResourceDimension::Texture1D, None, None),
+        (_, 0) => (D3D10ResourceDimension::Texture2D, None, None),
+        (_, d) => (
+            D3D10ResourceDimension::Texture3D,
+            Some(d as u32),
+            Some(Caps2::VOLUME),
+        ),
+    };
+    let mut dds = Dds::new_dxgi(NewDxgiParams {
+        height: height.max(1) as u32,
+        width: width as u32,
+        depth,
+        format,
+        mipmap_levels: Some(1),
+        array_layers: None,
+        caps2,
+        is_cubemap: false,
+        resource_dimension: dimension,
+        alpha_mode: AlphaMode::Unknown,
+    })
+    .map_err(|e| e.to_string())?;
+    dds.data = texture.interleaved(precision);
+    let mut bytes = Vec::new();
+    dds.write(&mut bytes).map_err(|e| e.to_string())?;
+    Ok(bytes)
+}

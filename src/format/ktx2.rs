@@ -1,0 +1,124 @@
+//! KTX2 (Khronos Texture 2.0) output: one texture, one mip level, no supercompression, with the
+//! table's metadata as key/value data.
+//!
+//! Layout (KTX 2.0 specification, Khronos, sections 3-4; Khronos Data Format 1.3 for the
+//! descriptor): the 12-byte identifier, the 68-byte header (`vkFormat`, `typeSize`, width,
+//! height, depth, layer count 0, face count 1, level count 1, supercompression 0), the section
+//! index, one level index entry, the data format descriptor (one basic block: RGBSDA colour
+//! model, BT.709 primaries, linear transfer, one sample per channel, signed float,
+//! `sampleLower = -1.0f`, `sampleUpper = 1.0f` as the specification's float formats have them),
+//! the key/value data (`KTXorientation = rd`: rows top to bottom; `KTXwriter`; `kiln`: the
+//! metadata JSON), sorted by key, then the texels, aligned to 16 bytes.
+//!
+//! Formats: `R16_SFLOAT` (76), `R16G16_SFLOAT` (83), `R32_SFLOAT` (100), `R32G32_SFLOAT` (103);
+//! 1-D, 2-D and 3-D (an IOR table: depth = the `eta` axis).
+
+use super::Precision;
+use super::texture::Texture;
+
+/// The KTX2 file identifier.
+pub const IDENTIFIER: [u8; 12] = [
+    0xAB, 0x4B, 0x54, 0x58, 0x20, 0x32, 0x30, 0xBB, 0x0D, 0x0A, 0x1A, 0x0A,
+];
+
+/// The `VkFormat` of a texture with `channels` float channels of `precision`.
+#[must_use]
+pub fn vk_format(channels: usize, precision: Precision) -> Option<u32> {
+    match (channels, precision) {
+        (1, Precision::F16) => Some(76),
+        (2, Precision::F16) => Some(83),
+        (1, Precision::F32) => Some(100),
+        (2, Precision::F32) => Some(103),
+        _ => None,
+    }
+}
+
+fn align(n: usize, to: usize) -> usize {
+    n.div_ceil(to) * to
+}
+
+/// Encodes a texture of one or two channels.
+pub fn encode(texture: &Texture, precision: Precision) -> std::result::Result<Vec<u8>, String> {
+    let channels = texture.channels.len();
+    let format = vk_format(channels, precision)
+        .ok_or_else(|| format!("KTX2 output takes one or two channels (got {channels})"))?;
+    let type_size = precision.bytes();
+    let texel_bytes = type_size * channels;
+    let texels = texture.interleaved(precision);
+
+    // Data format descriptor: total size, then one basic block of 24 + 16 * channels bytes.
+    let block_size = 24 + 16 * channels;
+    let mut dfd = Vec::new();
+    let put = |out: &mut Vec<u8>, v: u32| out.extend_from_slice(&v.to_le_bytes());
+    put(&mut dfd, (4 + block_size) as u32);
+    put(&mut dfd, 0); // vendor 0 (Khronos), descriptor type 0 (basic)
+    put(&mut dfd, 2 | (block_size as u32) << 16); // version 2
+    dfd.extend_from_slice(&[1, 1, 1, 0]); // RGBSDA, BT.709, linear, straight alpha
+    dfd.extend_from_slice(&[0, 0, 0, 0]); // texel block 1 x 1 x 1 x 1
+    dfd.extend_from_slice(&[texel_bytes as u8, 0, 0, 0, 0, 0, 0, 0]); // bytes per plane
+    let bits = 8 * type_size as u32;
+    for c in 0..channels as u32 {
+        // Float (0x80) and signed (0x40) qualifiers; channel id R = 0, G = 1.
+        let channel_type = 0x80 | 0x40 | c;
+        put(&mut dfd, (c * bits) | (bits - 1) << 16 | channel_type << 24);
+        put(&mut dfd, 0); // sample position
+        put(&mut dfd, (-1.0f32).to_bits());
+        put(&mut dfd, 1.0f32.to_bits());
+    }
+
+    // Key/value data, sorted by key (byte order).
+    let writer = format!("kiln {}", super::metadata::KILN_VERSION);
+    let mut pairs: Vec<(&str, &[u8])> = vec![
+        ("KTXorientation", b"rd"),
+        ("KTXwriter", writer.as_bytes()),
+        ("kiln", texture.metadata.as_bytes()),
+    ];
+    pairs.sort_by(|a, b| a.0.as_bytes().cmp(b.0.as_bytes()));
+    let mut kvd = Vec::new();
+    for (key, value) in pairs {
+        let length = key.len() + 1 + value.len() + 1;
+        put(&mut kvd, length as u32);
+        kvd.extend_from_slice(key.as_bytes());
+        kvd.push(0);
+        kvd.extend_from_slice(value);
+        kvd.push(0);
+        kvd.resize(align(kvd.len(), 4), 0);
+    }
+
+    let header_end = IDENTIFIER.len() + 9 * 4 + 4 * 4 + 2 * 8 + 3 * 8;
+    let dfd_offset = header_end;
+    let kvd_offset = dfd_offset + dfd.len();
+    let data_offset = align(kvd_offset + kvd.len(), 16);
+
+    let mut out = Vec::with_capacity(data_offset + texels.len());
+    out.extend_from_slice(&IDENTIFIER);
+    let (width, height, depth) = texture.extent();
+    for v in [
+        format,
+        type_size as u32,
+        width as u32,
+        height as u32,
+        depth as u32,
+        0, // layers: not an array
+        1, // faces
+        1, // levels
+        0, // no supercompression
+    ] {
+        put(&mut out, v);
+    }
+    for v in [dfd_offset, dfd.len(), kvd_offset, kvd.len()] {
+        put(&mut out, v as u32);
+    }
+    let put64 = |out: &mut Vec<u8>, v: u64| out.extend_from_slice(&v.to_le_bytes());
+    put64(&mut out, 0); // no supercompression global data
+    put64(&mut out, 0);
+    put64(&mut out, data_offset as u64);
+    put64(&mut out, texels.len() as u64);
+    put64(&mut out, texels.len() as u64);
+    debug_assert_eq!(out.len(), header_end);
+    out.extend_from_slice(&dfd);
+    out.extend_from_slice(&kvd);
+    out.resize(data_offset, 0);
+    out.extend_from_slice(&texels);
+    Ok(out)
+}

@@ -1,0 +1,110 @@
+//! A GPU texture made of tables: one or more value planes of the same layout, interleaved per
+//! texel, for the GPU containers ([`super::ktx2`], [`super::dds`]) and the C header.
+//!
+//! Layout, as in every kiln output: row-major, slowest axis first; the fastest axis is the
+//! texture's x (width), the next its y (height, rows top to bottom), an IOR axis its z (depth).
+
+use super::Precision;
+use crate::table::Table;
+
+/// Interleaved channels of one layout.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Texture {
+    /// The shape, slowest axis first (as [`crate::TableSpec::shape`]).
+    pub shape: Vec<usize>,
+    /// Channel names and values, in texel order (R, G, ...).
+    pub channels: Vec<(String, Vec<f64>)>,
+    /// What the texture holds: the tables' metadata as JSON.
+    pub metadata: String,
+}
+
+impl Texture {
+    /// A table's own texture: R = the value, G = one minus the value (estimated directly, the
+    /// channel to use near 1 in half precision).
+    #[must_use]
+    pub fn of_table(table: &Table) -> Texture {
+        let [value, one_minus, _] = table.channel_names();
+        Texture {
+            shape: table.spec.shape(),
+            channels: vec![
+                (value, table.value.clone()),
+                (one_minus, table.one_minus_value.clone()),
+            ],
+            metadata: metadata_json(&[table]),
+        }
+    }
+
+    /// The value planes of several tables of the same axes as channels R, G, ... (an engine's
+    /// scale/bias texture, for instance).
+    pub fn of_values(tables: &[&Table]) -> std::result::Result<Texture, String> {
+        let first = tables.first().ok_or("a texture needs at least one table")?;
+        if let Some(other) = tables.iter().find(|t| t.spec.axes() != first.spec.axes()) {
+            return Err(format!(
+                "{} and {} have different axes and cannot share a texture",
+                first.spec.id(),
+                other.spec.id()
+            ));
+        }
+        Ok(Texture {
+            shape: first.spec.shape(),
+            channels: tables
+                .iter()
+                .map(|t| (t.spec.quantity.symbol().to_string(), t.value.clone()))
+                .collect(),
+            metadata: metadata_json(tables),
+        })
+    }
+
+    /// `(width, height, depth)` as KTX2 counts them: 0 for an absent dimension.
+    #[must_use]
+    pub fn extent(&self) -> (usize, usize, usize) {
+        match self.shape[..] {
+            [n] => (n, 0, 0),
+            [rows, columns] => (columns, rows, 0),
+            [slices, rows, columns] => (columns, rows, slices),
+            _ => unreachable!("tables are 1-D, 2-D or 3-D"),
+        }
+    }
+
+    /// The number of texels.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.shape.iter().product()
+    }
+
+    /// Whether the texture has no texels (never, for a table's).
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The texels, channels interleaved, little-endian in `precision` (f16 through f32, as
+    /// kiln's other writers: [`super::f16`]).
+    #[must_use]
+    pub fn interleaved(&self, precision: Precision) -> Vec<u8> {
+        let mut out = Vec::with_capacity(self.len() * self.channels.len() * precision.bytes());
+        for k in 0..self.len() {
+            for (_, values) in &self.channels {
+                match precision {
+                    Precision::F32 => out.extend_from_slice(&(values[k] as f32).to_le_bytes()),
+                    Precision::F16 => {
+                        out.extend_from_slice(&super::f16::encode(values[k]).0.to_le_bytes());
+                    }
+                }
+            }
+        }
+        out
+    }
+}
+
+/// The metadata of the tables in a texture, as one JSON object: `channels` (names in texel
+/// order) and `tables` (each table's [`super::metadata::Metadata`]).
+fn metadata_json(tables: &[&Table]) -> String {
+    let object = serde_json::json!({
+        "tables": tables
+            .iter()
+            .map(|t| super::metadata::Metadata::new(t, "texture"))
+            .collect::<Vec<_>>(),
+    });
+    object.to_string()
+}
