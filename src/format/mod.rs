@@ -30,7 +30,7 @@ use std::path::{Path, PathBuf};
 pub enum Format {
     /// OpenEXR, channels `E`, `one_minus_E`, `std_error`, metadata in the header.
     Exr,
-    /// kiln's raw binary format ([`binary`]).
+    /// kiln's raw binary format (see the module `binary`).
     Bin,
     /// Rust source with `pub const` arrays.
     Rs,
@@ -39,11 +39,12 @@ pub enum Format {
     /// PNG heat map (2-D tables only).
     Png,
     /// KTX2 texture: R = value, G = 1 - value, `R16G16_SFLOAT` (`--precision f16`) or
-    /// `R32G32_SFLOAT`, metadata as key/value data ([`ktx2`]).
+    /// `R32G32_SFLOAT`, metadata as key/value data (not written by default).
     Ktx2,
-    /// DDS texture with the DX10 header: `R16G16_FLOAT` or `R32G32_FLOAT` ([`dds`]).
+    /// DDS texture with the DX10 header: `R16G16_FLOAT` or `R32G32_FLOAT` (not written by
+    /// default).
     Dds,
-    /// C/C++ header: float arrays and interleaved half-float bits ([`c_header`]).
+    /// C/C++ header: float arrays and interleaved half-float bits (not written by default).
     H,
 }
 
