@@ -14,6 +14,7 @@ pub mod ktx2;
 pub mod metadata;
 pub mod png;
 pub mod rust;
+pub mod shader;
 pub mod texture;
 
 use crate::error::{Error, Result};
@@ -46,6 +47,12 @@ pub enum Format {
     Dds,
     /// C/C++ header: float arrays and interleaved half-float bits (not written by default).
     H,
+    /// WGSL lookup functions for the table's KTX2/DDS texture (not written by default).
+    Wgsl,
+    /// GLSL 4.50 lookup functions (not written by default).
+    Glsl,
+    /// HLSL lookup functions (not written by default).
+    Hlsl,
 }
 
 impl Format {
@@ -70,6 +77,9 @@ impl Format {
             Format::Ktx2 => "ktx2",
             Format::Dds => "dds",
             Format::H => "h",
+            Format::Wgsl => "wgsl",
+            Format::Glsl => "glsl",
+            Format::Hlsl => "hlsl",
         }
     }
 }
@@ -152,6 +162,9 @@ pub fn encode_all(
                 Format::Dds => dds::encode(&texture::Texture::of_table(table), precision)
                     .map_err(|m| fail(format, m))?,
                 Format::H => c_header::encode(table).into_bytes(),
+                Format::Wgsl => shader::encode(table, shader::Language::Wgsl).into_bytes(),
+                Format::Glsl => shader::encode(table, shader::Language::Glsl).into_bytes(),
+                Format::Hlsl => shader::encode(table, shader::Language::Hlsl).into_bytes(),
                 Format::Json => continue, // last, once the others are known
             };
             let name = format!("{id}.{}", format.name());

@@ -1,0 +1,331 @@
+//! Shader lookup code for a table, in WGSL, GLSL (4.50) and HLSL (Shader Model 5): the axis
+//! mappings and texel convention kiln's [`Table::lookup`] applies, written so that a GPU's
+//! bilinear (trilinear for an IOR table) filter with clamp-to-edge returns the same blend.
+//!
+//! - 2-D and 3-D tables are textures (the `.ktx2` or `.dds` kiln writes, R = value,
+//!   G = `1 - value`): `NAME_uv(...)` gives the texture coordinate, `NAME_lookup(...)` samples
+//!   it (level 0) and returns both channels. Texture x is the fastest axis (`mu`), y the
+//!   roughness (row 0 at `v = 0`, the first row uploaded), z the IOR.
+//! - 1-D tables (`E_avg`, `F_avg`) are constant arrays in the shader with their own linear
+//!   interpolation, usable in any stage.
+//!
+//! Texel conventions: with `centers`, sample `i` sits at `t_i = (i + 0.5) / N`, where the GPU
+//! puts texel centres, so `u = t`; with `nodes`, `t_i = i / (N - 1)`, and the lookup must remap
+//! `u = (t (N - 1) + 0.5) / N` (the half-texel remap engines often forget, README).
+
+use super::metadata::{KILN_VERSION, Metadata};
+use crate::model::RoughnessConvention;
+use crate::table::Table;
+use crate::table::axis::{ADAPTIVE_POWER, ADAPTIVE_SCALE, Axis, Grid, IorMapping, MuMapping};
+use std::fmt::Write as _;
+
+/// A shading language.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Language {
+    Wgsl,
+    Glsl,
+    Hlsl,
+}
+
+impl Language {
+    fn float(self) -> &'static str {
+        match self {
+            Language::Wgsl => "f32",
+            Language::Glsl | Language::Hlsl => "float",
+        }
+    }
+
+    fn vector(self, n: usize) -> String {
+        match self {
+            Language::Wgsl => format!("vec{n}<f32>"),
+            Language::Glsl => format!("vec{n}"),
+            Language::Hlsl => format!("float{n}"),
+        }
+    }
+
+    /// A local constant: `let x = e;` / `float x = e;`.
+    fn local(self, name: &str, value: &str) -> String {
+        match self {
+            Language::Wgsl => format!("    let {name} = {value};\n"),
+            Language::Glsl | Language::Hlsl => format!("    float {name} = {value};\n"),
+        }
+    }
+
+    /// `cond ? a : b`.
+    fn select(self, cond: &str, a: &str, b: &str) -> String {
+        match self {
+            Language::Wgsl => format!("select({b}, {a}, {cond})"),
+            Language::Glsl | Language::Hlsl => format!("(({cond}) ? ({a}) : ({b}))"),
+        }
+    }
+
+    /// A function header.
+    fn function(self, name: &str, params: &[(&str, String)], ret: &str) -> String {
+        let list: Vec<String> = params
+            .iter()
+            .map(|(n, ty)| match self {
+                Language::Wgsl => format!("{n}: {ty}"),
+                Language::Glsl | Language::Hlsl => format!("{ty} {n}"),
+            })
+            .collect();
+        match self {
+            Language::Wgsl => format!("fn {name}({}) -> {ret} {{\n", list.join(", ")),
+            Language::Glsl | Language::Hlsl => format!("{ret} {name}({}) {{\n", list.join(", ")),
+        }
+    }
+
+    fn comment(self) -> &'static str {
+        "//"
+    }
+}
+
+/// A float literal every language accepts.
+fn literal(v: f64) -> String {
+    let text = format!("{:?}", v as f32);
+    if text.contains(['.', 'e', 'E']) {
+        text
+    } else {
+        format!("{text}.0")
+    }
+}
+
+/// The texture coordinate `t` of an axis from its physical coordinate (`alpha` bound for the
+/// adaptive mu mapping).
+fn coordinate(language: Language, axis: &Axis) -> String {
+    match *axis {
+        Axis::Mu { mapping, .. } => match mapping {
+            MuMapping::Linear => "mu".to_string(),
+            MuMapping::Sqrt => "sqrt(max(mu, 0.0))".to_string(),
+            MuMapping::Adaptive => {
+                let k = format!("{} * alpha", literal(ADAPTIVE_SCALE));
+                let t = format!(
+                    "pow(min(mu * (1.0 + {k}) / max(mu + {k}, 1e-30), 1.0), {})",
+                    literal(ADAPTIVE_POWER)
+                );
+                language.select("mu <= 0.0", "0.0", &t)
+            }
+        },
+        Axis::Roughness { .. } => "roughness".to_string(),
+        Axis::Ior { mapping, max, .. } => match mapping {
+            IorMapping::Linear => format!("(eta_up - 1.0) / {}", literal(max.0 - 1.0)),
+            IorMapping::Cycles => {
+                let z_max = ((max.0 - 1.0) / (max.0 + 1.0)).sqrt();
+                format!(
+                    "sqrt(max((eta_up - 1.0) / (eta_up + 1.0), 0.0)) / {}",
+                    literal(z_max)
+                )
+            }
+        },
+    }
+}
+
+/// The GPU texture coordinate of texture coordinate `t` on an axis of `n` samples.
+fn gpu_coordinate(grid: Grid, t: &str, n: usize) -> String {
+    match grid {
+        Grid::Centers => t.to_string(),
+        Grid::Nodes => format!(
+            "(clamp({t}, 0.0, 1.0) * {} + 0.5) / {}",
+            literal((n - 1) as f64),
+            literal(n as f64)
+        ),
+    }
+}
+
+/// The lookup's parameters, in the order of the Rust lookup: `mu`, `roughness`, `eta`.
+fn parameters(language: Language, table: &Table) -> Vec<(&'static str, String)> {
+    let mut params = Vec::new();
+    let f = language.float().to_string();
+    if table.spec.mu.is_some() {
+        params.push(("mu", f.clone()));
+    }
+    if table.spec.roughness.is_some() {
+        params.push(("roughness", f.clone()));
+    }
+    if table.spec.ior.is_some() {
+        params.push(("eta", f));
+    }
+    params
+}
+
+/// Lines that define `alpha`, `eta_up` and each axis' `t_*` as the axes need them.
+fn preamble(language: Language, table: &Table) -> String {
+    let spec = &table.spec;
+    let mut out = String::new();
+    if matches!(spec.mu, Some(Axis::Mu { mapping, .. }) if mapping.depends_on_roughness()) {
+        let alpha = match spec.roughness_convention() {
+            RoughnessConvention::Perceptual => "roughness * roughness",
+            RoughnessConvention::Alpha => "roughness",
+        };
+        out += &language.local("alpha", alpha);
+    }
+    if spec.ior.is_some() {
+        out += &language.local("eta_up", &language.select("eta < 1.0", "1.0 / eta", "eta"));
+    }
+    out
+}
+
+/// The function name stem: `ggx_height_correlated_e`.
+#[must_use]
+pub fn name(table: &Table) -> String {
+    super::rust::const_prefix(table).to_lowercase()
+}
+
+/// Generates the lookup code for a table.
+#[must_use]
+pub fn encode(table: &Table, language: Language) -> String {
+    let meta = Metadata::new(table, "f32");
+    let spec = &table.spec;
+    let stem = name(table);
+    let c = language.comment();
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "{c} Generated by kiln {KILN_VERSION}. Do not edit: regenerate with\n{c} `{}`\n{c}",
+        meta.command
+    );
+    let _ = writeln!(
+        out,
+        "{c} {} {}, {} masking: {}",
+        meta.ndf.to_uppercase(),
+        meta.quantity,
+        meta.masking,
+        meta.description
+    );
+    for axis in &meta.axes {
+        let _ = writeln!(
+            out,
+            "{c} axis {} ({} samples, {} grid): {}",
+            axis.name,
+            axis.size,
+            axis.grid.name(),
+            axis.formula
+        );
+    }
+    let axes = spec.axes();
+    let params = parameters(language, table);
+    if axes.len() == 1 {
+        write_array_lookup(&mut out, language, table, &stem, &params);
+        return out;
+    }
+    let _ = writeln!(
+        out,
+        "{c} Texture: the table's .ktx2 or .dds (R = value, G = 1 - value), x = {}, y = {}{}, \
+         sampled with a linear filter and clamp-to-edge addressing; row 0 at v = 0.",
+        axes[axes.len() - 1].name(),
+        axes[axes.len() - 2].name(),
+        if axes.len() == 3 {
+            format!(", z = {}", axes[0].name())
+        } else {
+            String::new()
+        }
+    );
+    // The coordinate function: fastest axis first (x, y, z).
+    let dims = axes.len();
+    out += &language.function(&format!("{stem}_uv"), &params, &language.vector(dims));
+    out += &preamble(language, table);
+    let mut components = Vec::new();
+    for (k, axis) in axes.iter().rev().enumerate() {
+        let t = format!("t{k}");
+        out += &language.local(&t, &coordinate(language, axis));
+        components.push(gpu_coordinate(axis.grid(), &t, axis.size()));
+    }
+    let _ = writeln!(
+        out,
+        "    return {}({});\n}}\n",
+        language.vector(dims),
+        components.join(", ")
+    );
+    // The sampling function.
+    let call_args: Vec<&str> = params.iter().map(|(n, _)| *n).collect();
+    let uv = format!("{stem}_uv({})", call_args.join(", "));
+    let mut sample_params: Vec<(&str, String)> = Vec::new();
+    let body = match language {
+        Language::Wgsl => {
+            sample_params.push(("table", format!("texture_{dims}d<f32>")));
+            sample_params.push(("linear_clamp", "sampler".to_string()));
+            format!("    return textureSampleLevel(table, linear_clamp, {uv}, 0.0).rg;\n")
+        }
+        Language::Glsl => {
+            // OpenGL's combined sampler; Vulkan GLSL (define KILN_NO_COMBINED_SAMPLERS) samples
+            // `sampler2D(texture, sampler)` at `NAME_uv` itself.
+            out.push_str("#ifndef KILN_NO_COMBINED_SAMPLERS\n");
+            sample_params.push(("table", format!("sampler{dims}D")));
+            format!("    return textureLod(table, {uv}, 0.0).rg;\n}}\n#endif\n")
+        }
+        Language::Hlsl => {
+            sample_params.push(("table", format!("Texture{dims}D<float2>")));
+            sample_params.push(("linear_clamp", "SamplerState".to_string()));
+            format!("    return table.SampleLevel(linear_clamp, {uv}, 0).rg;\n")
+        }
+    };
+    sample_params.extend(params.iter().cloned());
+    let _ = writeln!(
+        out,
+        "{c} Returns (value, 1 - value); use .y near 1 in half precision."
+    );
+    out += &language.function(
+        &format!("{stem}_lookup"),
+        &sample_params,
+        &language.vector(2),
+    );
+    out += &body;
+    if language != Language::Glsl {
+        out += "}\n";
+    }
+    out
+}
+
+/// A 1-D table as a constant array with its linear interpolation (no texture).
+fn write_array_lookup(
+    out: &mut String,
+    language: Language,
+    table: &Table,
+    stem: &str,
+    params: &[(&'static str, String)],
+) {
+    let axis = table.spec.axes()[0];
+    let n = axis.size();
+    let values: Vec<String> = table.value.iter().map(|&v| literal(v)).collect();
+    let constant = stem.to_uppercase();
+    let list = values.join(", ");
+    let _ = match language {
+        Language::Wgsl => writeln!(out, "const {constant} = array<f32, {n}>({list});"),
+        Language::Glsl => writeln!(out, "const float {constant}[{n}] = float[{n}]({list});"),
+        Language::Hlsl => writeln!(out, "static const float {constant}[{n}] = {{ {list} }};"),
+    };
+    *out += &language.function(&format!("{stem}_lookup"), params, language.float());
+    *out += &preamble(language, table);
+    *out += &language.local("t", &coordinate(language, &axis));
+    let last = literal((n - 1) as f64);
+    let position = match axis.grid() {
+        Grid::Nodes => format!("clamp(t * {last}, 0.0, {last})"),
+        Grid::Centers => format!("clamp(t * {} - 0.5, 0.0, {last})", literal(n as f64)),
+    };
+    *out += &language.local("p", &position);
+    let (index, cast) = match language {
+        Language::Wgsl => ("i32", "i32"),
+        Language::Glsl | Language::Hlsl => ("int", "int"),
+    };
+    let i_value = format!("min({cast}(floor(p)), {})", n - 2);
+    match language {
+        Language::Wgsl => {
+            let _ = writeln!(out, "    let i = {i_value};");
+            let _ = writeln!(out, "    let f = p - f32(i);");
+            // A function-scope copy: WGSL indexes a `const` array only by constants.
+            let _ = writeln!(out, "    var values = {constant};");
+            let _ = writeln!(
+                out,
+                "    return values[i] * (1.0 - f) + values[i + 1] * f;\n}}"
+            );
+            return;
+        }
+        Language::Glsl | Language::Hlsl => {
+            let _ = writeln!(out, "    {index} i = {i_value};");
+            let _ = writeln!(out, "    float f = p - float(i);");
+        }
+    }
+    let _ = writeln!(
+        out,
+        "    return {constant}[i] * (1.0 - f) + {constant}[i + 1] * f;\n}}"
+    );
+}
