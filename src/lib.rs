@@ -39,6 +39,7 @@ pub mod error;
 pub mod format;
 pub mod integrate;
 pub mod model;
+pub mod preset;
 pub mod scene;
 pub mod study;
 pub mod table;

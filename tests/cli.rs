@@ -833,3 +833,48 @@ fn fresnel_flags_on_bake_and_verify() {
         stderr(&refused)
     );
 }
+
+/// `kiln bake --preset three` writes the engine's file and kiln's sidecars; `kiln verify
+/// --preset three` audits that file as the engine would read it (one JSON object per table).
+#[test]
+fn presets_bake_and_verify() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().to_str().unwrap();
+    let baked = kiln(&["bake", "--preset", "three", "--out", out, "-q"]);
+    assert!(baked.status.success(), "{}", stderr(&baked));
+    assert_eq!(
+        files_in(dir.path()),
+        [
+            "DFGLUT.js",
+            "ggx-height-correlated-E_bias.json",
+            "ggx-height-correlated-E_scale.json"
+        ]
+    );
+    let file = dir.path().join("DFGLUT.js");
+    let audited = kiln(&[
+        "verify",
+        "--preset",
+        "three",
+        file.to_str().unwrap(),
+        "--json",
+        "-q",
+        "--density",
+        "1",
+    ]);
+    assert!(audited.status.success(), "{}", stderr(&audited));
+    let reports: Vec<serde_json::Value> = String::from_utf8(audited.stdout)
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(reports.len(), 2);
+    for report in &reports {
+        // Half floats: at most half a spacing (2^-12 below 1) off the reference.
+        let node_max = report["node_max_error"].as_f64().unwrap();
+        assert!(node_max <= 2f64.powi(-12) + 1e-7, "{report}");
+    }
+    assert_eq!(reports[0]["quantity"], "E_scale");
+    // A preset takes no table flags.
+    let refused = kiln(&["bake", "--preset", "bevy", "--size", "8", "--out", out]);
+    assert_eq!(refused.status.code(), Some(2));
+}

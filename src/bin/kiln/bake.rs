@@ -95,6 +95,19 @@ pub struct BakeArgs {
             "method", "no_reference_check", "max_error"]
     )]
     scene: Option<PathBuf>,
+    /// Bake an engine's table in that engine's own layout, to drop in for its file: cycles
+    /// (shader.tables: table_ggx_E, table_ggx_Eavg), bevy (dfg.ktx2, RG16F scale/bias, 64 x 64)
+    /// or three (DFGLUT.js, 16 x 16 transposed half bits); with kiln's JSON sidecars of the
+    /// tables it holds. --max-error and --out apply.
+    #[arg(
+        long,
+        value_enum,
+        conflicts_with_all = ["scene", "ndf", "masking", "quantity", "size", "samples",
+            "avg_samples", "scrambles", "seed", "format", "precision", "roughness_axis", "mu_axis",
+            "grid", "method", "no_reference_check", "ior_size", "ior_axis", "ior_max", "fresnel",
+            "f0", "f90", "ior", "eta", "k"]
+    )]
+    preset: Option<kiln::preset::Preset>,
     /// Output formats, comma-separated.
     #[arg(
         long,
@@ -146,6 +159,9 @@ pub struct BakeArgs {
 pub fn run(args: BakeArgs) -> kiln::Result<()> {
     if let Some(path) = &args.scene {
         return bake_scene(path, args.out.as_deref(), args.quiet);
+    }
+    if let Some(preset) = args.preset {
+        return bake_preset(preset, &args);
     }
     let out = args.out.clone().unwrap_or_else(|| PathBuf::from("tables"));
     // Naming a method or a sample count asks for that method; otherwise a max error decides.
@@ -222,6 +238,50 @@ pub fn run(args: BakeArgs) -> kiln::Result<()> {
         println!(
             "baked {} tables in {seconds:.1} s; wrote {} files to {}",
             tables.len(),
+            written.len(),
+            out.display()
+        );
+    }
+    Ok(())
+}
+
+/// `kiln bake --preset NAME`.
+fn bake_preset(preset: kiln::preset::Preset, args: &BakeArgs) -> kiln::Result<()> {
+    let out = args.out.clone().unwrap_or_else(|| PathBuf::from("tables"));
+    let options = BakeOptions {
+        max_error: Some(args.max_error.unwrap_or(BakeOptions::DEFAULT_MAX_ERROR)),
+        ..preset.options()
+    };
+    options.validate()?;
+    format::check_output_dir(&out)?;
+    let bar = crate::progress_bar(args.quiet, options.total_samples(), "integrating");
+    let start = Instant::now();
+    let tables = options.bake(&|samples| bar.inc(samples))?;
+    bar.finish_and_clear();
+    let mut files = vec![(preset.file_name().to_string(), preset.encode(&tables)?)];
+    files.extend(format::encode_all(
+        &tables,
+        &[Format::Json],
+        Precision::F32,
+    )?);
+    let written = format::write_files(&out, &files)?;
+    if !args.quiet {
+        for table in &tables {
+            if let Some(e) = table.node_errors {
+                println!(
+                    "{:<32} max error vs reference {:.1e} ({} texels)",
+                    table.spec.id(),
+                    e.max,
+                    e.texels
+                );
+            }
+        }
+        println!(
+            "{} layout: baked {} tables in {:.1} s; wrote {} ({} files) to {}",
+            preset.name(),
+            tables.len(),
+            start.elapsed().as_secs_f64(),
+            preset.file_name(),
             written.len(),
             out.display()
         );

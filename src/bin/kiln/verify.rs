@@ -40,9 +40,15 @@ pub struct VerifyArgs {
     /// The E_avg table for --furnace (default: beside FILE).
     #[arg(long, requires = "furnace")]
     average: Option<PathBuf>,
-    /// Print one JSON object instead of text.
+    /// Print one JSON object instead of text (one per table with --preset).
     #[arg(long)]
     json: bool,
+    /// FILE is an engine's own table in that engine's layout (cycles: shader.tables with
+    /// table_ggx_E and table_ggx_Eavg; bevy: an uncompressed dfg.ktx2; three: the DFG LUT's
+    /// Uint16Array): audit each of its tables against the reference for the model the engine
+    /// evaluates (GGX, height-correlated).
+    #[arg(long, value_enum, conflicts_with_all = ["furnace", "shape", "channel", "dtype"])]
+    preset: Option<kiln::preset::Preset>,
     /// Exit with status 1 when node_max_error exceeds this.
     #[arg(long, value_parser = parse_error_bound, allow_negative_numbers = true)]
     max_error: Option<f64>,
@@ -321,10 +327,28 @@ fn json_report(
 
 /// Returns whether the table passed `--max-error` (always true without it).
 pub fn run(args: VerifyArgs) -> kiln::Result<bool> {
+    if let Some(preset) = args.preset {
+        let bytes = std::fs::read(&args.file).map_err(|source| kiln::Error::Io {
+            path: args.file.clone(),
+            action: "read",
+            source,
+        })?;
+        let tables = preset.read_tables(&bytes, &args.file.display().to_string())?;
+        let mut passed = true;
+        for table in &tables {
+            passed &= audit_one(&args, table)?;
+        }
+        return Ok(passed);
+    }
     let table = args.load(&args.file)?;
     if args.furnace {
         return run_furnace(&args, &table);
     }
+    audit_one(&args, &table)
+}
+
+/// Audits one table and prints the report; whether it passed `--max-error`.
+fn audit_one(args: &VerifyArgs, table: &Table) -> kiln::Result<bool> {
     let other;
     let against = if args.against == "reference" {
         Against::Reference(ReferenceSettings::default())
@@ -350,13 +374,13 @@ pub fn run(args: VerifyArgs) -> kiln::Result<bool> {
         audit_points(&table.spec, &settings),
         "verifying",
     );
-    let report = audit(&table, &against, &settings, &|| bar.inc(1));
+    let report = audit(table, &against, &settings, &|| bar.inc(1));
     bar.finish_and_clear();
     let passed = args
         .max_error
         .is_none_or(|bound| report.node_max_error <= bound);
     if args.json {
-        println!("{}", json_report(&report, &args, passed));
+        println!("{}", json_report(&report, args, passed));
     } else {
         let shape: Vec<String> = report.shape.iter().map(|n| n.to_string()).collect();
         println!(

@@ -1,0 +1,166 @@
+//! Engine presets: each file, read back in the engine's own convention (by the test's own
+//! indexing, not kiln's), holds kiln's table at the same coordinates; `Preset::read_tables`
+//! (what `kiln verify --preset` audits) gives the tables back.
+
+use kiln::preset::Preset;
+use kiln::{BakeOptions, Table};
+
+fn bake(preset: Preset) -> Vec<Table> {
+    BakeOptions {
+        max_error: Some(1e-5),
+        ..preset.options()
+    }
+    .bake(&|_| {})
+    .unwrap()
+}
+
+fn f32_of(v: f64) -> f64 {
+    f64::from(v as f32)
+}
+
+fn f16_of(v: f64) -> f64 {
+    f64::from(kiln::format::f16::encode(v).0.to_f32())
+}
+
+/// The numbers between the braces after `name[`.
+fn c_numbers(text: &str, name: &str) -> Vec<f64> {
+    let start = text.find(&format!("{name}[")).expect(name);
+    let open = start + text[start..].find('{').unwrap();
+    let close = open + text[open..].find('}').unwrap();
+    text[open + 1..close]
+        .split(',')
+        .map(str::trim)
+        .filter(|s| !s.is_empty())
+        .map(|s| f64::from(s.trim_end_matches('f').parse::<f32>().unwrap()))
+        .collect()
+}
+
+#[test]
+fn cycles_layout_is_mu_major_nodes_with_e_avg_by_roughness() {
+    let tables = bake(Preset::Cycles);
+    let (e, avg) = (&tables[0], &tables[1]);
+    assert_eq!(e.spec.shape(), [32, 32]);
+    let text = String::from_utf8(Preset::Cycles.encode(&tables).unwrap()).unwrap();
+    let flat = c_numbers(&text, "table_ggx_E");
+    assert_eq!(flat.len(), 1024);
+    for r in 0..32 {
+        for m in 0..32 {
+            // Cycles: index = mu_index * 32 + r_index, nodes i / 31 on both axes.
+            let (alpha, mu) = e.spec.texel_coordinates(r * 32 + m);
+            assert_eq!(mu.unwrap(), m as f64 / 31.0);
+            assert!((alpha - (r as f64 / 31.0).powi(2)).abs() < 1e-15);
+            assert_eq!(
+                flat[m * 32 + r],
+                f32_of(e.value[r * 32 + m]),
+                "r {r}, mu {m}"
+            );
+        }
+    }
+    // Cycles' special case, r_index 0 is exactly 1 (a mirror), holds for kiln's nodes too.
+    assert!((0..32).all(|m| flat[m * 32] == 1.0));
+    let averages = c_numbers(&text, "table_ggx_Eavg");
+    assert_eq!(
+        averages,
+        avg.value.iter().map(|&v| f32_of(v)).collect::<Vec<_>>()
+    );
+    let back = Preset::Cycles.read_tables(text.as_bytes(), "test").unwrap();
+    assert_eq!(
+        (
+            back[0].spec.axes(),
+            back[0].spec.quantity,
+            back[0].spec.model
+        ),
+        (e.spec.axes(), e.spec.quantity, e.spec.model)
+    );
+    assert_eq!(
+        back[0].value,
+        e.value.iter().map(|&v| f32_of(v)).collect::<Vec<_>>()
+    );
+}
+
+#[test]
+fn bevy_layout_is_rg16f_ktx2_scale_bias_with_nov_across() {
+    let tables = bake(Preset::Bevy);
+    let (scale, bias) = (&tables[0], &tables[1]);
+    let bytes = Preset::Bevy.encode(&tables).unwrap();
+    let reader = ktx2::Reader::new(bytes.as_slice()).unwrap();
+    let header = reader.header();
+    assert_eq!(header.format, Some(ktx2::Format::R16G16_SFLOAT));
+    assert_eq!(
+        (header.pixel_width, header.pixel_height, header.pixel_depth),
+        (64, 64, 0)
+    );
+    let data = reader.levels().next().unwrap().data;
+    let texel = |x: usize, y: usize, c: usize| {
+        let i = 2 * (2 * (y * 64 + x) + c);
+        f64::from(half::f16::from_le_bytes([data[i], data[i + 1]]).to_f32())
+    };
+    for y in 0..64 {
+        for x in 0..64 {
+            // x = NoV, y = perceptual roughness, texel centres (i + 0.5) / 64.
+            let (alpha, mu) = scale.spec.texel_coordinates(y * 64 + x);
+            assert!((mu.unwrap() - (x as f64 + 0.5) / 64.0).abs() < 1e-15);
+            assert!((alpha - ((y as f64 + 0.5) / 64.0).powi(2)).abs() < 1e-15);
+            assert_eq!(texel(x, y, 0), f16_of(scale.value[y * 64 + x]));
+            assert_eq!(texel(x, y, 1), f16_of(bias.value[y * 64 + x]));
+        }
+    }
+    let back = Preset::Bevy.read_tables(&bytes, "test").unwrap();
+    assert_eq!(
+        back[1].value,
+        bias.value.iter().map(|&v| f16_of(v)).collect::<Vec<_>>()
+    );
+}
+
+#[test]
+fn three_layout_is_transposed_half_bits() {
+    let tables = bake(Preset::Three);
+    let (scale, bias) = (&tables[0], &tables[1]);
+    let text = String::from_utf8(Preset::Three.encode(&tables).unwrap()).unwrap();
+    let open = text.find("Uint16Array( [").unwrap() + "Uint16Array( [".len();
+    let close = open + text[open..].find(']').unwrap();
+    let bits: Vec<u16> = text[open..close]
+        .split(',')
+        .map(str::trim)
+        .filter(|s| !s.is_empty())
+        .map(|s| u16::from_str_radix(s.trim_start_matches("0x"), 16).unwrap())
+        .collect();
+    assert_eq!(bits.len(), 2 * 16 * 16);
+    let half = |b: u16| f64::from(half::f16::from_bits(b).to_f32());
+    for r in 0..16 {
+        for m in 0..16 {
+            // Transposed: x = roughness, y = NoV, so texel (x = r, y = mu) is at mu * 16 + r.
+            let k = m * 16 + r;
+            assert_eq!(
+                half(bits[2 * k]),
+                f16_of(scale.value[r * 16 + m]),
+                "r {r}, mu {m}"
+            );
+            assert_eq!(half(bits[2 * k + 1]), f16_of(bias.value[r * 16 + m]));
+        }
+    }
+    let back = Preset::Three.read_tables(text.as_bytes(), "test").unwrap();
+    assert_eq!(
+        back[0].value,
+        scale.value.iter().map(|&v| f16_of(v)).collect::<Vec<_>>()
+    );
+}
+
+#[test]
+fn damaged_engine_files_are_refused_with_a_reason() {
+    let error = Preset::Cycles
+        .read_tables(b"static const float table_ggx_E[2] = { 1.0f, 0.5f };", "x")
+        .unwrap_err()
+        .to_string();
+    assert!(error.contains("table_ggx_Eavg"), "{error}");
+    let error = Preset::Three
+        .read_tables(b"new Uint16Array( [ 0x3c00 ] )", "x")
+        .unwrap_err()
+        .to_string();
+    assert!(error.contains("expected 512"), "{error}");
+    let error = Preset::Bevy
+        .read_tables(b"KTX", "x")
+        .unwrap_err()
+        .to_string();
+    assert!(error.contains("not a bevy table"), "{error}");
+}
