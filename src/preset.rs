@@ -184,6 +184,11 @@ impl Preset {
                 }
                 Ok(vec![kiln_order(&e), avg])
             }
+            #[cfg(not(feature = "containers"))]
+            Preset::Bevy => Err(bad(
+                "reading KTX2 needs kiln's `containers` feature".to_string()
+            )),
+            #[cfg(feature = "containers")]
             Preset::Bevy => {
                 let reader = ::ktx2::Reader::new(bytes).map_err(|e| bad(format!("{e:?}")))?;
                 let header = reader.header();

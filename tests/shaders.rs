@@ -44,6 +44,16 @@ fn arguments(table: &Table) -> String {
     args.join(", ")
 }
 
+/// naga's validator, with every check and capability.
+fn validate(module: &naga::Module, source: &str, what: &str) {
+    naga::valid::Validator::new(
+        naga::valid::ValidationFlags::all(),
+        naga::valid::Capabilities::all(),
+    )
+    .validate(module)
+    .unwrap_or_else(|e| panic!("{what}: {e:?}\n{source}"));
+}
+
 #[test]
 fn wgsl_lookups_validate() {
     for (k, table) in tables().iter().enumerate() {
@@ -80,12 +90,11 @@ fn wgsl_lookups_validate() {
                 e.emit_to_string(&source)
             )
         });
-        naga::valid::Validator::new(
-            naga::valid::ValidationFlags::all(),
-            naga::valid::Capabilities::all(),
-        )
-        .validate(&module)
-        .unwrap_or_else(|e| panic!("table {k} ({}): {e:?}\n{source}", table.spec.id()));
+        validate(
+            &module,
+            &source,
+            &format!("table {k} ({})", table.spec.id()),
+        );
     }
 }
 
@@ -124,12 +133,11 @@ fn glsl_lookups_validate() {
                 &source,
             )
             .unwrap_or_else(|e| panic!("table {k} ({}): {e:?}\n{source}", table.spec.id()));
-        naga::valid::Validator::new(
-            naga::valid::ValidationFlags::all(),
-            naga::valid::Capabilities::all(),
-        )
-        .validate(&module)
-        .unwrap_or_else(|e| panic!("table {k} ({}): {e:?}\n{source}", table.spec.id()));
+        validate(
+            &module,
+            &source,
+            &format!("table {k} ({})", table.spec.id()),
+        );
     }
 }
 

@@ -6,6 +6,7 @@
 
 pub mod binary;
 pub mod c_header;
+#[cfg(feature = "containers")]
 pub mod dds;
 pub mod exr;
 pub mod f16;
@@ -159,8 +160,16 @@ pub fn encode_all(
                 },
                 Format::Ktx2 => ktx2::encode(&texture::Texture::of_table(table), precision)
                     .map_err(|m| fail(format, m))?,
+                #[cfg(feature = "containers")]
                 Format::Dds => dds::encode(&texture::Texture::of_table(table), precision)
                     .map_err(|m| fail(format, m))?,
+                #[cfg(not(feature = "containers"))]
+                Format::Dds => {
+                    return Err(fail(
+                        format,
+                        "DDS output needs kiln's `containers` feature".to_string(),
+                    ));
+                }
                 Format::H => c_header::encode(table).into_bytes(),
                 Format::Wgsl => shader::encode(table, shader::Language::Wgsl).into_bytes(),
                 Format::Glsl => shader::encode(table, shader::Language::Glsl).into_bytes(),

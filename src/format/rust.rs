@@ -116,6 +116,15 @@ fn coordinate_code(axis: &Axis) -> String {
     }
 }
 
+/// Each axis with its formula, for the lookups' doc comments.
+fn axis_formulas(spec: &crate::table::TableSpec) -> String {
+    spec.axes()
+        .iter()
+        .map(|a| format!("`{}` axis {}", a.name(), a.formula()))
+        .collect::<Vec<_>>()
+        .join("; ")
+}
+
 /// Rust for the continuous sample position of texture coordinate `t` on an axis of `n` samples.
 fn position_code(grid: Grid, t: &str, n: usize) -> String {
     let last = n - 1;
@@ -145,11 +154,7 @@ fn write_lookup(out: &mut String, table: &Table, prefix: &str, ty: &str) {
         out,
         "/// Bilinear lookup of [`{prefix}`] (or a table laid out like it: its `ONE_MINUS` and \
          `STD_ERROR`\n/// twins) the way kiln's `Table::lookup` does it, in f32: {}.",
-        spec.axes()
-            .iter()
-            .map(|a| format!("`{}` axis {}", a.name(), a.formula()))
-            .collect::<Vec<_>>()
-            .join("; ")
+        axis_formulas(spec)
     );
     let _ = writeln!(
         out,
@@ -221,11 +226,7 @@ fn write_ior_lookup(out: &mut String, table: &Table, prefix: &str, ty: &str) {
         out,
         "/// Lookup of [`{prefix}`] (or its `ONE_MINUS` and `STD_ERROR` twins) the way kiln's \
          `Table::lookup_eta`\n/// does it, in f32, clamp to edge: {}.",
-        spec.axes()
-            .iter()
-            .map(|a| format!("`{}` axis {}", a.name(), a.formula()))
-            .collect::<Vec<_>>()
-            .join("; ")
+        axis_formulas(spec)
     );
     let _ = writeln!(
         out,

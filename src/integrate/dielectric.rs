@@ -224,8 +224,10 @@ pub fn reference_dielectric_albedo(
 }
 
 /// `E_avg,eta = 2 ∫ E_eta(mu) mu dmu` with its parts, by nested quadrature: the inner integrals at
-/// a tenth of the tolerance, the outer one broken at `alpha / 16, alpha / 4, alpha, 4 alpha` (the
-/// grazing layer) and, for `eta < 1`, at the critical angle's `mu = sqrt(1 - eta^2)`.
+/// a quarter of the tolerance (their errors add up under a weight `2 mu` that integrates to 1),
+/// the outer one broken at `alpha / 16, alpha / 4, alpha, 4 alpha` (the grazing layer) and, for
+/// `eta < 1`, at the critical angle's `mu_c = sqrt(1 - eta^2)` and `mu_c +- alpha / 4, alpha,
+/// 4 alpha` (the roughness smooths the critical angle over a width ~alpha).
 #[must_use]
 pub fn reference_dielectric_average_albedo(
     model: Model,
