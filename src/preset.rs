@@ -11,8 +11,8 @@
 //!   lerps between nodes, so these are the values that lookup wants). C float arrays.
 //! - `bevy`: Bevy's `dfg.ktx2`: 64 x 64, x = `NoV` (linear `mu`), y = perceptual roughness, texel
 //!   centres, R = `E_scale` (`∫ (1 - Fc) w`), G = `E_bias` (`∫ Fc w`), `R16G16_SFLOAT`, GGX
-//!   height-correlated. Bevy ships it zstd-supercompressed; kiln writes it uncompressed (a valid
-//!   KTX2 its loader reads).
+//!   height-correlated, zstd-supercompressed as Bevy ships it (uncompressed without the
+//!   `containers` feature).
 //! - `three`: three.js' DFG LUT: 16 x 16, transposed (x = roughness, y = `NoV`), texel centres,
 //!   R = `E_scale`, G = `E_bias` as half-float bits in a `Uint16Array`, interleaved RG.
 
@@ -129,7 +129,11 @@ impl Preset {
             Preset::Bevy => {
                 let texture =
                     Texture::of_values(&[&tables[0], &tables[1]]).map_err(Error::InvalidInput)?;
-                ktx2::encode(&texture, Precision::F16).map_err(Error::InvalidInput)
+                #[cfg(feature = "containers")]
+                let scheme = ktx2::Supercompression::Zstd;
+                #[cfg(not(feature = "containers"))]
+                let scheme = ktx2::Supercompression::None;
+                ktx2::encode_with(&texture, Precision::F16, scheme).map_err(Error::InvalidInput)
             }
             Preset::Three => {
                 let (scale, bias) = (engine_order(&tables[0]), engine_order(&tables[1]));
@@ -192,14 +196,28 @@ impl Preset {
             Preset::Bevy => {
                 let reader = ::ktx2::Reader::new(bytes).map_err(|e| bad(format!("{e:?}")))?;
                 let header = reader.header();
-                if header.supercompression_scheme.is_some() {
-                    return Err(bad(
-                        "the file is supercompressed (Bevy ships dfg.ktx2 with zstd): kiln \
-                         reads uncompressed KTX2 only; decompress it first (ktx deflate or \
-                         ktx extract)"
-                            .into(),
-                    ));
-                }
+                let level = reader
+                    .levels()
+                    .next()
+                    .ok_or_else(|| bad("no level".into()))?;
+                let data: Vec<u8> = match header.supercompression_scheme {
+                    None => level.data.to_vec(),
+                    Some(::ktx2::SupercompressionScheme::Zstandard) => {
+                        let mut out = Vec::new();
+                        ruzstd::decoding::StreamingDecoder::new(level.data)
+                            .map_err(|e| bad(format!("zstd: {e}")))
+                            .and_then(|mut d| {
+                                std::io::Read::read_to_end(&mut d, &mut out)
+                                    .map_err(|e| bad(format!("zstd: {e}")))
+                            })?;
+                        out
+                    }
+                    Some(other) => {
+                        return Err(bad(format!(
+                            "supercompression {other:?}: kiln reads none or Zstandard"
+                        )));
+                    }
+                };
                 if header.format != Some(::ktx2::Format::R16G16_SFLOAT)
                     || (header.pixel_width, header.pixel_height) != (n as u32, n as u32)
                 {
@@ -208,11 +226,6 @@ impl Preset {
                         header.pixel_width, header.pixel_height, header.format
                     )));
                 }
-                let data = reader
-                    .levels()
-                    .next()
-                    .ok_or_else(|| bad("no level".into()))?
-                    .data;
                 let half = |k: usize| {
                     f64::from(half::f16::from_le_bytes([data[2 * k], data[2 * k + 1]]).to_f32())
                 };

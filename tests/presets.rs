@@ -90,7 +90,20 @@ fn bevy_layout_is_rg16f_ktx2_scale_bias_with_nov_across() {
         (header.pixel_width, header.pixel_height, header.pixel_depth),
         (64, 64, 0)
     );
-    let data = reader.levels().next().unwrap().data;
+    // zstd-supercompressed, as Bevy ships it.
+    assert_eq!(
+        header.supercompression_scheme,
+        Some(ktx2::SupercompressionScheme::Zstandard)
+    );
+    let level = reader.levels().next().unwrap();
+    assert_eq!(level.uncompressed_byte_length, 64 * 64 * 4);
+    let mut data = Vec::new();
+    std::io::Read::read_to_end(
+        &mut ruzstd::decoding::StreamingDecoder::new(level.data).unwrap(),
+        &mut data,
+    )
+    .unwrap();
+    assert!(level.data.len() < data.len(), "compressed");
     let texel = |x: usize, y: usize, c: usize| {
         let i = 2 * (2 * (y * 64 + x) + c);
         f64::from(half::f16::from_le_bytes([data[i], data[i + 1]]).to_f32())

@@ -12,6 +12,11 @@
 //!
 //! Formats: `R16_SFLOAT` (76), `R16G16_SFLOAT` (83), `R32_SFLOAT` (100), `R32G32_SFLOAT` (103);
 //! 1-D, 2-D and 3-D (an IOR table: depth = the `eta` axis).
+//!
+//! Supercompression ([`Supercompression::Zstd`], with the `containers` feature): the level's
+//! bytes compressed as one Zstandard frame (scheme 2, `ruzstd` at its fastest level,
+//! deterministic), `bytesPlane0` 0 as the specification requires of supercompressed data, the
+//! level index holding the compressed and the uncompressed lengths.
 
 use super::Precision;
 use super::texture::Texture;
@@ -33,18 +38,49 @@ pub fn vk_format(channels: usize, precision: Precision) -> Option<u32> {
     }
 }
 
+/// How the texels are stored.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Supercompression {
+    None,
+    /// Zstandard (KTX2 scheme 2), as Bevy ships its DFG table.
+    #[cfg(feature = "containers")]
+    Zstd,
+}
+
 fn align(n: usize, to: usize) -> usize {
     n.div_ceil(to) * to
 }
 
-/// Encodes a texture of one or two channels.
+/// Encodes a texture of one or two channels, uncompressed.
 pub fn encode(texture: &Texture, precision: Precision) -> std::result::Result<Vec<u8>, String> {
+    encode_with(texture, precision, Supercompression::None)
+}
+
+/// Encodes a texture of one or two channels with the given supercompression.
+pub fn encode_with(
+    texture: &Texture,
+    precision: Precision,
+    supercompression: Supercompression,
+) -> std::result::Result<Vec<u8>, String> {
     let channels = texture.channels.len();
     let format = vk_format(channels, precision)
         .ok_or_else(|| format!("KTX2 output takes one or two channels (got {channels})"))?;
     let type_size = precision.bytes();
     let texel_bytes = type_size * channels;
-    let texels = texture.interleaved(precision);
+    let raw = texture.interleaved(precision);
+    let (texels, scheme) = match supercompression {
+        Supercompression::None => (raw.clone(), 0),
+        #[cfg(feature = "containers")]
+        Supercompression::Zstd => (
+            ruzstd::encoding::compress_to_vec(
+                raw.as_slice(),
+                ruzstd::encoding::CompressionLevel::Fastest,
+            ),
+            2,
+        ),
+    };
+    // Supercompressed data has no fixed bytes per plane (KTX 2.0, 3.10.2).
+    let plane_bytes = if scheme == 0 { texel_bytes as u8 } else { 0 };
 
     // Data format descriptor: total size, then one basic block of 24 + 16 * channels bytes.
     let block_size = 24 + 16 * channels;
@@ -55,7 +91,7 @@ pub fn encode(texture: &Texture, precision: Precision) -> std::result::Result<Ve
     put(&mut dfd, 2 | (block_size as u32) << 16); // version 2
     dfd.extend_from_slice(&[1, 1, 1, 0]); // RGBSDA, BT.709, linear, straight alpha
     dfd.extend_from_slice(&[0, 0, 0, 0]); // texel block 1 x 1 x 1 x 1
-    dfd.extend_from_slice(&[texel_bytes as u8, 0, 0, 0, 0, 0, 0, 0]); // bytes per plane
+    dfd.extend_from_slice(&[plane_bytes, 0, 0, 0, 0, 0, 0, 0]); // bytes per plane
     let bits = 8 * type_size as u32;
     for c in 0..channels as u32 {
         // Float (0x80) and signed (0x40) qualifiers; channel id R = 0, G = 1.
@@ -102,7 +138,7 @@ pub fn encode(texture: &Texture, precision: Precision) -> std::result::Result<Ve
         0, // layers: not an array
         1, // faces
         1, // levels
-        0, // no supercompression
+        scheme,
     ] {
         put(&mut out, v);
     }
@@ -114,7 +150,7 @@ pub fn encode(texture: &Texture, precision: Precision) -> std::result::Result<Ve
     put64(&mut out, 0);
     put64(&mut out, data_offset as u64);
     put64(&mut out, texels.len() as u64);
-    put64(&mut out, texels.len() as u64);
+    put64(&mut out, raw.len() as u64);
     debug_assert_eq!(out.len(), header_end);
     out.extend_from_slice(&dfd);
     out.extend_from_slice(&kvd);
