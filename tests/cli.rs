@@ -878,3 +878,59 @@ fn presets_bake_and_verify() {
     let refused = kiln(&["bake", "--preset", "bevy", "--size", "8", "--out", out]);
     assert_eq!(refused.status.code(), Some(2));
 }
+
+/// `kiln eval --quantity e-dielectric --ior ETA`: the energy albedo in the usual JSON object,
+/// with the reference's reflected and transmitted parts and the radiance albedo beside it.
+#[test]
+fn eval_dielectric_reports_both_conventions() {
+    let output = kiln(&[
+        "eval",
+        "--quantity",
+        "e-dielectric",
+        "--ior",
+        "1.5",
+        "--alpha",
+        "0.5",
+        "--mu",
+        "0.5",
+        "--method",
+        "reference",
+        "--json",
+    ]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let json: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    let get = |k: &str| json[k].as_f64().unwrap_or_else(|| panic!("{k} in {json}"));
+    let (r, t) = (get("reflection"), get("transmission"));
+    assert!((get("value") - (r + t)).abs() < 1e-15);
+    assert!((get("radiance_albedo") - (r + t / 2.25)).abs() < 1e-15);
+    assert!((get("value") + get("one_minus_value") - 1.0).abs() < 1e-10);
+    assert_eq!(json["quantity"], "E_dielectric");
+    // QMC agrees within its standard error (4 of them).
+    let output = kiln(&[
+        "eval",
+        "--quantity",
+        "e-dielectric",
+        "--ior",
+        "1.5",
+        "--alpha",
+        "0.5",
+        "--mu",
+        "0.5",
+        "--json",
+    ]);
+    let qmc: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    let gap = (qmc["value"].as_f64().unwrap() - get("value")).abs();
+    assert!(gap < 4.0 * qmc["std_error"].as_f64().unwrap(), "{qmc}");
+    // Without the index: one line, status 2.
+    let refused = kiln(&[
+        "eval",
+        "--quantity",
+        "e-dielectric",
+        "--alpha",
+        "0.5",
+        "--mu",
+        "0.5",
+    ]);
+    assert_eq!(refused.status.code(), Some(2));
+    assert!(stderr(&refused).contains("--ior"), "{}", stderr(&refused));
+}

@@ -26,6 +26,12 @@ pub enum EvalQuantity {
     /// Average Fresnel reflectance F_avg = 2 * integral of F(mu) mu dmu for the --fresnel model
     /// (per channel; no roughness).
     FAvg,
+    /// Energy albedo R + T of a rough dielectric interface at relative index --ior (light
+    /// arriving from the side --ior is relative to; give 1/eta for inside), with --mu; the
+    /// reference also reports R, T and the radiance albedo R + T / eta^2.
+    EDielectric,
+    /// Its average 2 * integral of E mu dmu.
+    EAvgDielectric,
 }
 
 /// Evaluate E or E_avg at one point, or F_avg.
@@ -87,6 +93,8 @@ pub fn run(args: EvalArgs) -> kiln::Result<()> {
         EvalQuantity::FAvg => return fresnel_average(&args, fresnel),
         EvalQuantity::E => Quantity::E,
         EvalQuantity::EAvg => Quantity::EAvg,
+        EvalQuantity::EDielectric => Quantity::EDielectric,
+        EvalQuantity::EAvgDielectric => Quantity::EAvgDielectric,
     };
     if args.fresnel.given() && quantity == Quantity::EAvg {
         return Err(kiln::Error::InvalidInput(
@@ -111,13 +119,24 @@ pub fn run(args: EvalArgs) -> kiln::Result<()> {
     };
     let mu = match (quantity, args.mu) {
         (q, None) if q.has_mu() => {
-            return Err(kiln::Error::InvalidInput(
-                "--quantity e needs --mu (cos(theta) in [0, 1])".into(),
-            ));
+            return Err(kiln::Error::InvalidInput(format!(
+                "--quantity {} needs --mu (cos(theta) in [0, 1])",
+                q.cli_name()
+            )));
         }
         (q, Some(mu)) if q.has_mu() => Some(mu),
         _ => None,
     };
+    if quantity.has_ior() {
+        let Fresnel::Dielectric { eta } = fresnel else {
+            return Err(kiln::Error::InvalidInput(format!(
+                "--quantity {} needs the relative index: --ior ETA (e.g. 1.5 for light arriving \
+                 from air onto glass, 0.6667 for light arriving from inside)",
+                quantity.cli_name()
+            )));
+        };
+        return dielectric(&args, model, eta, alpha, mu);
+    }
     if fresnel != Fresnel::None {
         let mu = mu.expect("E has a mu");
         return fresnel_weighted(&args, model, fresnel, alpha, mu);
@@ -359,6 +378,126 @@ fn fresnel_weighted(
 }
 
 /// Prints an eval JSON object, with the QMC settings when QMC computed it.
+/// `kiln eval --quantity e-dielectric|e-avg-dielectric --ior ETA`.
+fn dielectric(
+    args: &EvalArgs,
+    model: Model,
+    eta: f64,
+    alpha: f64,
+    mu: Option<f64>,
+) -> kiln::Result<()> {
+    use kiln::integrate::dielectric::{
+        dielectric_albedo, dielectric_average_albedo, reference_dielectric_albedo,
+        reference_dielectric_average_albedo,
+    };
+    let start = Instant::now();
+    let (value, one_minus_value, error, samples, converged, parts) = match args.method {
+        Method::Qmc => {
+            let settings = QmcSettings {
+                samples: args.samples.unwrap_or(if mu.is_some() {
+                    QmcSettings::DEFAULT_SAMPLES
+                } else {
+                    16 * QmcSettings::DEFAULT_SAMPLES
+                }),
+                scrambles: args.scrambles,
+                seed: args.seed,
+            };
+            settings.validate().map_err(kiln::Error::InvalidInput)?;
+            let e = match mu {
+                Some(mu) => dielectric_albedo(model, alpha, mu, eta, &settings),
+                None => dielectric_average_albedo(model, alpha, eta, &settings),
+            };
+            (
+                e.value,
+                e.one_minus_value,
+                e.std_error,
+                e.samples,
+                true,
+                None,
+            )
+        }
+        Method::Reference => {
+            args.no_samples_for_reference()?;
+            let settings = ReferenceSettings::default();
+            let r = match mu {
+                Some(mu) => reference_dielectric_albedo(model, alpha, mu, eta, &settings),
+                None => reference_dielectric_average_albedo(
+                    model,
+                    alpha,
+                    eta,
+                    &ReferenceSettings {
+                        tolerance: 1e-9,
+                        ..settings
+                    },
+                ),
+            };
+            let parts = (r.reflection, r.transmission, r.radiance_albedo(eta));
+            (
+                r.value(),
+                r.one_minus_value,
+                r.error,
+                r.evaluations,
+                r.converged,
+                Some(parts),
+            )
+        }
+    };
+    let seconds = start.elapsed().as_secs_f64();
+    let symbol = if mu.is_some() {
+        "E_dielectric"
+    } else {
+        "E_avg_dielectric"
+    };
+    let method = match args.method {
+        Method::Qmc => "qmc",
+        Method::Reference => "reference",
+    };
+    if args.json {
+        let mut object = serde_json::json!({
+            "quantity": symbol,
+            "ndf": model.ndf.name(),
+            "masking": model.masking.name(),
+            "eta": eta,
+            "alpha": alpha,
+            "roughness": args.roughness,
+            "mu": mu,
+            "value": value,
+            "one_minus_value": one_minus_value,
+            "convention": "energy albedo R + T (sample weight)",
+            "std_error": error,
+            "method": method,
+            "samples": samples,
+            "seconds": seconds,
+            "converged": converged,
+            "kiln_version": kiln::format::metadata::KILN_VERSION,
+        });
+        if let Some((reflection, transmission, radiance)) = parts {
+            object["reflection"] = reflection.into();
+            object["transmission"] = transmission.into();
+            object["radiance_albedo"] = radiance.into();
+        }
+        print_json(args, object);
+    } else {
+        println!(
+            "{symbol} = {value:.10} (1 - {symbol} = {one_minus_value:.4e}), {} {error:.2e}, \
+             eta {eta}, alpha {alpha}{}",
+            if args.method == Method::Qmc {
+                "std error"
+            } else {
+                "error estimate"
+            },
+            mu.map(|m| format!(", mu {m}")).unwrap_or_default()
+        );
+        if let Some((reflection, transmission, radiance)) = parts {
+            println!(
+                "  reflection R = {reflection:.10}, transmission T = {transmission:.10}, \
+                 radiance albedo R + T / eta^2 = {radiance:.10}"
+            );
+        }
+    }
+    Ok(())
+}
+
 fn print_json(args: &EvalArgs, mut object: serde_json::Value) {
     if args.method == Method::Qmc {
         object["estimator"] = "vndf-sobol-owen".into();
