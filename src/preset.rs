@@ -15,6 +15,9 @@
 //!   `containers` feature).
 //! - `three`: three.js' DFG LUT: 16 x 16, transposed (x = roughness, y = `NoV`), texel centres,
 //!   R = `E_scale`, G = `E_bias` as half-float bits in a `Uint16Array`, interleaved RG.
+//! - `enterprise-pbr`: Dassault Systèmes' Enterprise PBR `res/GGX_E.exr` (32 x 32, x = `cos`,
+//!   y = perceptual roughness from the top, texel centres) and `res/GGX_E_avg.exr` (32 x 1), GGX
+//!   height-correlated, F = 1, one half-float channel `Y`.
 
 use crate::bake::BakeOptions;
 use crate::error::{Error, Result};
@@ -34,11 +37,19 @@ pub enum Preset {
     Bevy,
     /// three.js: scale/bias, 16 x 16 transposed (roughness, NoV), centres, half bits.
     Three,
+    /// Enterprise PBR: GGX_E.exr 32 x 32 and GGX_E_avg.exr 32, centres, half channel Y.
+    #[cfg_attr(feature = "cli", value(name = "enterprise-pbr"))]
+    EnterprisePbr,
 }
 
 impl Preset {
     /// Every preset.
-    pub const ALL: [Preset; 3] = [Preset::Cycles, Preset::Bevy, Preset::Three];
+    pub const ALL: [Preset; 4] = [
+        Preset::Cycles,
+        Preset::Bevy,
+        Preset::Three,
+        Preset::EnterprisePbr,
+    ];
 
     /// The name on the command line.
     #[must_use]
@@ -47,17 +58,30 @@ impl Preset {
             Preset::Cycles => "cycles",
             Preset::Bevy => "bevy",
             Preset::Three => "three",
+            Preset::EnterprisePbr => "enterprise-pbr",
         }
     }
 
-    /// The file the preset writes (the engine's own name where it has one).
+    /// The file the preset writes (the engine's own name; the first, for a preset of two).
     #[must_use]
     pub fn file_name(self) -> &'static str {
         match self {
             Preset::Cycles => "shader.tables",
             Preset::Bevy => "dfg.ktx2",
             Preset::Three => "DFGLUT.js",
+            Preset::EnterprisePbr => "GGX_E.exr",
         }
+    }
+
+    /// Every file the preset writes, `(name, bytes)`.
+    pub fn files(self, tables: &[Table]) -> Result<Vec<(String, Vec<u8>)>> {
+        let mut files = vec![(self.file_name().to_string(), self.encode(tables)?)];
+        if self == Preset::EnterprisePbr {
+            let average = crate::format::exr::encode_value_as(&tables[1], "Y", Precision::F16)
+                .map_err(Error::InvalidInput)?;
+            files.push(("GGX_E_avg.exr".to_string(), average));
+        }
+        Ok(files)
     }
 
     /// The bake that gives the preset's tables (to the default max error).
@@ -65,6 +89,7 @@ impl Preset {
     pub fn options(self) -> BakeOptions {
         let (size, grid, quantities) = match self {
             Preset::Cycles => (32, Grid::Nodes, vec![Quantity::E, Quantity::EAvg]),
+            Preset::EnterprisePbr => (32, Grid::Centers, vec![Quantity::E, Quantity::EAvg]),
             Preset::Bevy => (64, Grid::Centers, vec![Quantity::EScale, Quantity::EBias]),
             Preset::Three => (16, Grid::Centers, vec![Quantity::EScale, Quantity::EBias]),
         };
@@ -88,11 +113,12 @@ impl Preset {
         match self {
             // mu-major (Cycles), roughness rows (Bevy), NoV rows (three.js).
             Preset::Cycles | Preset::Three => m * n + r,
-            Preset::Bevy => r * n + m,
+            Preset::Bevy | Preset::EnterprisePbr => r * n + m,
         }
     }
 
-    /// Writes the tables ([`Preset::options`]'s bake, in its order) in the engine's layout.
+    /// Writes the tables ([`Preset::options`]'s bake, in its order) in the engine's layout: the
+    /// file [`Preset::file_name`] (see [`Preset::files`] for all of them).
     pub fn encode(self, tables: &[Table]) -> Result<Vec<u8>> {
         let n = self.options().size;
         let engine_order = |table: &Table| -> Vec<f64> {
@@ -105,6 +131,10 @@ impl Preset {
             out
         };
         match self {
+            Preset::EnterprisePbr => {
+                crate::format::exr::encode_value_as(&tables[0], "Y", Precision::F16)
+                    .map_err(Error::InvalidInput)
+            }
             Preset::Cycles => {
                 let mut out = format!(
                     "/* kiln {}: Cycles' GGX energy-compensation tables (GGX, height-correlated, \
@@ -156,10 +186,9 @@ impl Preset {
         }
     }
 
-    /// Reads an engine's own file in this layout: per channel of [`Preset::options`]'s
-    /// quantities, the values in kiln's order (roughness rows, `mu` columns; `E_avg` by
-    /// roughness).
-    pub fn decode(self, bytes: &[u8]) -> Result<Vec<Vec<f64>>> {
+    /// Reads an engine's own file in this layout: each table it holds, as its quantity and its
+    /// values in kiln's order (roughness rows, `mu` columns; `E_avg` by roughness).
+    pub fn decode(self, bytes: &[u8]) -> Result<Vec<(Quantity, Vec<f64>)>> {
         let n = self.options().size;
         let bad = |m: String| Error::InvalidInput(format!("not a {} table: {m}", self.name()));
         let kiln_order = |engine: &[f64]| -> Vec<f64> {
@@ -172,6 +201,21 @@ impl Preset {
             out
         };
         match self {
+            Preset::EnterprisePbr => {
+                let image = crate::format::exr::decode(bytes).map_err(bad)?;
+                let (_, values) = image
+                    .channels
+                    .iter()
+                    .find(|(name, _)| name == "Y")
+                    .ok_or_else(|| bad("no channel Y".into()))?;
+                match (image.width, image.height) {
+                    (w, h) if (w, h) == (n, n) => Ok(vec![(Quantity::E, kiln_order(values))]),
+                    (w, 1) if w == n => Ok(vec![(Quantity::EAvg, values.clone())]),
+                    (w, h) => Err(bad(format!(
+                        "{w} x {h} (expected GGX_E.exr, {n} x {n}, or GGX_E_avg.exr, {n} x 1)"
+                    ))),
+                }
+            }
             Preset::Cycles => {
                 let text = String::from_utf8_lossy(bytes);
                 let e =
@@ -186,7 +230,7 @@ impl Preset {
                         n * n
                     )));
                 }
-                Ok(vec![kiln_order(&e), avg])
+                Ok(vec![(Quantity::E, kiln_order(&e)), (Quantity::EAvg, avg)])
             }
             #[cfg(not(feature = "containers"))]
             Preset::Bevy => Err(bad(
@@ -232,7 +276,10 @@ impl Preset {
                 let channel = |c: usize| -> Vec<f64> {
                     kiln_order(&(0..n * n).map(|k| half(2 * k + c)).collect::<Vec<_>>())
                 };
-                Ok(vec![channel(0), channel(1)])
+                Ok(vec![
+                    (Quantity::EScale, channel(0)),
+                    (Quantity::EBias, channel(1)),
+                ])
             }
             Preset::Three => {
                 let text = String::from_utf8_lossy(bytes);
@@ -264,7 +311,10 @@ impl Preset {
                         .collect();
                     kiln_order(&engine)
                 };
-                Ok(vec![channel(0), channel(1)])
+                Ok(vec![
+                    (Quantity::EScale, channel(0)),
+                    (Quantity::EBias, channel(1)),
+                ])
             }
         }
     }
@@ -274,11 +324,14 @@ impl Preset {
     /// An engine's own file read as kiln tables of the preset's specs (values as stored; `1 -
     /// value` by subtraction; no standard errors), for auditing.
     pub fn read_tables(self, bytes: &[u8], origin: &str) -> Result<Vec<Table>> {
-        let values = self.decode(bytes)?;
         let specs = self.options().resolved().specs();
-        Ok(specs
+        Ok(self
+            .decode(bytes)?
             .into_iter()
-            .zip(values)
+            .filter_map(|(quantity, value)| {
+                let spec = specs.iter().find(|s| s.quantity == quantity)?.clone();
+                Some((spec, value))
+            })
             .map(|(spec, value)| Table {
                 one_minus_value: value.iter().map(|v| 1.0 - v).collect(),
                 std_error: vec![0.0; value.len()],

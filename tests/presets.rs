@@ -177,3 +177,34 @@ fn damaged_engine_files_are_refused_with_a_reason() {
         .to_string();
     assert!(error.contains("not a bevy table"), "{error}");
 }
+
+#[test]
+fn enterprise_pbr_layout_is_half_exr_channel_y_with_cos_across() {
+    let tables = bake(Preset::EnterprisePbr);
+    let (e, avg) = (&tables[0], &tables[1]);
+    let files = Preset::EnterprisePbr.files(&tables).unwrap();
+    let names: Vec<&str> = files.iter().map(|(n, _)| n.as_str()).collect();
+    assert_eq!(names, ["GGX_E.exr", "GGX_E_avg.exr"]);
+    // Read through the exr crate (kiln's thin reader of any EXR): one half-float channel Y.
+    for ((_, bytes), table) in files.iter().zip([e, avg]) {
+        let decoded = kiln::format::exr::decode(bytes).unwrap();
+        assert_eq!(decoded.channels.len(), 1);
+        assert_eq!(decoded.channels[0].0, "Y");
+        let (w, h) = match table.spec.shape()[..] {
+            [rows, columns] => (columns, rows),
+            [n] => (n, 1),
+            _ => unreachable!(),
+        };
+        assert_eq!((decoded.width, decoded.height), (w, h));
+        for (k, &v) in decoded.channels[0].1.iter().enumerate() {
+            // Row y = roughness index from the top, column x = cos, texel centres.
+            assert_eq!(v, f16_of(table.value[k]), "{} {k}", table.spec.id());
+        }
+        let back = Preset::EnterprisePbr.read_tables(bytes, "test").unwrap();
+        assert_eq!(back.len(), 1);
+        assert_eq!(back[0].spec.quantity, table.spec.quantity);
+    }
+    let (alpha, mu) = e.spec.texel_coordinates(3 * 32 + 5);
+    assert!((mu.unwrap() - 5.5 / 32.0).abs() < 1e-15);
+    assert!((alpha - (3.5f64 / 32.0).powi(2)).abs() < 1e-15);
+}

@@ -34,17 +34,60 @@ pub fn encode(table: &Table, precision: Precision) -> std::result::Result<Vec<u8
     };
     let names = table.channel_names();
     let channels = table.channels();
+    write(
+        table,
+        (width, height),
+        vec![
+            (names[0].as_str(), channels[0], precision),
+            (names[1].as_str(), channels[1], precision),
+            (names[2].as_str(), channels[2], Precision::F32),
+        ],
+    )
+}
+
+/// Encodes only the table's value channel, under the channel name `name` (an engine's layout,
+/// e.g. Enterprise PBR's half-float `Y`), with the same header and metadata as [`encode`].
+pub fn encode_value_as(
+    table: &Table,
+    name: &str,
+    precision: Precision,
+) -> std::result::Result<Vec<u8>, String> {
+    let shape = table.spec.shape();
+    let (width, height) = match shape[..] {
+        [rows, columns] => (columns, rows),
+        [n] => (n, 1),
+        _ => {
+            return Err(format!(
+                "cannot store a table of shape {shape:?} as an image"
+            ));
+        }
+    };
+    write(
+        table,
+        (width, height),
+        vec![(name, &table.value, precision)],
+    )
+}
+
+/// Writes channels `(name, values, precision)` of a `width x height` image with kiln's header.
+fn write(
+    table: &Table,
+    (width, height): (usize, usize),
+    channels: Vec<(&str, &[f64], Precision)>,
+) -> std::result::Result<Vec<u8>, String> {
+    let precision = channels[0].2;
     let samples = |values: &[f64], precision: Precision| match precision {
         Precision::F32 => FlatSamples::F32(values.iter().map(|&v| v as f32).collect()),
         Precision::F16 => {
             FlatSamples::F16(values.iter().map(|&v| super::f16::encode(v).0).collect())
         }
     };
-    let list = SmallVec::from_vec(vec![
-        AnyChannel::new(names[0].as_str(), samples(channels[0], precision)),
-        AnyChannel::new(names[1].as_str(), samples(channels[1], precision)),
-        AnyChannel::new(names[2].as_str(), samples(channels[2], Precision::F32)),
-    ]);
+    let list = SmallVec::from_vec(
+        channels
+            .into_iter()
+            .map(|(name, values, precision)| AnyChannel::new(name, samples(values, precision)))
+            .collect(),
+    );
     let metadata = serde_json::to_string(&Metadata::new(table, precision.name()))
         .map_err(|e| e.to_string())?;
     let mut attributes = LayerAttributes::named(table.spec.id().as_str());

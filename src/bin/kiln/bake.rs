@@ -96,9 +96,10 @@ pub struct BakeArgs {
     )]
     scene: Option<PathBuf>,
     /// Bake an engine's table in that engine's own layout, to drop in for its file: cycles
-    /// (shader.tables: table_ggx_E, table_ggx_Eavg), bevy (dfg.ktx2, RG16F scale/bias, 64 x 64)
-    /// or three (DFGLUT.js, 16 x 16 transposed half bits); with kiln's JSON sidecars of the
-    /// tables it holds. --max-error and --out apply.
+    /// (shader.tables: table_ggx_E, table_ggx_Eavg), bevy (dfg.ktx2, RG16F scale/bias, 64 x 64,
+    /// zstd), three (DFGLUT.js, 16 x 16 transposed half bits) or enterprise-pbr (GGX_E.exr and
+    /// GGX_E_avg.exr, half channel Y); with kiln's JSON sidecars of the tables it holds.
+    /// --max-error and --out apply.
     #[arg(
         long,
         value_enum,
@@ -258,7 +259,7 @@ fn bake_preset(preset: kiln::preset::Preset, args: &BakeArgs) -> kiln::Result<()
     let start = Instant::now();
     let tables = options.bake(&|samples| bar.inc(samples))?;
     bar.finish_and_clear();
-    let mut files = vec![(preset.file_name().to_string(), preset.encode(&tables)?)];
+    let mut files = preset.files(&tables)?;
     files.extend(format::encode_all(
         &tables,
         &[Format::Json],

@@ -44,9 +44,9 @@ pub struct VerifyArgs {
     #[arg(long)]
     json: bool,
     /// FILE is an engine's own table in that engine's layout (cycles: shader.tables with
-    /// table_ggx_E and table_ggx_Eavg; bevy: an uncompressed dfg.ktx2; three: the DFG LUT's
-    /// Uint16Array): audit each of its tables against the reference for the model the engine
-    /// evaluates (GGX, height-correlated).
+    /// table_ggx_E and table_ggx_Eavg; bevy: dfg.ktx2, zstd or not; three: the DFG LUT's
+    /// Uint16Array; enterprise-pbr: GGX_E.exr or GGX_E_avg.exr): audit each of its tables
+    /// against the reference for the model the engine evaluates (GGX, height-correlated).
     #[arg(long, value_enum, conflicts_with_all = ["furnace", "shape", "channel", "dtype"])]
     preset: Option<kiln::preset::Preset>,
     /// Exit with status 1 when node_max_error exceeds this.
