@@ -176,6 +176,9 @@ impl BakeOptions {
             (true, Some(fresnel)) => fresnel.validate().map_err(Error::InvalidInput)?,
             (false, None) => {}
         }
+        for model in self.models() {
+            model.validate().map_err(Error::InvalidInput)?;
+        }
         if self.ndfs.is_empty() || self.maskings.is_empty() || self.quantities.is_empty() {
             return Err(Error::InvalidInput(
                 "name at least one ndf, one masking and one quantity".into(),

@@ -241,6 +241,9 @@ impl Scene {
                 .model()
                 .validate()
                 .map_err(|e| bad(format!("material '{}': {e}", m.name)))?;
+            m.model()
+                .validate()
+                .map_err(|e| bad(format!("material '{}': {e}", m.name)))?;
             if m.transmission && !matches!(m.fresnel, FresnelSpec::Dielectric { .. }) {
                 return Err(bad(format!(
                     "material '{}': transmission = true needs a dielectric fresnel, e.g. \

@@ -132,6 +132,7 @@ proptest! {
                 Masking::Separable => {
                     prop_assert!(grazing.value < 1.0 && sampled.value < 1.0, "{model:?} {alpha:e}");
                 }
+                Masking::SchlickGgx => unreachable!("models() holds the Smith forms"),
             }
             let smooth_alpha = alpha * 1e-3 * mu;
             let near_mirror = reference_albedo(model, smooth_alpha, mu, &quick_reference());

@@ -119,6 +119,18 @@ pub fn albedo(model: Model, alpha: f64, mu: f64, settings: &QmcSettings) -> Esti
                     |[u0, u1]| ggx_loss::<false>(&view, u0, u1),
                 )
             }
+            (Ndf::Ggx, masking) => {
+                // Schlick-GGX: the generic visible-normal sampler.
+                let ndf = Ggx { alpha };
+                let o = Vec3::from_mu(mu);
+                let lambda_o = ndf.lambda(o);
+                sum_over_block(
+                    seq,
+                    log2_n,
+                    #[inline(always)]
+                    |u| generic_loss(ndf, masking, o, lambda_o, u),
+                )
+            }
             (Ndf::Beckmann, masking) => {
                 let ndf = Beckmann { alpha };
                 let o = Vec3::from_mu(mu);
@@ -219,6 +231,18 @@ pub fn average_albedo(model: Model, alpha: f64, settings: &QmcSettings) -> Estim
                 #[inline(always)]
                 |[u0, u1, s]| ggx_loss::<false>(&GgxView::from_mu2(alpha, s), u0, u1),
             ),
+            (Ndf::Ggx, masking) => {
+                let ndf = Ggx { alpha };
+                sum_over_block(
+                    seq,
+                    log2_n,
+                    #[inline(always)]
+                    |[u0, u1, s]| {
+                        let o = Vec3::new((1.0 - s).sqrt(), 0.0, s.sqrt());
+                        generic_loss(ndf, masking, o, ndf.lambda(o), [u0, u1])
+                    },
+                )
+            }
             (Ndf::Beckmann, masking) => {
                 let ndf = Beckmann { alpha };
                 sum_over_block(
@@ -372,7 +396,7 @@ pub fn reflection_loss<N: MicrofacetDistribution>(
 ) -> f64 {
     let i = o.reflect(m);
     if i.z > 0.0 {
-        masking.loss(lambda_o, ndf.lambda(i))
+        masking.loss_at(ndf.alpha(), o.z, i.z, lambda_o, ndf.lambda(i))
     } else {
         1.0
     }
@@ -537,6 +561,7 @@ mod tests {
                         let fast = match masking {
                             Masking::HeightCorrelated => ggx_loss::<true>(&view, u0, u1),
                             Masking::Separable => ggx_loss::<false>(&view, u0, u1),
+                            Masking::SchlickGgx => unreachable!("ALL holds the Smith forms"),
                         };
                         // Both are a function of a direction computed two ways; near the
                         // horizon that direction is ill-conditioned, so compare loosely there.

@@ -261,10 +261,14 @@ fn albedo_quadrature<N: MicrofacetDistribution>(
             // G2 / mu = 1 / (mu (1 + Lo) + mu Li).
             Masking::HeightCorrelated => 1.0 / (1.0 / inverse_area + mu * lambda_i),
             Masking::Separable => inverse_area / (1.0 + lambda_i),
+            // G1_S(o) G1_S(i) / mu = G1_S(i) / (mu (1 - k) + k), k = alpha / 2.
+            Masking::SchlickGgx => {
+                Masking::schlick_g1(i.z, alpha) / (mu * (1.0 - 0.5 * alpha) + 0.5 * alpha)
+            }
         };
         [
             weight * g2_over_mu * h(om.min(1.0)),
-            weight * inverse_area * masking.loss(lambda_o, lambda_i),
+            weight * inverse_area * masking.loss_at(alpha, mu, i.z, lambda_o, lambda_i),
         ]
     };
 

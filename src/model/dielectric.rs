@@ -90,7 +90,7 @@ pub fn scattering<N: MicrofacetDistribution>(
     let fresnel = super::fresnel::dielectric(eta, c);
     let i_r = o.reflect(m);
     let reflection_loss = if i_r.z > 0.0 {
-        masking.loss(lambda_o, ndf.lambda(i_r))
+        masking.loss_at(ndf.alpha(), o.z, i_r.z, lambda_o, ndf.lambda(i_r))
     } else {
         1.0
     };
@@ -98,8 +98,10 @@ pub fn scattering<N: MicrofacetDistribution>(
         // Index-matched, i_t = -o: Lambda(i_t) = Lambda(o), and at a grazing view the loss takes
         // its limit along the view (1/2 height-correlated, 1 separable), not the value at
         // Lambda(o) = infinity with Lambda(i) finite that `Masking::loss` gives.
-        _ if eta == 1.0 => masking.loss_index_matched(lambda_o),
-        Some(i_t) if i_t.z < 0.0 => masking.loss(lambda_o, ndf.lambda(i_t)),
+        _ if eta == 1.0 => masking.loss_index_matched(ndf.alpha(), o.z, lambda_o),
+        Some(i_t) if i_t.z < 0.0 => {
+            masking.loss_at(ndf.alpha(), o.z, i_t.z, lambda_o, ndf.lambda(i_t))
+        }
         _ => 1.0,
     };
     let transmitted = 1.0 - fresnel;

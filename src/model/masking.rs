@@ -1,7 +1,13 @@
-//! Smith masking-shadowing `G2`, in the two forms renderers use.
+//! Masking-shadowing `G2`: Smith's, in the two forms renderers use, and the separable
+//! Schlick-GGX approximation engines evaluate.
 //!
-//! Source: Heitz 2014, "Understanding the Masking-Shadowing Function in Microfacet-Based BRDFs",
-//! eqs. 98 (separable) and 99 (height-correlated); `physics.md`.
+//! Sources: Heitz 2014, "Understanding the Masking-Shadowing Function in Microfacet-Based BRDFs",
+//! eqs. 98 (separable) and 99 (height-correlated); `physics.md`. Schlick-GGX: Schlick 1994's
+//! `G1(v) = mu / (mu (1 - k) + k)` with Karis 2013's (UE4) `k = alpha / 2` for image-based
+//! lighting, as Godot and the GAMES202 homework evaluate it (`physics.md`, "Masking-shadowing").
+//!
+//! The estimators sample Smith's visible normals whatever the form, so every form is expressed
+//! as the loss `1 - G2 / G1_Smith(o)` of a sample ([`Masking::loss_at`]).
 
 use serde::{Deserialize, Serialize};
 
@@ -15,10 +21,17 @@ pub enum Masking {
     HeightCorrelated,
     /// `G2 = G1(o) G1(i)`.
     Separable,
+    /// `G2 = G1(o) G1(i)` with Schlick's `G1(v) = mu / (mu (1 - k) + k)`, `k = alpha / 2`
+    /// (separable Schlick-GGX: UE4's image-based lighting, Godot, GAMES202). At `alpha = 1` it
+    /// equals Smith's separable GGX exactly (`G1 = 2 mu / (1 + mu)` both).
+    #[serde(rename = "schlick-ggx")]
+    #[cfg_attr(feature = "cli", value(name = "schlick-ggx"))]
+    SchlickGgx,
 }
 
 impl Masking {
-    /// Every form, in a fixed order.
+    /// The two Smith forms, in a fixed order (the forms every property of `physics.md` holds
+    /// for; [`Masking::SchlickGgx`] is an approximation engines use).
     pub const ALL: [Masking; 2] = [Masking::HeightCorrelated, Masking::Separable];
 
     /// The name used on the command line and in files.
@@ -27,15 +40,60 @@ impl Masking {
         match self {
             Masking::HeightCorrelated => "height-correlated",
             Masking::Separable => "separable",
+            Masking::SchlickGgx => "schlick-ggx",
+        }
+    }
+
+    /// Whether the form is Smith's (expressed through `Lambda` alone).
+    #[must_use]
+    pub fn is_smith(self) -> bool {
+        self != Masking::SchlickGgx
+    }
+
+    /// Schlick's `G1(v) = mu / (mu (1 - k) + k)` with `k = alpha / 2`, for `|mu|`.
+    #[must_use]
+    pub fn schlick_g1(mu: f64, alpha: f64) -> f64 {
+        let mu = mu.abs();
+        let k = 0.5 * alpha;
+        if mu == 0.0 && k == 0.0 {
+            return 1.0; // the mirror's limit
+        }
+        mu / (mu * (1.0 - k) + k)
+    }
+
+    /// One minus the visible-normal estimator's weight `G2 / G1_Smith(o)` for a sample whose
+    /// outgoing direction `i` is on the right side: [`Masking::loss`] for the Smith forms; for
+    /// Schlick-GGX `1 - G1_S(o) G1_S(i) (1 + Lambda(o))` (which may be slightly negative where
+    /// Schlick's `G1` exceeds Smith's). `mu_o`, `mu_i`: cosines of `o` and `i` (either sign).
+    #[must_use]
+    #[inline]
+    pub fn loss_at(self, alpha: f64, mu_o: f64, mu_i: f64, lambda_o: f64, lambda_i: f64) -> f64 {
+        match self {
+            Masking::SchlickGgx => {
+                let g2 = Self::schlick_g1(mu_o, alpha) * Self::schlick_g1(mu_i, alpha);
+                if lambda_o.is_infinite() {
+                    // mu_o = 0: G1_S(o) / G1_Smith(o) tends to a finite ratio; its limit as
+                    // mu_o -> 0 is (1 / k) / (2 / alpha) = 1 for k = alpha / 2 (both ~ 2 mu /
+                    // alpha), so the weight tends to G1_S(i).
+                    return 1.0 - Self::schlick_g1(mu_i, alpha);
+                }
+                1.0 - g2 * (1.0 + lambda_o)
+            }
+            _ => self.loss(lambda_o, lambda_i),
         }
     }
 
     /// `G2(o, i)` from `Lambda(o)` and `Lambda(i)`.
     #[must_use]
+    ///
+    /// # Panics
+    /// For [`Masking::SchlickGgx`], which is not a function of `Lambda` (see
+    /// [`Masking::loss_at`]).
     pub fn g2(self, lambda_o: f64, lambda_i: f64) -> f64 {
         match self {
             Masking::HeightCorrelated => 1.0 / (1.0 + lambda_o + lambda_i),
             Masking::Separable => 1.0 / ((1.0 + lambda_o) * (1.0 + lambda_i)),
+            Masking::SchlickGgx => panic!("Schlick-GGX's G2 needs the directions: loss_at"),
         }
     }
 
@@ -61,6 +119,7 @@ impl Masking {
                 }
             }
             Masking::Separable => 1.0 / (1.0 + 1.0 / lambda_i),
+            Masking::SchlickGgx => panic!("Schlick-GGX's loss needs the directions: loss_at"),
         }
     }
 }
@@ -68,15 +127,21 @@ impl Masking {
 impl Masking {
     /// [`Masking::loss`] for a direction and its opposite, `Lambda(i) = Lambda(o)` (light passing
     /// straight through an index-matched interface): `L / (1 + 2 L)` height-correlated,
-    /// `L / (1 + L)` separable, with their limits 1/2 and 1 as `L -> infinity` (a grazing view).
+    /// `L / (1 + L)` separable, with their limits 1/2 and 1 as `L -> infinity` (a grazing view);
+    /// Schlick-GGX through [`Masking::loss_at`] with `mu_i = mu_o`.
     #[must_use]
-    pub fn loss_index_matched(self, lambda: f64) -> f64 {
+    pub fn loss_index_matched(self, alpha: f64, mu: f64, lambda: f64) -> f64 {
         if lambda == 0.0 {
-            return 0.0;
+            return if self.is_smith() {
+                0.0
+            } else {
+                self.loss_at(alpha, mu, mu, lambda, lambda)
+            };
         }
         match self {
             Masking::HeightCorrelated => 1.0 / (2.0 + 1.0 / lambda),
             Masking::Separable => 1.0 / (1.0 + 1.0 / lambda),
+            Masking::SchlickGgx => self.loss_at(alpha, mu, mu, lambda, lambda),
         }
     }
 }
@@ -90,6 +155,28 @@ impl std::fmt::Display for Masking {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// At `alpha = 1`, `k = 1/2`: Schlick's `G1 = mu / (mu / 2 + 1/2) = 2 mu / (1 + mu)`, Smith's
+    /// GGX `G1 = 1 / (1 + (1 / mu - 1) / 2)`: the same; so the losses agree with separable.
+    #[test]
+    fn schlick_ggx_equals_smith_separable_at_alpha_one() {
+        use crate::model::{Ggx, MicrofacetDistribution, Vec3};
+        let ndf = Ggx { alpha: 1.0 };
+        for mu_o in [0.05, 0.3, 0.9, 1.0] {
+            for mu_i in [0.01, 0.4, 1.0] {
+                let (lo, li) = (
+                    ndf.lambda(Vec3::from_mu(mu_o)),
+                    ndf.lambda(Vec3::from_mu(mu_i)),
+                );
+                let schlick = Masking::SchlickGgx.loss_at(1.0, mu_o, mu_i, lo, li);
+                let smith = Masking::Separable.loss(lo, li);
+                assert!(
+                    (schlick - smith).abs() < 1e-14,
+                    "{mu_o} {mu_i}: {schlick} {smith}"
+                );
+            }
+        }
+    }
 
     #[test]
     fn loss_is_one_minus_the_weight() {
@@ -111,13 +198,16 @@ mod tests {
         assert_eq!(Masking::Separable.loss(2.0, f64::INFINITY), 1.0);
         for m in Masking::ALL {
             for l in [0.0, 1e-9, 0.3, 4.0] {
-                assert!((m.loss_index_matched(l) - m.loss(l, l)).abs() < 1e-15);
+                assert!((m.loss_index_matched(0.3, 0.5, l) - m.loss(l, l)).abs() < 1e-15);
             }
         }
         assert_eq!(
-            Masking::HeightCorrelated.loss_index_matched(f64::INFINITY),
+            Masking::HeightCorrelated.loss_index_matched(0.3, 0.0, f64::INFINITY),
             0.5
         );
-        assert_eq!(Masking::Separable.loss_index_matched(f64::INFINITY), 1.0);
+        assert_eq!(
+            Masking::Separable.loss_index_matched(0.3, 0.0, f64::INFINITY),
+            1.0
+        );
     }
 }

@@ -91,6 +91,21 @@ pub struct Model {
     pub masking: Masking,
 }
 
+impl Model {
+    /// Checks the combination: Schlick-GGX masking approximates GGX's Smith `G1` and is
+    /// defined with GGX only.
+    pub fn validate(&self) -> Result<(), String> {
+        if self.masking == Masking::SchlickGgx && self.ndf != Ndf::Ggx {
+            return Err(format!(
+                "masking schlick-ggx approximates GGX's masking and goes with --ndf ggx only \
+                 (got {})",
+                self.ndf
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// How a roughness number is to be read.
 ///
 /// Perceptual roughness `r` maps to `alpha = r^2` (Burley 2012, Karis 2013; Filament, Cycles,

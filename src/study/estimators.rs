@@ -112,6 +112,10 @@ fn g2_over_mu<N: MicrofacetDistribution>(ndf: &N, masking: Masking, mu_o: f64, i
     match masking {
         Masking::HeightCorrelated => 1.0 / (area + mu_o * lambda_i),
         Masking::Separable => 1.0 / ((1.0 + lambda_i) * area),
+        Masking::SchlickGgx => {
+            let k = 0.5 * ndf.alpha();
+            Masking::schlick_g1(i.z, ndf.alpha()) / (mu_o * (1.0 - k) + k)
+        }
     }
 }
 

@@ -304,9 +304,11 @@ impl TableSpec {
     /// rule.
     #[must_use]
     pub fn average_rule_order(&self) -> Option<usize> {
+        // The rules' bounds were measured for the Smith forms only.
         if self.method != Method::Reference
             || self.quantity != Quantity::EAvg
             || self.reference_digits.is_none()
+            || !self.model.masking.is_smith()
         {
             return None;
         }

@@ -306,6 +306,7 @@ fn spec_and_values(
             layout.shape
         ));
     }
+    layout.model.validate()?;
     if layout.quantity.has_ior() {
         return Err(format!(
             "--quantity {}: only kiln's own dielectric and F_avg tables can be audited (their \

@@ -107,6 +107,7 @@ pub fn run(args: EvalArgs) -> kiln::Result<()> {
         ndf: args.ndf,
         masking: args.masking,
     };
+    model.validate().map_err(kiln::Error::InvalidInput)?;
     let alpha = match (args.alpha, args.roughness) {
         (Some(alpha), _) => alpha,
         (None, Some(r)) => RoughnessConvention::Perceptual.to_alpha(r),
