@@ -231,32 +231,30 @@ pub fn average_albedo(model: Model, alpha: f64, settings: &QmcSettings) -> Estim
                 #[inline(always)]
                 |[u0, u1, s]| ggx_loss::<false>(&GgxView::from_mu2(alpha, s), u0, u1),
             ),
-            (Ndf::Ggx, masking) => {
-                let ndf = Ggx { alpha };
-                sum_over_block(
-                    seq,
-                    log2_n,
-                    #[inline(always)]
-                    |[u0, u1, s]| {
-                        let o = Vec3::new((1.0 - s).sqrt(), 0.0, s.sqrt());
-                        generic_loss(ndf, masking, o, ndf.lambda(o), [u0, u1])
-                    },
-                )
-            }
-            (Ndf::Beckmann, masking) => {
-                let ndf = Beckmann { alpha };
-                sum_over_block(
-                    seq,
-                    log2_n,
-                    #[inline(always)]
-                    |[u0, u1, s]| {
-                        let o = Vec3::new((1.0 - s).sqrt(), 0.0, s.sqrt());
-                        generic_loss(ndf, masking, o, ndf.lambda(o), [u0, u1])
-                    },
-                )
-            }
+            (Ndf::Ggx, masking) => generic_average(Ggx { alpha }, masking, seq, log2_n),
+            (Ndf::Beckmann, masking) => generic_average(Beckmann { alpha }, masking, seq, log2_n),
         }
     })
+}
+
+/// The summed loss of one scramble of `E_avg` for any distribution and masking, with
+/// `s = mu^2` as the third dimension (the readable form; GGX's Smith forms have the
+/// specialised kernel).
+fn generic_average<N: MicrofacetDistribution>(
+    ndf: N,
+    masking: Masking,
+    seq: &OwenSobol,
+    log2_n: u32,
+) -> f64 {
+    sum_over_block(
+        seq,
+        log2_n,
+        #[inline(always)]
+        |[u0, u1, s]| {
+            let o = Vec3::new((1.0 - s).sqrt(), 0.0, s.sqrt());
+            generic_loss(ndf, masking, o, ndf.lambda(o), [u0, u1])
+        },
+    )
 }
 
 pub(crate) fn model_key(model: Model) -> u64 {
