@@ -199,3 +199,33 @@ fn c_headers_compile_and_hold_the_values() {
         }
     }
 }
+
+/// One-channel textures (a table's value alone, as an engine may upload it): `R16_SFLOAT` and
+/// `R32_SFLOAT`, 2-D and 3-D.
+#[test]
+fn one_channel_ktx2_textures() {
+    use kiln::format::ktx2::encode;
+    use kiln::format::texture::Texture;
+    for table in tables().iter().filter(|t| t.spec.shape().len() > 1) {
+        let texture = Texture::of_values(&[table]).unwrap();
+        for (precision, format) in [
+            (Precision::F16, ktx2::Format::R16_SFLOAT),
+            (Precision::F32, ktx2::Format::R32_SFLOAT),
+        ] {
+            let bytes = encode(&texture, precision).unwrap();
+            let reader = ktx2::Reader::new(bytes.as_slice()).unwrap();
+            assert_eq!(reader.header().format, Some(format), "{}", table.spec.id());
+            let data = reader.levels().next().unwrap().data;
+            assert_eq!(data.len(), table.spec.len() * precision.bytes());
+            let last = table.spec.len() - 1;
+            let i = last * precision.bytes();
+            let stored = match precision {
+                Precision::F16 => {
+                    f64::from(half::f16::from_le_bytes([data[i], data[i + 1]]).to_f32())
+                }
+                Precision::F32 => f64::from(f32::from_le_bytes(data[i..i + 4].try_into().unwrap())),
+            };
+            assert_eq!(stored, expected(table.value[last], precision));
+        }
+    }
+}
