@@ -539,17 +539,13 @@ pub fn bake_table(spec: TableSpec, command: String, progress: &(dyn Fn(u64) + Sy
 pub fn estimate_texel(spec: &TableSpec, index: usize) -> Estimate {
     let (alpha, mu) = spec.texel_coordinates(index);
     let eta = spec.texel_eta(index);
-    match (spec.method, eta) {
-        // F_avg is a 1-D integral: always the quadrature.
-        (_, Some(eta)) if spec.quantity == Quantity::FAvg => {
-            let f = crate::model::Fresnel::Dielectric { eta }.average_report();
-            Estimate {
-                value: f.value[0],
-                one_minus_value: 1.0 - f.value[0],
-                std_error: f.error,
-                samples: f.evaluations,
-            }
-        }
+    // F_avg is a 1-D integral: always the quadrature, whatever the method.
+    let method = if spec.quantity == Quantity::FAvg {
+        Method::Reference
+    } else {
+        spec.method
+    };
+    match (method, eta) {
         (Method::Qmc, Some(eta)) => match mu {
             Some(mu) => dielectric_albedo(spec.model, alpha, mu, eta, &spec.qmc),
             None => dielectric_average_albedo(spec.model, alpha, eta, &spec.qmc),

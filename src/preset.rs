@@ -147,12 +147,7 @@ impl Preset {
                     ("table_ggx_E", engine_order(&tables[0])),
                     ("table_ggx_Eavg", tables[1].value.clone()),
                 ] {
-                    let _ = write!(out, "\nstatic const float {name}[{}] = {{", values.len());
-                    for (k, v) in values.iter().enumerate() {
-                        out.push_str(if k % 8 == 0 { "\n    " } else { " " });
-                        let _ = write!(out, "{:?}f,", *v as f32);
-                    }
-                    out.push_str("\n};\n");
+                    crate::format::c_header::float_array(&mut out, name, &values);
                 }
                 Ok(out.into_bytes())
             }

@@ -21,6 +21,20 @@ fn write_values(out: &mut String, values: impl Iterator<Item = String>) {
     out.push_str("\n};\n");
 }
 
+/// Appends `static const float NAME[N] = { ... };` (eight values a line, shortest f32 literals).
+pub(crate) fn float_array(out: &mut String, name: &str, values: &[f64]) {
+    let float = |v: &f64| {
+        let text = format!("{:?}", *v as f32);
+        if text.contains(['.', 'e', 'E']) {
+            format!("{text}f")
+        } else {
+            format!("{text}.0f")
+        }
+    };
+    let _ = write!(out, "\nstatic const float {name}[{}] = {{", values.len());
+    write_values(out, values.iter().map(float));
+}
+
 /// Generates the header.
 #[must_use]
 pub fn encode(table: &Table) -> String {
@@ -85,23 +99,13 @@ pub fn encode(table: &Table) -> String {
             axis.size, axis.name
         );
     }
-    let float = |v: &f64| {
-        let f = *v as f32;
-        let text = format!("{f:?}");
-        if text.contains(['.', 'e', 'E']) {
-            format!("{text}f")
-        } else {
-            format!("{text}.0f")
-        }
-    };
     let planes = [
         ("", &table.value),
         ("_ONE_MINUS", &table.one_minus_value),
         ("_STD_ERROR", &table.std_error),
     ];
     for (suffix, values) in planes {
-        let _ = write!(out, "\nstatic const float {prefix}{suffix}[{n}] = {{");
-        write_values(&mut out, values.iter().map(float));
+        float_array(&mut out, &format!("{prefix}{suffix}"), values);
     }
     let _ = write!(out, "\nstatic const uint16_t {prefix}_HALF[{}] = {{", 2 * n);
     let half = (0..n).flat_map(|k| {

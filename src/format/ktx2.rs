@@ -68,8 +68,9 @@ pub fn encode_with(
     let type_size = precision.bytes();
     let texel_bytes = type_size * channels;
     let raw = texture.interleaved(precision);
+    let raw_len = raw.len();
     let (texels, scheme) = match supercompression {
-        Supercompression::None => (raw.clone(), 0),
+        Supercompression::None => (raw, 0),
         #[cfg(feature = "containers")]
         Supercompression::Zstd => (
             ruzstd::encoding::compress_to_vec(
@@ -150,7 +151,7 @@ pub fn encode_with(
     put64(&mut out, 0);
     put64(&mut out, data_offset as u64);
     put64(&mut out, texels.len() as u64);
-    put64(&mut out, raw.len() as u64);
+    put64(&mut out, raw_len as u64);
     debug_assert_eq!(out.len(), header_end);
     out.extend_from_slice(&dfd);
     out.extend_from_slice(&kvd);

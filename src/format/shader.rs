@@ -73,10 +73,6 @@ impl Language {
             Language::Glsl | Language::Hlsl => format!("{ret} {name}({}) {{\n", list.join(", ")),
         }
     }
-
-    fn comment(self) -> &'static str {
-        "//"
-    }
 }
 
 /// A float literal every language accepts.
@@ -176,7 +172,7 @@ pub fn encode(table: &Table, language: Language) -> String {
     let meta = Metadata::new(table, "f32");
     let spec = &table.spec;
     let stem = name(table);
-    let c = language.comment();
+    let c = "//"; // every language's line comment
     let mut out = String::new();
     let _ = writeln!(
         out,
@@ -302,11 +298,11 @@ fn write_array_lookup(
         Grid::Centers => format!("clamp(t * {} - 0.5, 0.0, {last})", literal(n as f64)),
     };
     *out += &language.local("p", &position);
-    let (index, cast) = match language {
-        Language::Wgsl => ("i32", "i32"),
-        Language::Glsl | Language::Hlsl => ("int", "int"),
+    let int = match language {
+        Language::Wgsl => "i32",
+        Language::Glsl | Language::Hlsl => "int",
     };
-    let i_value = format!("min({cast}(floor(p)), {})", n - 2);
+    let i_value = format!("min({int}(floor(p)), {})", n - 2);
     match language {
         Language::Wgsl => {
             let _ = writeln!(out, "    let i = {i_value};");
@@ -320,7 +316,7 @@ fn write_array_lookup(
             return;
         }
         Language::Glsl | Language::Hlsl => {
-            let _ = writeln!(out, "    {index} i = {i_value};");
+            let _ = writeln!(out, "    {int} i = {i_value};");
             let _ = writeln!(out, "    float f = p - float(i);");
         }
     }

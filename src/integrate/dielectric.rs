@@ -79,7 +79,7 @@ pub fn dielectric_albedo(
         settings: &QmcSettings,
         key: &[u64],
     ) -> Estimate {
-        let o = Vec3::new(sin_from_cos(mu), 0.0, mu);
+        let o = Vec3::from_mu(mu);
         let lambda_o = ndf.lambda(o);
         replicates(settings, key, |seq, log2_n| {
             sum_over_block(

@@ -88,12 +88,7 @@ pub fn scattering<N: MicrofacetDistribution>(
 ) -> Scattering {
     let c = o.dot(m).clamp(0.0, 1.0);
     let fresnel = super::fresnel::dielectric(eta, c);
-    let i_r = o.reflect(m);
-    let reflection_loss = if i_r.z > 0.0 {
-        masking.loss_at(ndf.alpha(), o.z, i_r.z, lambda_o, ndf.lambda(i_r))
-    } else {
-        1.0
-    };
+    let reflection_loss = crate::integrate::albedo::reflection_loss(ndf, masking, o, lambda_o, m);
     let transmission_loss = match refract(o, m, c, eta) {
         // Index-matched, i_t = -o: Lambda(i_t) = Lambda(o), and at a grazing view the loss takes
         // its limit along the view (1/2 height-correlated, 1 separable), not the value at

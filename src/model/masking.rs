@@ -131,17 +131,11 @@ impl Masking {
     /// Schlick-GGX through [`Masking::loss_at`] with `mu_i = mu_o`.
     #[must_use]
     pub fn loss_index_matched(self, alpha: f64, mu: f64, lambda: f64) -> f64 {
-        if lambda == 0.0 {
-            return if self.is_smith() {
-                0.0
-            } else {
-                self.loss_at(alpha, mu, mu, lambda, lambda)
-            };
-        }
         match self {
+            Masking::SchlickGgx => self.loss_at(alpha, mu, mu, lambda, lambda),
+            _ if lambda == 0.0 => 0.0,
             Masking::HeightCorrelated => 1.0 / (2.0 + 1.0 / lambda),
             Masking::Separable => 1.0 / (1.0 + 1.0 / lambda),
-            Masking::SchlickGgx => self.loss_at(alpha, mu, mu, lambda, lambda),
         }
     }
 }
