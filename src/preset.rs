@@ -18,6 +18,19 @@
 //! - `enterprise-pbr`: Dassault Systèmes' Enterprise PBR `res/GGX_E.exr` (32 x 32, x = `cos`,
 //!   y = perceptual roughness from the top, texel centres) and `res/GGX_E_avg.exr` (32 x 1), GGX
 //!   height-correlated, F = 1, one half-float channel `Y`.
+//! - `filament`: Filament's `dfg.inc` (`cmgen --ibl-dfg-multiscatter --ibl-dfg-cloth`, included
+//!   into `DFG_LUT[]` and uploaded as `RGB16F`): 128 x 128 in GL order, x = `NoV`, y = perceptual
+//!   roughness, both on texel centres (`PrefilteredDFG_LUT` samples `vec2(NoV, r)` unremapped);
+//!   R = `E_bias` (`∫ Fc w`), G = `E` (`∫ w`), B = the Charlie/Ashikhmin cloth albedo
+//!   ([`crate::integrate::sheen`]), half-float bits. GGX height-correlated. Filament's own file
+//!   computes row `j` at `r = min(1, (j + 1.5) / 128)`, one texel rougher than its shader reads
+//!   (`CubemapIBL::DFG` takes `(height - y + 0.5) / height` before cmgen flips the rows); kiln's
+//!   row `j` is at `(j + 0.5) / 128`, where the shader reads it.
+//! - `godot`: Godot 4's DFG texture (`integrate_dfg.glsl`, computed at start-up into an
+//!   `rgba16f` image) written as `dfg_lut.dds`, `R16G16B16A16_FLOAT`: 128 x 128, x = `NoV`,
+//!   rows from the top at roughness `1 - (j + 0.5) / 128` (the shader stores row `127 - y`),
+//!   texel centres; R = `E_bias`, G = `E`, B = the cloth albedo, A = 1; GGX with separable
+//!   Schlick-GGX masking, `k = alpha / 2`, as Godot integrates it.
 
 use crate::bake::BakeOptions;
 use crate::error::{Error, Result};
@@ -40,16 +53,26 @@ pub enum Preset {
     /// Enterprise PBR: GGX_E.exr 32 x 32 and GGX_E_avg.exr 32, centres, half channel Y.
     #[cfg_attr(feature = "cli", value(name = "enterprise-pbr"))]
     EnterprisePbr,
+    /// Filament: multiscatter DFG + cloth, 128 x 128, centres, RGB16F half bits (dfg.inc).
+    Filament,
+    /// Godot 4: Filament's layout flipped (1 - r), Schlick-GGX k = alpha/2, RGBA16F DDS.
+    Godot,
 }
 
 impl Preset {
     /// Every preset.
-    pub const ALL: [Preset; 4] = [
+    pub const ALL: [Preset; 6] = [
         Preset::Cycles,
         Preset::Bevy,
         Preset::Three,
         Preset::EnterprisePbr,
+        Preset::Filament,
+        Preset::Godot,
     ];
+
+    /// The absolute tolerance of the cloth channel's quadrature (Filament, Godot): well below
+    /// half-float spacing (`2^-11` relative).
+    pub const SHEEN_TOLERANCE: f64 = 1e-7;
 
     /// The name on the command line.
     #[must_use]
@@ -59,6 +82,8 @@ impl Preset {
             Preset::Bevy => "bevy",
             Preset::Three => "three",
             Preset::EnterprisePbr => "enterprise-pbr",
+            Preset::Filament => "filament",
+            Preset::Godot => "godot",
         }
     }
 
@@ -70,6 +95,8 @@ impl Preset {
             Preset::Bevy => "dfg.ktx2",
             Preset::Three => "DFGLUT.js",
             Preset::EnterprisePbr => "GGX_E.exr",
+            Preset::Filament => "dfg.inc",
+            Preset::Godot => "dfg_lut.dds",
         }
     }
 
@@ -92,10 +119,18 @@ impl Preset {
             Preset::EnterprisePbr => (32, Grid::Centers, vec![Quantity::E, Quantity::EAvg]),
             Preset::Bevy => (64, Grid::Centers, vec![Quantity::EScale, Quantity::EBias]),
             Preset::Three => (16, Grid::Centers, vec![Quantity::EScale, Quantity::EBias]),
+            Preset::Filament | Preset::Godot => {
+                (128, Grid::Centers, vec![Quantity::EBias, Quantity::E])
+            }
+        };
+        let masking = if self == Preset::Godot {
+            Masking::SchlickGgx
+        } else {
+            Masking::HeightCorrelated
         };
         BakeOptions {
             ndfs: vec![Ndf::Ggx],
-            maskings: vec![Masking::HeightCorrelated],
+            maskings: vec![masking],
             quantities,
             size,
             grid,
@@ -113,19 +148,29 @@ impl Preset {
         match self {
             // mu-major (Cycles), roughness rows (Bevy), NoV rows (three.js).
             Preset::Cycles | Preset::Three => m * n + r,
-            Preset::Bevy | Preset::EnterprisePbr => r * n + m,
+            Preset::Bevy | Preset::EnterprisePbr | Preset::Filament => r * n + m,
+            // Rows from the top at 1 - r.
+            Preset::Godot => (n - 1 - r) * n + m,
         }
+    }
+
+    /// The cloth channel (Filament, Godot) in kiln's order, with its largest quadrature error
+    /// estimate; `None` for the presets without one.
+    pub fn sheen(self) -> Option<crate::integrate::sheen::SheenPlane> {
+        matches!(self, Preset::Filament | Preset::Godot).then(|| {
+            crate::integrate::sheen::sheen_plane(self.options().size, Self::SHEEN_TOLERANCE)
+        })
     }
 
     /// Writes the tables ([`Preset::options`]'s bake, in its order) in the engine's layout: the
     /// file [`Preset::file_name`] (see [`Preset::files`] for all of them).
     pub fn encode(self, tables: &[Table]) -> Result<Vec<u8>> {
         let n = self.options().size;
-        let engine_order = |table: &Table| -> Vec<f64> {
+        let engine_order = |values: &[f64]| -> Vec<f64> {
             let mut out = vec![0.0; n * n];
             for r in 0..n {
                 for m in 0..n {
-                    out[self.texel(r, m)] = table.value[r * n + m];
+                    out[self.texel(r, m)] = values[r * n + m];
                 }
             }
             out
@@ -144,7 +189,7 @@ impl Preset {
                     tables[0].command
                 );
                 for (name, values) in [
-                    ("table_ggx_E", engine_order(&tables[0])),
+                    ("table_ggx_E", engine_order(&tables[0].value)),
                     ("table_ggx_Eavg", tables[1].value.clone()),
                 ] {
                     crate::format::c_header::float_array(&mut out, name, &values);
@@ -161,7 +206,10 @@ impl Preset {
                 ktx2::encode_with(&texture, Precision::F16, scheme).map_err(Error::InvalidInput)
             }
             Preset::Three => {
-                let (scale, bias) = (engine_order(&tables[0]), engine_order(&tables[1]));
+                let (scale, bias) = (
+                    engine_order(&tables[0].value),
+                    engine_order(&tables[1].value),
+                );
                 let mut out = format!(
                     "// kiln {}: three.js DFG LUT, 16 x 16, x = roughness, y = dot(N, V), texel \
                      centres;\n// RG half floats: R = scale (integral of (1 - Fc) f mu_i), G = bias \
@@ -177,6 +225,53 @@ impl Preset {
                 }
                 out.push_str("\n] );\n");
                 Ok(out.into_bytes())
+            }
+            Preset::Filament => {
+                let sheen = self.sheen().expect("filament has a cloth channel");
+                let planes = [
+                    engine_order(&tables[0].value),
+                    engine_order(&tables[1].value),
+                    engine_order(&sheen.value),
+                ];
+                let mut out = format!(
+                    "// kiln {}: Filament's DFG LUT (dfg.inc), {n} x {n} RGB16F half-float bits in \
+                     GL order,\n// x = NoV = (i + 0.5) / {n}, y = perceptual roughness = (j + 0.5) \
+                     / {n} (alpha = r^2), texel centres.\n// R = integral of Fc f mu_i, G = integral \
+                     of f mu_i (GGX, height-correlated, F = 1);\n// B = cloth albedo (Charlie NDF, \
+                     Ashikhmin visibility), quadrature error estimate <= {:.0e}.\n// Regenerate: \
+                     {}\n",
+                    crate::format::metadata::KILN_VERSION,
+                    sheen.max_error,
+                    tables[0].command
+                );
+                let half = |v: f64| crate::format::f16::encode(v).0.to_bits();
+                for k in 0..n * n {
+                    for plane in &planes {
+                        let _ = write!(out, "0x{:04x}, ", half(plane[k]));
+                    }
+                    if k % 4 == 3 {
+                        out.truncate(out.trim_end().len());
+                        out.push('\n');
+                    }
+                }
+                Ok(out.into_bytes())
+            }
+            #[cfg(not(feature = "containers"))]
+            Preset::Godot => Err(Error::InvalidInput(
+                "writing DDS needs kiln's `containers` feature".to_string(),
+            )),
+            #[cfg(feature = "containers")]
+            Preset::Godot => {
+                let sheen = self.sheen().expect("godot has a cloth channel");
+                let mut texture =
+                    Texture::of_values(&[&tables[0], &tables[1]]).map_err(Error::InvalidInput)?;
+                texture.channels = vec![
+                    ("E_bias".into(), engine_order(&tables[0].value)),
+                    ("E".into(), engine_order(&tables[1].value)),
+                    ("E_sheen".into(), engine_order(&sheen.value)),
+                    ("A".into(), vec![1.0; n * n]),
+                ];
+                crate::format::dds::encode(&texture, Precision::F16).map_err(Error::InvalidInput)
             }
         }
     }
@@ -309,6 +404,79 @@ impl Preset {
                 Ok(vec![
                     (Quantity::EScale, channel(0)),
                     (Quantity::EBias, channel(1)),
+                ])
+            }
+            Preset::Filament => {
+                // Every 0x number outside comments: RGB (or, from cmgen before the cloth
+                // channel, RG) half-float bits per texel.
+                let text = String::from_utf8_lossy(bytes);
+                let bits: Vec<u16> = text
+                    .lines()
+                    .map(|line| line.split("//").next().unwrap_or(""))
+                    .flat_map(|line| line.split(','))
+                    .map(str::trim)
+                    .filter(|s| !s.is_empty())
+                    .filter_map(|s| s.strip_prefix("0x").or_else(|| s.strip_prefix("0X")))
+                    .map(|s| u16::from_str_radix(s, 16).map_err(|e| bad(format!("'0x{s}': {e}"))))
+                    .collect::<Result<_>>()?;
+                let stride = match bits.len() / (n * n) {
+                    s @ (2 | 3) if bits.len() == s * n * n => s,
+                    _ => {
+                        return Err(bad(format!(
+                            "{} half floats (expected {} for RGB16F or {} for RG16F)",
+                            bits.len(),
+                            3 * n * n,
+                            2 * n * n
+                        )));
+                    }
+                };
+                let channel = |c: usize| -> Vec<f64> {
+                    let engine: Vec<f64> = (0..n * n)
+                        .map(|k| f64::from(half::f16::from_bits(bits[stride * k + c]).to_f32()))
+                        .collect();
+                    kiln_order(&engine)
+                };
+                Ok(vec![
+                    (Quantity::EBias, channel(0)),
+                    (Quantity::E, channel(1)),
+                ])
+            }
+            #[cfg(not(feature = "containers"))]
+            Preset::Godot => Err(bad(
+                "reading DDS needs kiln's `containers` feature".to_string()
+            )),
+            #[cfg(feature = "containers")]
+            Preset::Godot => {
+                let dds = ddsfile::Dds::read(bytes).map_err(|e| bad(e.to_string()))?;
+                let format = dds.get_dxgi_format();
+                let stride = match format {
+                    Some(ddsfile::DxgiFormat::R16G16B16A16_Float) => 4,
+                    Some(ddsfile::DxgiFormat::R16G16_Float) => 2,
+                    _ => 0,
+                };
+                if stride == 0
+                    || (dds.get_width(), dds.get_height()) != (n as u32, n as u32)
+                    || dds.data.len() < 2 * stride * n * n
+                {
+                    return Err(bad(format!(
+                        "expected {n} x {n} R16G16B16A16_FLOAT, found {} x {} {format:?}",
+                        dds.get_width(),
+                        dds.get_height()
+                    )));
+                }
+                let data = &dds.data;
+                let channel = |c: usize| -> Vec<f64> {
+                    let engine: Vec<f64> = (0..n * n)
+                        .map(|k| {
+                            let i = 2 * (stride * k + c);
+                            f64::from(half::f16::from_le_bytes([data[i], data[i + 1]]).to_f32())
+                        })
+                        .collect();
+                    kiln_order(&engine)
+                };
+                Ok(vec![
+                    (Quantity::EBias, channel(0)),
+                    (Quantity::E, channel(1)),
                 ])
             }
         }

@@ -6,8 +6,13 @@ use kiln::preset::Preset;
 use kiln::{BakeOptions, Table};
 
 fn bake(preset: Preset) -> Vec<Table> {
+    bake_to(preset, 1e-5)
+}
+
+/// A bake to `max_error` (the layout tests compare bits, so a coarser bake does as well).
+fn bake_to(preset: Preset, max_error: f64) -> Vec<Table> {
     BakeOptions {
-        max_error: Some(1e-5),
+        max_error: Some(max_error),
         ..preset.options()
     }
     .bake(&|_| {})
@@ -207,4 +212,94 @@ fn enterprise_pbr_layout_is_half_exr_channel_y_with_cos_across() {
     let (alpha, mu) = e.spec.texel_coordinates(3 * 32 + 5);
     assert!((mu.unwrap() - 5.5 / 32.0).abs() < 1e-15);
     assert!((alpha - (3.5f64 / 32.0).powi(2)).abs() < 1e-15);
+}
+
+#[test]
+fn filament_layout_is_rgb16f_half_bits_in_gl_order_with_cloth_in_blue() {
+    let tables = bake_to(Preset::Filament, 1e-4);
+    let (bias, e) = (&tables[0], &tables[1]);
+    assert_eq!(
+        (bias.spec.quantity, e.spec.quantity),
+        (kiln::Quantity::EBias, kiln::Quantity::E)
+    );
+    let text = String::from_utf8(Preset::Filament.encode(&tables).unwrap()).unwrap();
+    // An include pasted into `const uint16_t DFG_LUT[] = { ... };`: comments and hex only.
+    let bits: Vec<u16> = text
+        .lines()
+        .filter(|l| !l.starts_with("//"))
+        .flat_map(|l| l.split(','))
+        .map(str::trim)
+        .filter(|s| !s.is_empty())
+        .map(|s| u16::from_str_radix(s.strip_prefix("0x").unwrap(), 16).unwrap())
+        .collect();
+    assert_eq!(bits.len(), 3 * 128 * 128);
+    let half = |b: u16| f64::from(half::f16::from_bits(b).to_f32());
+    for y in 0..128 {
+        for x in 0..128 {
+            // GL order: row y is t = (y + 0.5) / 128 = perceptual roughness, x = NoV.
+            let k = y * 128 + x;
+            let (alpha, mu) = e.spec.texel_coordinates(k);
+            let (r, mu) = (alpha.sqrt(), mu.unwrap());
+            assert!((r - (y as f64 + 0.5) / 128.0).abs() < 1e-15);
+            assert!((mu - (x as f64 + 0.5) / 128.0).abs() < 1e-15);
+            assert_eq!(half(bits[3 * k]), f16_of(bias.value[k]), "R at {x}, {y}");
+            assert_eq!(half(bits[3 * k + 1]), f16_of(e.value[k]), "G at {x}, {y}");
+            if k % 61 == 0 {
+                let cloth = kiln::integrate::sheen::sheen_albedo(alpha, mu, 1e-9).value[0];
+                // The preset's quadrature tolerance and half-float rounding (half a spacing,
+                // 2^-11 relative, or 2^-25 among the subnormals).
+                let rounding = (cloth.abs() * 2f64.powi(-11)).max(2f64.powi(-25));
+                assert!(
+                    (half(bits[3 * k + 2]) - cloth).abs()
+                        <= Preset::SHEEN_TOLERANCE + 2.0 * rounding,
+                    "B at {x}, {y}: {} vs {cloth}",
+                    half(bits[3 * k + 2])
+                );
+            }
+        }
+    }
+    let back = Preset::Filament
+        .read_tables(text.as_bytes(), "test")
+        .unwrap();
+    assert_eq!(back.len(), 2);
+    assert_eq!(
+        back[1].value,
+        e.value.iter().map(|&v| f16_of(v)).collect::<Vec<_>>()
+    );
+    assert_eq!(back[1].spec.model, e.spec.model);
+}
+
+#[test]
+fn godot_layout_is_rgba16f_dds_with_roughness_rows_from_the_top() {
+    let tables = bake_to(Preset::Godot, 1e-4);
+    let (bias, e) = (&tables[0], &tables[1]);
+    assert_eq!(e.spec.model.masking, kiln::Masking::SchlickGgx);
+    let bytes = Preset::Godot.encode(&tables).unwrap();
+    let dds = ddsfile::Dds::read(bytes.as_slice()).unwrap();
+    assert_eq!(
+        dds.get_dxgi_format(),
+        Some(ddsfile::DxgiFormat::R16G16B16A16_Float)
+    );
+    assert_eq!((dds.get_width(), dds.get_height()), (128, 128));
+    let texel = |x: usize, row: usize, c: usize| {
+        let i = 2 * (4 * (row * 128 + x) + c);
+        f64::from(half::f16::from_le_bytes([dds.data[i], dds.data[i + 1]]).to_f32())
+    };
+    for row in 0..128 {
+        for x in 0..128 {
+            // integrate_dfg.glsl stores roughness index y at row 127 - y.
+            let k = (127 - row) * 128 + x;
+            let (alpha, mu) = e.spec.texel_coordinates(k);
+            assert!((alpha.sqrt() - (1.0 - (row as f64 + 0.5) / 128.0)).abs() < 1e-14);
+            assert!((mu.unwrap() - (x as f64 + 0.5) / 128.0).abs() < 1e-15);
+            assert_eq!(texel(x, row, 0), f16_of(bias.value[k]));
+            assert_eq!(texel(x, row, 1), f16_of(e.value[k]));
+            assert_eq!(texel(x, row, 3), 1.0);
+        }
+    }
+    let back = Preset::Godot.read_tables(&bytes, "test").unwrap();
+    assert_eq!(
+        back[0].value,
+        bias.value.iter().map(|&v| f16_of(v)).collect::<Vec<_>>()
+    );
 }

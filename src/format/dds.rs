@@ -1,5 +1,6 @@
 //! DDS (DirectDraw Surface) output with the DX10 header, through the `ddsfile` crate: DXGI
-//! `R16_FLOAT`, `R16G16_FLOAT`, `R32_FLOAT` or `R32G32_FLOAT`, a 1-D, 2-D or (IOR tables) 3-D
+//! `R16_FLOAT`, `R16G16_FLOAT`, `R32_FLOAT` or `R32G32_FLOAT` (and four-channel
+//! `R16G16B16A16_FLOAT` / `R32G32B32A32_FLOAT` for engine presets), a 1-D, 2-D or (IOR tables) 3-D
 //! texture with one mip level, rows top to bottom. DDS has no room for metadata: the JSON sidecar
 //! or the KTX2 file carries it.
 
@@ -15,15 +16,17 @@ pub fn dxgi_format(channels: usize, precision: Precision) -> Option<DxgiFormat> 
         (2, Precision::F16) => Some(DxgiFormat::R16G16_Float),
         (1, Precision::F32) => Some(DxgiFormat::R32_Float),
         (2, Precision::F32) => Some(DxgiFormat::R32G32_Float),
+        (4, Precision::F16) => Some(DxgiFormat::R16G16B16A16_Float),
+        (4, Precision::F32) => Some(DxgiFormat::R32G32B32A32_Float),
         _ => None,
     }
 }
 
-/// Encodes a texture of one or two channels.
+/// Encodes a texture of one, two or four channels.
 pub fn encode(texture: &Texture, precision: Precision) -> std::result::Result<Vec<u8>, String> {
     let channels = texture.channels.len();
     let format = dxgi_format(channels, precision)
-        .ok_or_else(|| format!("DDS output takes one or two channels (got {channels})"))?;
+        .ok_or_else(|| format!("DDS output takes one, two or four channels (got {channels})"))?;
     let (width, height, depth) = texture.extent();
     let (dimension, depth, caps2) = match (height, depth) {
         (0, _) => (D3D10ResourceDimension::Texture1D, None, None),

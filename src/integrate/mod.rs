@@ -7,6 +7,7 @@ pub mod estimate;
 pub mod gauss_kronrod;
 pub mod gauss_legendre;
 pub mod reference;
+pub mod sheen;
 pub mod sobol;
 
 pub use albedo::{QmcSettings, albedo, average_albedo};

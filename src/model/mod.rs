@@ -8,6 +8,7 @@ pub mod fresnel;
 pub mod kulla_conty;
 pub mod masking;
 pub mod ndf;
+pub mod sheen;
 pub mod special;
 pub mod vector;
 

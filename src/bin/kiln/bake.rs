@@ -277,6 +277,12 @@ fn bake_preset(preset: kiln::preset::Preset, args: &BakeArgs) -> kiln::Result<()
                 );
             }
         }
+        if let Some(sheen) = preset.sheen() {
+            println!(
+                "{:<32} quadrature error estimate {:.1e} (blue channel)",
+                "cloth (Charlie, Ashikhmin)", sheen.max_error
+            );
+        }
         println!(
             "{} layout: baked {} tables in {:.1} s; wrote {} ({} files) to {}",
             preset.name(),
