@@ -31,6 +31,18 @@
 //!   rows from the top at roughness `1 - (j + 0.5) / 128` (the shader stores row `127 - y`),
 //!   texel centres; R = `E_bias`, G = `E`, B = the cloth albedo, A = 1; GGX with separable
 //!   Schlick-GGX masking, `k = alpha / 2`, as Godot integrates it.
+//! - `unity-hdrp`: Unity HDRP's `_PreIntegratedFGD_GGXDisneyDiffuse` (drawn at start-up by
+//!   `preIntegratedFGD_GGXDisneyDiffuse.shader` into a 64 x 64 `A2B10G10R10_UNormPack32` target)
+//!   written as a half-float RGB EXR to import in its place: x = `sqrt(NoV)`, y = perceptual
+//!   roughness, both on nodes `i / 63` (Unity remaps half a texel on write and read); R =
+//!   `E_bias`, G = `E` (GGX height-correlated), B = the Disney diffuse albedo minus 0.5
+//!   ([`crate::model::disney_diffuse`]); rows from the top at `r = 1 - j / 63`, since Unity puts
+//!   an imported image's top row at `v = 1`.
+//! - `unreal`: Unreal Engine 5's `ShadingEnergyGGXSpecTexture` (`ShadingEnergyConservation`: a
+//!   precomputed RGBA16F texture uploaded as `G16R16` UNORM, or built at run time by
+//!   `BuildEnergyTableCS`): 32 x 32, x = `NoV`, y = roughness (perceptual; rows from the top, as
+//!   D3D and Unreal's importer count `v`), texel centres; R = `E`, G = `∫ Fc w` (the shader's
+//!   `F0 E + (F90 - F0) E_Fc`), B = 0, A = 1, as a half-float EXR to import in its place.
 
 use crate::bake::BakeOptions;
 use crate::error::{Error, Result};
@@ -57,17 +69,24 @@ pub enum Preset {
     Filament,
     /// Godot 4: Filament's layout flipped (1 - r), Schlick-GGX k = alpha/2, RGBA16F DDS.
     Godot,
+    /// Unity HDRP: FGD + Disney diffuse, 64 x 64, sqrt(NoV) nodes, half RGB EXR.
+    #[cfg_attr(feature = "cli", value(name = "unity-hdrp"))]
+    UnityHdrp,
+    /// Unreal Engine 5: E and E*Fc, 32 x 32, centres, half RGBA EXR.
+    Unreal,
 }
 
 impl Preset {
     /// Every preset.
-    pub const ALL: [Preset; 6] = [
+    pub const ALL: [Preset; 8] = [
         Preset::Cycles,
         Preset::Bevy,
         Preset::Three,
         Preset::EnterprisePbr,
         Preset::Filament,
         Preset::Godot,
+        Preset::UnityHdrp,
+        Preset::Unreal,
     ];
 
     /// The absolute tolerance of the cloth channel's quadrature (Filament, Godot): well below
@@ -84,6 +103,8 @@ impl Preset {
             Preset::EnterprisePbr => "enterprise-pbr",
             Preset::Filament => "filament",
             Preset::Godot => "godot",
+            Preset::UnityHdrp => "unity-hdrp",
+            Preset::Unreal => "unreal",
         }
     }
 
@@ -97,6 +118,8 @@ impl Preset {
             Preset::EnterprisePbr => "GGX_E.exr",
             Preset::Filament => "dfg.inc",
             Preset::Godot => "dfg_lut.dds",
+            Preset::UnityHdrp => "preIntegratedFGD_GGXDisneyDiffuse.exr",
+            Preset::Unreal => "ShadingEnergyGGXSpec.exr",
         }
     }
 
@@ -122,6 +145,13 @@ impl Preset {
             Preset::Filament | Preset::Godot => {
                 (128, Grid::Centers, vec![Quantity::EBias, Quantity::E])
             }
+            Preset::UnityHdrp => (64, Grid::Nodes, vec![Quantity::EBias, Quantity::E]),
+            Preset::Unreal => (32, Grid::Centers, vec![Quantity::E, Quantity::EBias]),
+        };
+        let mu_mapping = if self == Preset::UnityHdrp {
+            MuMapping::Sqrt
+        } else {
+            MuMapping::Linear
         };
         let masking = if self == Preset::Godot {
             Masking::SchlickGgx
@@ -134,7 +164,7 @@ impl Preset {
             quantities,
             size,
             grid,
-            mu_mapping: MuMapping::Linear,
+            mu_mapping,
             roughness_convention: RoughnessConvention::Perceptual,
             ..BakeOptions::default()
         }
@@ -148,9 +178,9 @@ impl Preset {
         match self {
             // mu-major (Cycles), roughness rows (Bevy), NoV rows (three.js).
             Preset::Cycles | Preset::Three => m * n + r,
-            Preset::Bevy | Preset::EnterprisePbr | Preset::Filament => r * n + m,
+            Preset::Bevy | Preset::EnterprisePbr | Preset::Filament | Preset::Unreal => r * n + m,
             // Rows from the top at 1 - r.
-            Preset::Godot => (n - 1 - r) * n + m,
+            Preset::Godot | Preset::UnityHdrp => (n - 1 - r) * n + m,
         }
     }
 
@@ -272,6 +302,45 @@ impl Preset {
                     ("A".into(), vec![1.0; n * n]),
                 ];
                 crate::format::dds::encode(&texture, Precision::F16).map_err(Error::InvalidInput)
+            }
+            Preset::UnityHdrp => {
+                let spec = &tables[1].spec;
+                let diffuse: Vec<f64> = (0..n * n)
+                    .map(|k| {
+                        let (alpha, mu) = spec.texel_coordinates(k);
+                        let mu = mu.expect("a 2-D table has a mu axis");
+                        crate::model::disney_diffuse::disney_diffuse_albedo(alpha.sqrt(), mu) - 0.5
+                    })
+                    .collect();
+                let planes = [
+                    engine_order(&tables[0].value),
+                    engine_order(&tables[1].value),
+                    engine_order(&diffuse),
+                ];
+                crate::format::exr::encode_planes(
+                    &tables[1],
+                    &[("R", &planes[0]), ("G", &planes[1]), ("B", &planes[2])],
+                    Precision::F16,
+                )
+                .map_err(Error::InvalidInput)
+            }
+            Preset::Unreal => {
+                let (zeros, ones) = (vec![0.0; n * n], vec![1.0; n * n]);
+                let planes = [
+                    engine_order(&tables[0].value),
+                    engine_order(&tables[1].value),
+                ];
+                crate::format::exr::encode_planes(
+                    &tables[0],
+                    &[
+                        ("R", &planes[0]),
+                        ("G", &planes[1]),
+                        ("B", &zeros),
+                        ("A", &ones),
+                    ],
+                    Precision::F16,
+                )
+                .map_err(Error::InvalidInput)
             }
         }
     }
@@ -478,6 +547,29 @@ impl Preset {
                     (Quantity::EBias, channel(0)),
                     (Quantity::E, channel(1)),
                 ])
+            }
+            Preset::UnityHdrp | Preset::Unreal => {
+                let image = crate::format::exr::decode(bytes).map_err(bad)?;
+                if (image.width, image.height) != (n, n) {
+                    return Err(bad(format!(
+                        "{} x {} (expected {n} x {n})",
+                        image.width, image.height
+                    )));
+                }
+                let channel = |name: &str| -> Result<Vec<f64>> {
+                    image
+                        .channels
+                        .iter()
+                        .find(|(c, _)| c == name)
+                        .map(|(_, values)| kiln_order(values))
+                        .ok_or_else(|| bad(format!("no channel {name}")))
+                };
+                let (red, green) = if self == Preset::Unreal {
+                    (Quantity::E, Quantity::EBias)
+                } else {
+                    (Quantity::EBias, Quantity::E)
+                };
+                Ok(vec![(red, channel("R")?), (green, channel("G")?)])
             }
         }
     }

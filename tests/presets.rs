@@ -303,3 +303,67 @@ fn godot_layout_is_rgba16f_dds_with_roughness_rows_from_the_top() {
         bias.value.iter().map(|&v| f16_of(v)).collect::<Vec<_>>()
     );
 }
+
+#[test]
+fn unity_hdrp_layout_is_sqrt_nov_nodes_with_disney_diffuse_in_blue() {
+    let tables = bake_to(Preset::UnityHdrp, 1e-4);
+    let (bias, e) = (&tables[0], &tables[1]);
+    let bytes = Preset::UnityHdrp.encode(&tables).unwrap();
+    let image = kiln::format::exr::decode(&bytes).unwrap();
+    assert_eq!((image.width, image.height), (64, 64));
+    let channel = |name: &str| &image.channels.iter().find(|(c, _)| c == name).unwrap().1;
+    let (red, green, blue) = (channel("R"), channel("G"), channel("B"));
+    for row in 0..64 {
+        for x in 0..64 {
+            // Unity: u = sqrt(NoV), v = perceptual roughness, both nodes i / 63 after its
+            // half-texel remap; an imported image's top row is v = 1.
+            let (r, t) = ((63 - row) as f64 / 63.0, x as f64 / 63.0);
+            let k = (63 - row) * 64 + x;
+            let (alpha, mu) = e.spec.texel_coordinates(k);
+            assert!((alpha - r * r).abs() < 1e-15 && (mu.unwrap() - t * t).abs() < 1e-15);
+            let at = row * 64 + x;
+            assert_eq!(red[at], f16_of(bias.value[k]), "R at {x}, {row}");
+            assert_eq!(green[at], f16_of(e.value[k]), "G at {x}, {row}");
+            let diffuse = kiln::model::disney_diffuse::disney_diffuse_albedo(r, t * t) - 0.5;
+            assert_eq!(blue[at], f16_of(diffuse), "B at {x}, {row}");
+        }
+    }
+    let back = Preset::UnityHdrp.read_tables(&bytes, "test").unwrap();
+    assert_eq!(
+        back[1].value,
+        e.value.iter().map(|&v| f16_of(v)).collect::<Vec<_>>()
+    );
+    assert_eq!(back[1].spec.axes(), e.spec.axes());
+}
+
+#[test]
+fn unreal_layout_is_e_and_e_fc_in_red_and_green_with_roughness_rows() {
+    let tables = bake_to(Preset::Unreal, 1e-4);
+    let (e, bias) = (&tables[0], &tables[1]);
+    assert_eq!(
+        (e.spec.quantity, bias.spec.quantity),
+        (kiln::Quantity::E, kiln::Quantity::EBias)
+    );
+    let bytes = Preset::Unreal.encode(&tables).unwrap();
+    let image = kiln::format::exr::decode(&bytes).unwrap();
+    assert_eq!((image.width, image.height), (32, 32));
+    let channel = |name: &str| &image.channels.iter().find(|(c, _)| c == name).unwrap().1;
+    for row in 0..32 {
+        for x in 0..32 {
+            // Unreal samples float2(NoV, Roughness), v from the top row, texel centres.
+            let k = row * 32 + x;
+            let (alpha, mu) = e.spec.texel_coordinates(k);
+            assert!((alpha.sqrt() - (row as f64 + 0.5) / 32.0).abs() < 1e-15);
+            assert!((mu.unwrap() - (x as f64 + 0.5) / 32.0).abs() < 1e-15);
+            assert_eq!(channel("R")[k], f16_of(e.value[k]));
+            assert_eq!(channel("G")[k], f16_of(bias.value[k]));
+            assert_eq!((channel("B")[k], channel("A")[k]), (0.0, 1.0));
+        }
+    }
+    let back = Preset::Unreal.read_tables(&bytes, "test").unwrap();
+    assert_eq!(back[0].spec.quantity, kiln::Quantity::E);
+    assert_eq!(
+        back[1].value,
+        bias.value.iter().map(|&v| f16_of(v)).collect::<Vec<_>>()
+    );
+}

@@ -69,6 +69,26 @@ pub fn encode_value_as(
     )
 }
 
+/// Encodes named planes of `table`'s 2-D shape (an engine's RGB layout, values already in that
+/// engine's texel order) in `precision`, with `table`'s header and metadata.
+pub fn encode_planes(
+    table: &Table,
+    planes: &[(&str, &[f64])],
+    precision: Precision,
+) -> std::result::Result<Vec<u8>, String> {
+    let [rows, columns] = table.spec.shape()[..] else {
+        return Err("engine planes are 2-D".to_string());
+    };
+    write(
+        table,
+        (columns, rows),
+        planes
+            .iter()
+            .map(|&(name, values)| (name, values, precision))
+            .collect(),
+    )
+}
+
 /// Writes channels `(name, values, precision)` of a `width x height` image with kiln's header.
 fn write(
     table: &Table,

@@ -4,6 +4,7 @@
 //! the tables here are for `F = 1`.
 
 pub mod dielectric;
+pub mod disney_diffuse;
 pub mod fresnel;
 pub mod kulla_conty;
 pub mod masking;

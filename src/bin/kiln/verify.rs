@@ -45,8 +45,10 @@ pub struct VerifyArgs {
     json: bool,
     /// FILE is an engine's own table in that engine's layout (cycles: shader.tables with
     /// table_ggx_E and table_ggx_Eavg; bevy: dfg.ktx2, zstd or not; three: the DFG LUT's
-    /// Uint16Array; enterprise-pbr: GGX_E.exr or GGX_E_avg.exr): audit each of its tables
-    /// against the reference for the model the engine evaluates (GGX, height-correlated).
+    /// Uint16Array; enterprise-pbr: GGX_E.exr or GGX_E_avg.exr; filament: dfg.inc, RGB or RG
+    /// half bits; godot: dfg_lut.dds; unity-hdrp and unreal: their EXR): audit each of its
+    /// tables against the reference for the model the engine evaluates (GGX, height-correlated;
+    /// Godot: separable Schlick-GGX). Cloth and diffuse channels are not audited.
     #[arg(long, value_enum, conflicts_with_all = ["furnace", "shape", "channel", "dtype"])]
     preset: Option<kiln::preset::Preset>,
     /// Exit with status 1 when node_max_error exceeds this.
