@@ -184,12 +184,41 @@ impl Preset {
         }
     }
 
-    /// The cloth channel (Filament, Godot) in kiln's order, with its largest quadrature error
-    /// estimate; `None` for the presets without one.
-    pub fn sheen(self) -> Option<crate::integrate::sheen::SheenPlane> {
-        matches!(self, Preset::Filament | Preset::Godot).then(|| {
-            crate::integrate::sheen::sheen_plane(self.options().size, Self::SHEEN_TOLERANCE)
-        })
+    /// The channel of the engine's texture that is not one of kiln's tables, at the preset's
+    /// texels in kiln's order: Filament's and Godot's cloth albedo
+    /// ([`crate::integrate::sheen`]), HDRP's Disney diffuse albedo minus 0.5
+    /// ([`crate::model::disney_diffuse`]); `None` for the other presets.
+    #[must_use]
+    pub fn extra_channel(self) -> Option<ExtraChannel> {
+        match self {
+            Preset::Filament | Preset::Godot => {
+                let plane = crate::integrate::sheen::sheen_plane(
+                    self.options().size,
+                    Self::SHEEN_TOLERANCE,
+                );
+                Some(ExtraChannel {
+                    name: "cloth albedo (Charlie NDF, Ashikhmin visibility)",
+                    value: plane.value,
+                    max_error: plane.max_error,
+                })
+            }
+            Preset::UnityHdrp => {
+                let spec = self.options().resolved().specs().swap_remove(0);
+                let value = (0..spec.len())
+                    .map(|k| {
+                        let (alpha, mu) = spec.texel_coordinates(k);
+                        let mu = mu.expect("a 2-D table has a mu axis");
+                        crate::model::disney_diffuse::disney_diffuse_albedo(alpha.sqrt(), mu) - 0.5
+                    })
+                    .collect();
+                Some(ExtraChannel {
+                    name: "Disney diffuse albedo - 0.5",
+                    value,
+                    max_error: 0.0,
+                })
+            }
+            _ => None,
+        }
     }
 
     /// Writes the tables ([`Preset::options`]'s bake, in its order) in the engine's layout: the
@@ -257,7 +286,7 @@ impl Preset {
                 Ok(out.into_bytes())
             }
             Preset::Filament => {
-                let sheen = self.sheen().expect("filament has a cloth channel");
+                let sheen = self.extra_channel().expect("filament has a cloth channel");
                 let planes = [
                     engine_order(&tables[0].value),
                     engine_order(&tables[1].value),
@@ -292,7 +321,7 @@ impl Preset {
             )),
             #[cfg(feature = "containers")]
             Preset::Godot => {
-                let sheen = self.sheen().expect("godot has a cloth channel");
+                let sheen = self.extra_channel().expect("godot has a cloth channel");
                 let mut texture =
                     Texture::of_values(&[&tables[0], &tables[1]]).map_err(Error::InvalidInput)?;
                 texture.channels = vec![
@@ -304,18 +333,13 @@ impl Preset {
                 crate::format::dds::encode(&texture, Precision::F16).map_err(Error::InvalidInput)
             }
             Preset::UnityHdrp => {
-                let spec = &tables[1].spec;
-                let diffuse: Vec<f64> = (0..n * n)
-                    .map(|k| {
-                        let (alpha, mu) = spec.texel_coordinates(k);
-                        let mu = mu.expect("a 2-D table has a mu axis");
-                        crate::model::disney_diffuse::disney_diffuse_albedo(alpha.sqrt(), mu) - 0.5
-                    })
-                    .collect();
+                let diffuse = self
+                    .extra_channel()
+                    .expect("unity-hdrp has a diffuse channel");
                 let planes = [
                     engine_order(&tables[0].value),
                     engine_order(&tables[1].value),
-                    engine_order(&diffuse),
+                    engine_order(&diffuse.value),
                 ];
                 crate::format::exr::encode_planes(
                     &tables[1],
@@ -348,7 +372,20 @@ impl Preset {
     /// Reads an engine's own file in this layout: each table it holds, as its quantity and its
     /// values in kiln's order (roughness rows, `mu` columns; `E_avg` by roughness).
     pub fn decode(self, bytes: &[u8]) -> Result<Vec<(Quantity, Vec<f64>)>> {
+        Ok(self.decode_all(bytes)?.0)
+    }
+
+    /// Reads the [`Preset::extra_channel`] of an engine's own file, in kiln's order: `None` if
+    /// the preset has none or the file does not hold it (an RG16F Filament include, say).
+    pub fn decode_extra(self, bytes: &[u8]) -> Result<Option<Vec<f64>>> {
+        Ok(self.decode_all(bytes)?.1)
+    }
+
+    /// [`Preset::decode`] and [`Preset::decode_extra`] in one reading.
+    #[allow(clippy::type_complexity)]
+    fn decode_all(self, bytes: &[u8]) -> Result<(Vec<(Quantity, Vec<f64>)>, Option<Vec<f64>>)> {
         let n = self.options().size;
+        let mut extra = None;
         let bad = |m: String| Error::InvalidInput(format!("not a {} table: {m}", self.name()));
         let kiln_order = |engine: &[f64]| -> Vec<f64> {
             let mut out = vec![0.0; n * n];
@@ -359,7 +396,7 @@ impl Preset {
             }
             out
         };
-        match self {
+        let tables = match self {
             Preset::EnterprisePbr => {
                 let image = crate::format::exr::decode(bytes).map_err(bad)?;
                 let (_, values) = image
@@ -505,6 +542,9 @@ impl Preset {
                         .collect();
                     kiln_order(&engine)
                 };
+                if stride == 3 {
+                    extra = Some(channel(2));
+                }
                 Ok(vec![
                     (Quantity::EBias, channel(0)),
                     (Quantity::E, channel(1)),
@@ -543,6 +583,9 @@ impl Preset {
                         .collect();
                     kiln_order(&engine)
                 };
+                if stride == 4 {
+                    extra = Some(channel(2));
+                }
                 Ok(vec![
                     (Quantity::EBias, channel(0)),
                     (Quantity::E, channel(1)),
@@ -567,12 +610,82 @@ impl Preset {
                 let (red, green) = if self == Preset::Unreal {
                     (Quantity::E, Quantity::EBias)
                 } else {
+                    extra = channel("B").ok();
                     (Quantity::EBias, Quantity::E)
                 };
                 Ok(vec![(red, channel("R")?), (green, channel("G")?)])
             }
-        }
+        }?;
+        Ok((tables, extra))
     }
+}
+
+impl Preset {
+    /// Audits the [`Preset::extra_channel`] of an engine's own file at its texels against
+    /// kiln's values there; `None` if the file holds no such channel.
+    pub fn audit_extra(self, bytes: &[u8]) -> Result<Option<ExtraAudit>> {
+        let Some(stored) = self.decode_extra(bytes)? else {
+            return Ok(None);
+        };
+        let reference = self
+            .extra_channel()
+            .expect("a preset that decodes an extra channel computes it");
+        let (mut max_error, mut sum2, mut worst) = (0.0f64, 0.0, 0);
+        for (k, (s, r)) in stored.iter().zip(&reference.value).enumerate() {
+            let error = (s - r).abs();
+            sum2 += error * error;
+            if error > max_error || error.is_nan() {
+                (max_error, worst) = (error, k);
+            }
+        }
+        let spec = self.options().resolved().specs().swap_remove(0);
+        let (worst_alpha, worst_mu) = spec.texel_coordinates(worst);
+        Ok(Some(ExtraAudit {
+            name: reference.name,
+            texels: stored.len(),
+            max_error,
+            rms_error: (sum2 / stored.len() as f64).sqrt(),
+            worst_alpha,
+            worst_mu: worst_mu.unwrap_or(0.0),
+            worst_table: stored[worst],
+            worst_reference: reference.value[worst],
+            reference_error: reference.max_error,
+        }))
+    }
+}
+
+/// The result of [`Preset::audit_extra`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExtraAudit {
+    /// What the channel holds.
+    pub name: &'static str,
+    /// Texels compared.
+    pub texels: usize,
+    /// The largest absolute difference from kiln's values (NaN if the file holds a NaN).
+    pub max_error: f64,
+    /// The root-mean-square difference.
+    pub rms_error: f64,
+    /// Where the largest difference is: `alpha` and `mu` of that texel.
+    pub worst_alpha: f64,
+    /// See `worst_alpha`.
+    pub worst_mu: f64,
+    /// The file's value there.
+    pub worst_table: f64,
+    /// kiln's value there.
+    pub worst_reference: f64,
+    /// The error estimate of kiln's values.
+    pub reference_error: f64,
+}
+
+/// See [`Preset::extra_channel`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExtraChannel {
+    /// What the channel holds.
+    pub name: &'static str,
+    /// Its values at the preset's texels, roughness rows and `mu` columns.
+    pub value: Vec<f64>,
+    /// The largest error estimate of those values (0: exact up to rounding).
+    pub max_error: f64,
 }
 
 impl Preset {

@@ -258,6 +258,50 @@ fn filament_layout_is_rgb16f_half_bits_in_gl_order_with_cloth_in_blue() {
             }
         }
     }
+    // The blue channel reads back as kiln's cloth values; an RG16F include (cmgen before the
+    // cloth channel: two halves per texel) reads as the same R and G with no blue channel.
+    let cloth = Preset::Filament.extra_channel().unwrap();
+    assert_eq!(
+        Preset::Filament
+            .decode_extra(text.as_bytes())
+            .unwrap()
+            .unwrap(),
+        cloth.value.iter().map(|&v| f16_of(v)).collect::<Vec<_>>()
+    );
+    let rg: String = bits
+        .chunks(3)
+        .map(|t| format!("0x{:04x}, 0x{:04x},\n", t[0], t[1]))
+        .collect();
+    assert_eq!(Preset::Filament.decode_extra(rg.as_bytes()).unwrap(), None);
+    assert_eq!(
+        Preset::Filament.decode(rg.as_bytes()).unwrap(),
+        Preset::Filament.decode(text.as_bytes()).unwrap()
+    );
+    // The audit of the blue channel: half-float rounding only, and a damaged texel is found.
+    let audit = Preset::Filament
+        .audit_extra(text.as_bytes())
+        .unwrap()
+        .unwrap();
+    let largest = cloth.value.iter().fold(0.0f64, |m, &v| m.max(v));
+    assert!(audit.max_error <= largest * 2f64.powi(-11) + Preset::SHEEN_TOLERANCE);
+    let k = 77 * 128 + 40;
+    let damaged_bits: Vec<u16> = bits
+        .iter()
+        .enumerate()
+        .map(|(i, &b)| if i == 3 * k + 2 { 0 } else { b })
+        .collect();
+    let damaged: String = damaged_bits
+        .iter()
+        .map(|b| format!("0x{b:04x},\n"))
+        .collect();
+    let audit = Preset::Filament
+        .audit_extra(damaged.as_bytes())
+        .unwrap()
+        .unwrap();
+    let (alpha, mu) = e.spec.texel_coordinates(k);
+    assert_eq!((audit.worst_alpha, audit.worst_mu), (alpha, mu.unwrap()));
+    assert_eq!(audit.max_error, cloth.value[k]);
+    assert_eq!(Preset::Filament.audit_extra(rg.as_bytes()).unwrap(), None);
     let back = Preset::Filament
         .read_tables(text.as_bytes(), "test")
         .unwrap();
@@ -328,6 +372,16 @@ fn unity_hdrp_layout_is_sqrt_nov_nodes_with_disney_diffuse_in_blue() {
             assert_eq!(blue[at], f16_of(diffuse), "B at {x}, {row}");
         }
     }
+    assert_eq!(
+        Preset::UnityHdrp.decode_extra(&bytes).unwrap().unwrap(),
+        Preset::UnityHdrp
+            .extra_channel()
+            .unwrap()
+            .value
+            .iter()
+            .map(|&v| f16_of(v))
+            .collect::<Vec<_>>()
+    );
     let back = Preset::UnityHdrp.read_tables(&bytes, "test").unwrap();
     assert_eq!(
         back[1].value,
@@ -360,6 +414,8 @@ fn unreal_layout_is_e_and_e_fc_in_red_and_green_with_roughness_rows() {
             assert_eq!((channel("B")[k], channel("A")[k]), (0.0, 1.0));
         }
     }
+    // Unreal's texture has no third quantity (its B is 0).
+    assert_eq!(Preset::Unreal.decode_extra(&bytes).unwrap(), None);
     let back = Preset::Unreal.read_tables(&bytes, "test").unwrap();
     assert_eq!(back[0].spec.quantity, kiln::Quantity::E);
     assert_eq!(

@@ -280,10 +280,10 @@ fn bake_preset(preset: kiln::preset::Preset, args: &BakeArgs) -> kiln::Result<()
                 );
             }
         }
-        if let Some(sheen) = preset.sheen() {
+        if let Some(extra) = preset.extra_channel() {
             println!(
-                "{:<32} quadrature error estimate {:.1e} (blue channel)",
-                "cloth (Charlie, Ashikhmin)", sheen.max_error
+                "blue channel: {}, error estimate {:.1e}",
+                extra.name, extra.max_error
             );
         }
         println!(

@@ -48,7 +48,8 @@ pub struct VerifyArgs {
     /// Uint16Array; enterprise-pbr: GGX_E.exr or GGX_E_avg.exr; filament: dfg.inc, RGB or RG
     /// half bits; godot: dfg_lut.dds; unity-hdrp and unreal: their EXR): audit each of its
     /// tables against the reference for the model the engine evaluates (GGX, height-correlated;
-    /// Godot: separable Schlick-GGX). Cloth and diffuse channels are not audited.
+    /// Godot: separable Schlick-GGX); a blue channel (Filament's and Godot's cloth, HDRP's
+    /// Disney diffuse) is compared with kiln's values at its texels (node errors only).
     #[arg(long, value_enum, conflicts_with_all = ["furnace", "shape", "channel", "dtype"])]
     preset: Option<kiln::preset::Preset>,
     /// Exit with status 1 when node_max_error exceeds this.
@@ -340,6 +341,9 @@ pub fn run(args: VerifyArgs) -> kiln::Result<bool> {
         for table in &tables {
             passed &= audit_one(&args, table)?;
         }
+        if let Some(audit) = preset.audit_extra(&bytes)? {
+            passed &= audit_extra(&args, &audit);
+        }
         return Ok(passed);
     }
     let table = args.load(&args.file)?;
@@ -347,6 +351,52 @@ pub fn run(args: VerifyArgs) -> kiln::Result<bool> {
         return run_furnace(&args, &table);
     }
     audit_one(&args, &table)
+}
+
+/// Audits an engine file's channel that is not one of kiln's tables (Filament's and Godot's
+/// cloth albedo, HDRP's Disney diffuse) at its texels against kiln's values there, and prints
+/// the report; whether it passed `--max-error`.
+fn audit_extra(args: &VerifyArgs, audit: &kiln::preset::ExtraAudit) -> bool {
+    let passed = args.max_error.is_none_or(|bound| audit.max_error <= bound);
+    if args.json {
+        let mut object = serde_json::json!({
+            "file": args.file.display().to_string(),
+            "channel": audit.name,
+            "texels": audit.texels,
+            "node_max_error": audit.max_error,
+            "node_rms_error": audit.rms_error,
+            "worst_node": {"alpha": audit.worst_alpha, "mu": audit.worst_mu,
+                           "table": audit.worst_table, "reference": audit.worst_reference},
+            "reference_error_estimate": audit.reference_error,
+        });
+        if let Some(bound) = args.max_error {
+            object["max_error"] = bound.into();
+            object["passed"] = passed.into();
+        }
+        println!("{object}");
+    } else {
+        println!(
+            "{}: blue channel, {} ({} texels, against kiln's values, error estimate {:.0e})",
+            args.file.display(),
+            audit.name,
+            audit.texels,
+            audit.reference_error
+        );
+        println!(
+            "  nodes   {:>6}: max error {:.2e}, rms {:.2e}; worst at mu = {:.6}, r = {:.6} \
+             (alpha {:.3e}): table {:.7}, reference {:.7}",
+            audit.texels,
+            audit.max_error,
+            audit.rms_error,
+            audit.worst_mu,
+            audit.worst_alpha.sqrt(),
+            audit.worst_alpha,
+            audit.worst_table,
+            audit.worst_reference
+        );
+        print_verdict(args.max_error, passed, "node max error", audit.max_error);
+    }
+    passed
 }
 
 /// Audits one table and prints the report; whether it passed `--max-error`.
