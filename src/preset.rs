@@ -396,6 +396,13 @@ impl Preset {
             }
             out
         };
+        // Channel `c` of `stride` interleaved half floats per texel, in kiln's order.
+        let half_channel = |bits: &[u16], stride: usize, c: usize| -> Vec<f64> {
+            let engine: Vec<f64> = (0..n * n)
+                .map(|k| f64::from(half::f16::from_bits(bits[stride * k + c]).to_f32()))
+                .collect();
+            kiln_order(&engine)
+        };
         let tables = match self {
             Preset::EnterprisePbr => {
                 let image = crate::format::exr::decode(bytes).map_err(bad)?;
@@ -466,15 +473,10 @@ impl Preset {
                         header.pixel_width, header.pixel_height, header.format
                     )));
                 }
-                let half = |k: usize| {
-                    f64::from(half::f16::from_le_bytes([data[2 * k], data[2 * k + 1]]).to_f32())
-                };
-                let channel = |c: usize| -> Vec<f64> {
-                    kiln_order(&(0..n * n).map(|k| half(2 * k + c)).collect::<Vec<_>>())
-                };
+                let bits = little_endian(&data);
                 Ok(vec![
-                    (Quantity::EScale, channel(0)),
-                    (Quantity::EBias, channel(1)),
+                    (Quantity::EScale, half_channel(&bits, 2, 0)),
+                    (Quantity::EBias, half_channel(&bits, 2, 1)),
                 ])
             }
             Preset::Three => {
@@ -501,15 +503,9 @@ impl Preset {
                         2 * n * n
                     )));
                 }
-                let channel = |c: usize| -> Vec<f64> {
-                    let engine: Vec<f64> = (0..n * n)
-                        .map(|k| f64::from(half::f16::from_bits(bits[2 * k + c]).to_f32()))
-                        .collect();
-                    kiln_order(&engine)
-                };
                 Ok(vec![
-                    (Quantity::EScale, channel(0)),
-                    (Quantity::EBias, channel(1)),
+                    (Quantity::EScale, half_channel(&bits, 2, 0)),
+                    (Quantity::EBias, half_channel(&bits, 2, 1)),
                 ])
             }
             Preset::Filament => {
@@ -536,18 +532,10 @@ impl Preset {
                         )));
                     }
                 };
-                let channel = |c: usize| -> Vec<f64> {
-                    let engine: Vec<f64> = (0..n * n)
-                        .map(|k| f64::from(half::f16::from_bits(bits[stride * k + c]).to_f32()))
-                        .collect();
-                    kiln_order(&engine)
-                };
-                if stride == 3 {
-                    extra = Some(channel(2));
-                }
+                extra = (stride > 2).then(|| half_channel(&bits, stride, 2));
                 Ok(vec![
-                    (Quantity::EBias, channel(0)),
-                    (Quantity::E, channel(1)),
+                    (Quantity::EBias, half_channel(&bits, stride, 0)),
+                    (Quantity::E, half_channel(&bits, stride, 1)),
                 ])
             }
             #[cfg(not(feature = "containers"))]
@@ -573,22 +561,11 @@ impl Preset {
                         dds.get_height()
                     )));
                 }
-                let data = &dds.data;
-                let channel = |c: usize| -> Vec<f64> {
-                    let engine: Vec<f64> = (0..n * n)
-                        .map(|k| {
-                            let i = 2 * (stride * k + c);
-                            f64::from(half::f16::from_le_bytes([data[i], data[i + 1]]).to_f32())
-                        })
-                        .collect();
-                    kiln_order(&engine)
-                };
-                if stride == 4 {
-                    extra = Some(channel(2));
-                }
+                let bits = little_endian(&dds.data);
+                extra = (stride > 2).then(|| half_channel(&bits, stride, 2));
                 Ok(vec![
-                    (Quantity::EBias, channel(0)),
-                    (Quantity::E, channel(1)),
+                    (Quantity::EBias, half_channel(&bits, stride, 0)),
+                    (Quantity::E, half_channel(&bits, stride, 1)),
                 ])
             }
             Preset::UnityHdrp | Preset::Unreal => {
@@ -711,6 +688,14 @@ impl Preset {
             })
             .collect())
     }
+}
+
+/// Little-endian 16-bit words (a container's half floats).
+#[cfg(feature = "containers")]
+fn little_endian(data: &[u8]) -> Vec<u16> {
+    data.chunks_exact(2)
+        .map(|b| u16::from_le_bytes([b[0], b[1]]))
+        .collect()
 }
 
 /// The numbers of the C float array `name` (`name[...] = { ... }`), `f` suffixes allowed, read
