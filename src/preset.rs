@@ -382,8 +382,7 @@ impl Preset {
     }
 
     /// [`Preset::decode`] and [`Preset::decode_extra`] in one reading.
-    #[allow(clippy::type_complexity)]
-    fn decode_all(self, bytes: &[u8]) -> Result<(Vec<(Quantity, Vec<f64>)>, Option<Vec<f64>>)> {
+    fn decode_all(self, bytes: &[u8]) -> Result<Decoded> {
         let n = self.options().size;
         let mut extra = None;
         let bad = |m: String| Error::InvalidInput(format!("not a {} table: {m}", self.name()));
@@ -519,6 +518,12 @@ impl Preset {
                     .map(str::trim)
                     .filter(|s| !s.is_empty())
                     .filter_map(|s| s.strip_prefix("0x").or_else(|| s.strip_prefix("0X")))
+                    // The digits only: the last number may run into the closing `};`.
+                    .map(|s| {
+                        s.split(|c: char| !c.is_ascii_hexdigit())
+                            .next()
+                            .unwrap_or("")
+                    })
                     .map(|s| u16::from_str_radix(s, 16).map_err(|e| bad(format!("'0x{s}': {e}"))))
                     .collect::<Result<_>>()?;
                 let stride = match bits.len() / (n * n) {
@@ -689,6 +694,9 @@ impl Preset {
             .collect())
     }
 }
+
+/// An engine file's tables (quantity, values in kiln's order) and its extra channel.
+type Decoded = (Vec<(Quantity, Vec<f64>)>, Option<Vec<f64>>);
 
 /// Little-endian 16-bit words (a container's half floats).
 #[cfg(feature = "containers")]

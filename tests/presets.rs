@@ -273,6 +273,15 @@ fn filament_layout_is_rgb16f_half_bits_in_gl_order_with_cloth_in_blue() {
         .map(|t| format!("0x{:04x}, 0x{:04x},\n", t[0], t[1]))
         .collect();
     assert_eq!(Preset::Filament.decode_extra(rg.as_bytes()).unwrap(), None);
+    // A whole C array around the include reads the same (the last number before `}`).
+    let wrapped = format!(
+        "const uint16_t DFG_LUT[] = {{\n{}}};",
+        text.trim_end().trim_end_matches(',')
+    );
+    assert_eq!(
+        Preset::Filament.decode(wrapped.as_bytes()).unwrap(),
+        Preset::Filament.decode(text.as_bytes()).unwrap()
+    );
     assert_eq!(
         Preset::Filament.decode(rg.as_bytes()).unwrap(),
         Preset::Filament.decode(text.as_bytes()).unwrap()
