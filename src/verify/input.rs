@@ -92,7 +92,11 @@ fn channel(path: &Path, channels: &[(String, Vec<f64>)], name: &str) -> Result<V
             let names: Vec<&str> = channels.iter().map(|(n, _)| n.as_str()).collect();
             invalid(
                 path,
-                format!("no channel '{name}' (it has {})", names.join(", ")),
+                format!(
+                    "no channel '{name}' (it has {}); an engine layout's file (R, G, B ...) \
+                     reads with --preset NAME, another channel with --channel NAME",
+                    names.join(", ")
+                ),
             )
         })
 }
