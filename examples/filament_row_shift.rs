@@ -32,11 +32,12 @@ fn main() -> kiln::Result<()> {
             })
             .collect();
     }
-    std::fs::write(&out, preset.encode(&tables)?).map_err(|source| kiln::Error::Io {
-        path: out.clone().into(),
-        action: "write",
-        source,
-    })?;
-    println!("wrote {out}");
+    // Staged and renamed into place: an interrupted run leaves no partial file.
+    let out = std::path::Path::new(&out);
+    let dir = out.parent().filter(|p| !p.as_os_str().is_empty());
+    let name = out.file_name().expect("a file name").to_string_lossy();
+    let files = [(name.to_string(), preset.encode(&tables)?)];
+    let written = kiln::format::write_files(dir.unwrap_or(std::path::Path::new(".")), &files)?;
+    println!("wrote {}", written[0].display());
     Ok(())
 }

@@ -124,14 +124,24 @@ impl Preset {
     }
 
     /// Every file the preset writes, `(name, bytes)`.
-    pub fn files(self, tables: &[Table]) -> Result<Vec<(String, Vec<u8>)>> {
-        let mut files = vec![(self.file_name().to_string(), self.encode(tables)?)];
+    pub fn files(self, tables: &[Table]) -> Result<Files> {
+        Ok(self.files_and_extra(tables)?.0)
+    }
+
+    /// [`Preset::files`], with the [`Preset::extra_channel`] they hold (computed once), for a
+    /// caller that reports it.
+    pub fn files_and_extra(self, tables: &[Table]) -> Result<(Files, Option<ExtraChannel>)> {
+        let extra = self.extra_channel();
+        let mut files = vec![(
+            self.file_name().to_string(),
+            self.encode_with(tables, extra.as_ref())?,
+        )];
         if self == Preset::EnterprisePbr {
             let average = crate::format::exr::encode_value_as(&tables[1], "Y", Precision::F16)
                 .map_err(Error::InvalidInput)?;
             files.push(("GGX_E_avg.exr".to_string(), average));
         }
-        Ok(files)
+        Ok((files, extra))
     }
 
     /// The bake that gives the preset's tables (to the default max error).
@@ -224,6 +234,11 @@ impl Preset {
     /// Writes the tables ([`Preset::options`]'s bake, in its order) in the engine's layout: the
     /// file [`Preset::file_name`] (see [`Preset::files`] for all of them).
     pub fn encode(self, tables: &[Table]) -> Result<Vec<u8>> {
+        self.encode_with(tables, self.extra_channel().as_ref())
+    }
+
+    /// [`Preset::encode`] with the preset's [`Preset::extra_channel`] already computed.
+    fn encode_with(self, tables: &[Table], extra: Option<&ExtraChannel>) -> Result<Vec<u8>> {
         let n = self.options().size;
         let engine_order = |values: &[f64]| -> Vec<f64> {
             let mut out = vec![0.0; n * n];
@@ -286,7 +301,7 @@ impl Preset {
                 Ok(out.into_bytes())
             }
             Preset::Filament => {
-                let sheen = self.extra_channel().expect("filament has a cloth channel");
+                let sheen = extra.expect("filament has a cloth channel");
                 let planes = [
                     engine_order(&tables[0].value),
                     engine_order(&tables[1].value),
@@ -321,7 +336,7 @@ impl Preset {
             )),
             #[cfg(feature = "containers")]
             Preset::Godot => {
-                let sheen = self.extra_channel().expect("godot has a cloth channel");
+                let sheen = extra.expect("godot has a cloth channel");
                 let mut texture =
                     Texture::of_values(&[&tables[0], &tables[1]]).map_err(Error::InvalidInput)?;
                 texture.channels = vec![
@@ -333,9 +348,7 @@ impl Preset {
                 crate::format::dds::encode(&texture, Precision::F16).map_err(Error::InvalidInput)
             }
             Preset::UnityHdrp => {
-                let diffuse = self
-                    .extra_channel()
-                    .expect("unity-hdrp has a diffuse channel");
+                let diffuse = extra.expect("unity-hdrp has a diffuse channel");
                 let planes = [
                     engine_order(&tables[0].value),
                     engine_order(&tables[1].value),
@@ -549,7 +562,8 @@ impl Preset {
             )),
             #[cfg(feature = "containers")]
             Preset::Godot => {
-                let dds = ddsfile::Dds::read(bytes).map_err(|e| bad(e.to_string()))?;
+                let dds =
+                    ddsfile::Dds::read(bytes).map_err(|e| bad(format!("not a DDS file ({e})")))?;
                 let format = dds.get_dxgi_format();
                 let stride = match format {
                     Some(ddsfile::DxgiFormat::R16G16B16A16_Float) => 4,
@@ -574,7 +588,8 @@ impl Preset {
                 ])
             }
             Preset::UnityHdrp | Preset::Unreal => {
-                let image = crate::format::exr::decode(bytes).map_err(bad)?;
+                let image = crate::format::exr::decode(bytes)
+                    .map_err(|e| bad(format!("not an EXR file ({e})")))?;
                 if (image.width, image.height) != (n, n) {
                     return Err(bad(format!(
                         "{} x {} (expected {n} x {n})",
@@ -694,6 +709,9 @@ impl Preset {
             .collect())
     }
 }
+
+/// Files a preset writes: `(name, bytes)`.
+pub type Files = Vec<(String, Vec<u8>)>;
 
 /// An engine file's tables (quantity, values in kiln's order) and its extra channel.
 type Decoded = (Vec<(Quantity, Vec<f64>)>, Option<Vec<f64>>);

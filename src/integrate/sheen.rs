@@ -13,6 +13,7 @@
 //! outer integral, as is the distribution's width `1 / sqrt(k)`, `k = 1 / (2 alpha)`, past the
 //! support's start. Both integrals are adaptive Gauss-Kronrod ([`super::gauss_kronrod`]).
 
+use super::albedo::sin_from_cos;
 use super::gauss_kronrod::{Quadrature, integrate, integrate_pieces};
 use crate::model::sheen::{ashikhmin_v, charlie_d};
 use std::f64::consts::{FRAC_PI_2, PI};
@@ -22,7 +23,7 @@ use std::f64::consts::{FRAC_PI_2, PI};
 #[must_use]
 pub fn sheen_albedo(alpha: f64, mu_o: f64, tolerance: f64) -> Quadrature<1> {
     let mu_o = mu_o.clamp(0.0, 1.0);
-    let s_o = (1.0 - mu_o * mu_o).max(0.0).sqrt();
+    let s_o = sin_from_cos(mu_o);
     let theta_o = mu_o.acos();
     let c_start = ((theta_o + FRAC_PI_2) / 2.0).cos();
     let c_full = ((FRAC_PI_2 - theta_o) / 2.0).cos();
@@ -38,7 +39,7 @@ pub fn sheen_albedo(alpha: f64, mu_o: f64, tolerance: f64) -> Quadrature<1> {
         if d == 0.0 {
             return [0.0];
         }
-        let s_h = (1.0 - c * c).max(0.0).sqrt();
+        let s_h = sin_from_cos(c);
         // mu_i > 0  <=>  cos(phi) > (mu_o / (2 c) - mu_o c) / (s_o s_h).
         let numerator = mu_o / (2.0 * c) - mu_o * c;
         let denominator = s_o * s_h;

@@ -262,7 +262,7 @@ fn bake_preset(preset: kiln::preset::Preset, args: &BakeArgs) -> kiln::Result<()
     let start = Instant::now();
     let tables = options.bake(&|samples| bar.inc(samples))?;
     bar.finish_and_clear();
-    let mut files = preset.files(&tables)?;
+    let (mut files, extra) = preset.files_and_extra(&tables)?;
     files.extend(format::encode_all(
         &tables,
         &[Format::Json],
@@ -280,7 +280,7 @@ fn bake_preset(preset: kiln::preset::Preset, args: &BakeArgs) -> kiln::Result<()
                 );
             }
         }
-        if let Some(extra) = preset.extra_channel() {
+        if let Some(extra) = extra {
             println!(
                 "blue channel: {}, error estimate {:.1e}",
                 extra.name, extra.max_error
