@@ -2,7 +2,7 @@
 //! convention, grid, channels, container), so that kiln's file replaces the engine's own, and
 //! the reader of that layout for `kiln verify --preset`.
 //!
-//! Conventions (`../shared/docs/peers.md`, and the engines' sources named there):
+//! Conventions (`docs/engines.md`, with the engines' source files and commits):
 //!
 //! - `cycles`: Blender Cycles' `table_ggx_E[1024]` and `table_ggx_Eavg[32]` (`shader.tables`):
 //!   GGX, height-correlated, F = 1; 32 x 32, `index = mu_index * 32 + r_index` (roughness

@@ -1,4 +1,4 @@
-//! kiln's QMC estimates against independent values: closed forms, physics.md's check values and a
+//! kiln's QMC estimates against independent values: closed forms, docs/physics.md's check values and a
 //! deterministic quadrature, within the estimates' own standard errors.
 
 mod common;
@@ -40,7 +40,7 @@ fn closed_form_e_at_normal_incidence_alpha_one() {
 #[test]
 fn physics_check_values_at_default_settings() {
     let s = QmcSettings::default();
-    // physics.md gives eight decimals: the values are known to ±5e-9.
+    // docs/physics.md gives eight decimals: the values are known to ±5e-9.
     let rounding = 5e-9;
     assert_agrees(
         "GGX E(0.5, 0.5)",
@@ -171,14 +171,14 @@ fn albedo_stays_in_range_with_finite_values_across_the_domain() {
         }
     }
     // The limits kiln returns without sampling: a mirror keeps all energy; a height-correlated
-    // surface seen exactly at grazing too (physics.md).
+    // surface seen exactly at grazing too (docs/physics.md).
     assert_eq!(albedo(model(Ndf::Ggx, SEP), 0.0, 0.3, &s).value, 1.0);
     assert_eq!(albedo(model(Ndf::Beckmann, HC), 0.7, 0.0, &s).value, 1.0);
 }
 
 #[test]
 fn one_minus_e_keeps_relative_precision_near_a_mirror() {
-    // At alpha = 0.01 (r = 0.1), 1 - E_avg is about 5.1e-4 (physics.md); its estimate must be
+    // At alpha = 0.01 (r = 0.1), 1 - E_avg is about 5.1e-4 (docs/physics.md); its estimate must be
     // meaningful in relative terms, not a difference of two numbers near 1.
     // At the E_avg sample count `kiln bake` uses by default (16 x the default).
     let s = QmcSettings {

@@ -1,4 +1,4 @@
-//! The edges of the domain (`physics.md`, "Hard cases"): property-based tests over `mu` in
+//! The edges of the domain (`docs/physics.md`, "Hard cases"): property-based tests over `mu` in
 //! [0, 1] and `alpha` in [0, 4], with their exact edges drawn often, for every distribution and
 //! masking form; and a table of hard points checked against the deterministic reference.
 

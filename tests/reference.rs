@@ -30,7 +30,7 @@ fn closed_form_and_physics_check_values() {
         (e.value - (1.0 - std::f64::consts::LN_2)).abs() < 1e-10,
         "{e:?}"
     );
-    // Eight-decimal check values (physics.md): known to ±5e-9.
+    // Eight-decimal check values (docs/physics.md): known to ±5e-9.
     let checks = [
         (reference_albedo(HC_GGX, 0.5, 0.5, &s), 0.698_250_70),
         (reference_average_albedo(HC_GGX, 1.0, &s), 0.409_137_09),
@@ -65,7 +65,7 @@ fn closed_form_and_physics_check_values() {
             "{r:?} vs {expected}"
         );
     }
-    // physics.md: 1 - E_avg is about 5.1e-4 at alpha = 0.01.
+    // docs/physics.md: 1 - E_avg is about 5.1e-4 at alpha = 0.01.
     let r = reference_average_albedo(HC_GGX, 0.01, &s);
     assert!((r.one_minus_value - 5.1e-4).abs() < 0.05e-4, "{r:?}");
 }

@@ -1,5 +1,5 @@
 //! `kiln verify`: kiln's own tables, external tables in every format and layout, bad input, the
-//! `--max-error` gate, and an audit of Blender Cycles' shipped GGX table.
+//! `--max-error` gate (engines' real files: `tests/engine_files.rs`).
 
 #![cfg(feature = "cli")]
 
@@ -396,55 +396,6 @@ fn max_error_gates_a_build_and_tables_compare_with_each_other() {
     let (_, report) = verify(&[json.to_str().unwrap(), "--against", exr.to_str().unwrap()]);
     assert!(number(&report, "node_max_error") < 1e-7, "{report}");
     assert!(report["against"].as_str().unwrap().starts_with("table"));
-}
-
-/// Blender Cycles' shipped GGX table (../shared/anchors, read at run time, never committed):
-/// its nodes are right to the level of its 6-decimal printing; its linear-mu lookup is worst
-/// near grazing at low roughness.
-#[test]
-fn audit_of_cycles_ggx_table() {
-    let anchor = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/anchors/cycles-ggx.json");
-    let text = std::fs::read(&anchor).unwrap_or_else(|e| {
-        panic!(
-            "{}: {e} (the shared anchors sit beside the repository)",
-            anchor.display()
-        )
-    });
-    let anchor: Value = serde_json::from_slice(&text).unwrap();
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("cycles_ggx_E.txt");
-    let numbers: Vec<String> = anchor["ggx_E"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|v| v.to_string())
-        .collect();
-    std::fs::write(&path, numbers.join("\n")).unwrap();
-    let (status, report) = verify(&[
-        path.to_str().unwrap(),
-        "--shape",
-        "32x32",
-        "--order",
-        "mu,r",
-        "--grid",
-        "nodes",
-        "--clamp-min",
-        "1e-4",
-    ]);
-    assert_eq!(status, Some(0));
-    // 6 decimals round by up to 5e-7; Cycles' own QMC (2^23 samples) adds about as much.
-    let node = number(&report, "node_max_error");
-    assert!(
-        node < 2e-6 && number(&report, "node_rms_error") < 5e-7,
-        "{report}"
-    );
-    // Between the nodes a linear mu axis misses the grazing boundary layer at mu ~ alpha.
-    assert!(number(&report, "lookup_max_error") > 1e-2, "{report}");
-    let worst = &report["worst_lookup"];
-    assert!(
-        worst["mu"].as_f64().unwrap() < 1.0 / 31.0 && worst["roughness"].as_f64().unwrap() < 0.25,
-        "{worst}"
-    );
 }
 
 /// `--furnace` finds the E_avg table beside the E file (or takes --average), reports JSON, and

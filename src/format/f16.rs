@@ -4,7 +4,7 @@
 //! f16 has 11 significant bits: a rounding error of at most `2^-11` (4.9e-4) relative for
 //! normal values, down to `2^-14` (6.1e-5). Below that, subnormals keep a fixed spacing of `2^-24` (6.0e-8), so their
 //! relative precision falls; below half that spacing a value would round to zero. `1 - E` is
-//! stored beside `E` for this reason (`physics.md`, "Hard cases"): `E(1, alpha = 0.01)` rounds
+//! stored beside `E` for this reason (`docs/physics.md`, "Hard cases"): `E(1, alpha = 0.01)` rounds
 //! to exactly 1 as an f16, while `1 - E` keeps 0.05 % relative precision down to 6.1e-5.
 
 use half::f16;

@@ -3,7 +3,7 @@
 //!
 //! With `m` drawn from the visible normals of `o` and `i = reflect(o, m)`, the F = 1 albedo
 //! `E(mu_o) = ∫ f(o, i) mu_i dω_i` is the mean of `w = G2(o, i) / G1(o)` when `i` is above the
-//! horizon and 0 below (Heitz & d'Eon 2014, eq. 10; `physics.md`, "Estimating E"). kiln accumulates
+//! horizon and 0 below (Heitz & d'Eon 2014, eq. 10; `docs/physics.md`, "Estimating E"). kiln accumulates
 //! `1 - w` (see [`Masking::loss`]), so `1 - E` keeps its relative precision near `E = 1`.
 //!
 //! `E_avg = 2 ∫_0^1 E(mu) mu dmu = ∫_0^1 E(sqrt(s)) ds` is integrated in its own right, with `s =
@@ -85,7 +85,7 @@ pub(crate) const TAG_DIELECTRIC_AVG: u64 = 0x454441;
 /// `E(mu)` for the model at `alpha` (slope-space roughness), `mu = cos(theta_o)` in [0, 1].
 ///
 /// Exact limits are returned without sampling: `alpha = 0` with `mu > 0` (a mirror, `E = 1`)
-/// and, for height-correlated masking, `mu = 0` (`E(0) = 1`, `physics.md`). Below
+/// and, for height-correlated masking, `mu = 0` (`E(0) = 1`, `docs/physics.md`). Below
 /// [`SMOOTH_ALPHA`] the estimate is taken at the similar point ([`smooth_point`]).
 ///
 /// # Panics
@@ -610,7 +610,7 @@ mod tests {
 
     #[test]
     fn closed_form_at_normal_incidence() {
-        // GGX, mu = 1, alpha = 1: E = 1 - ln 2 (physics.md).
+        // GGX, mu = 1, alpha = 1: E = 1 - ln 2 (docs/physics.md).
         let e = albedo(hc(Ndf::Ggx), 1.0, 1.0, &QmcSettings::default());
         let exact = 1.0 - std::f64::consts::LN_2;
         assert!(e.std_error < 1e-5 && e.std_error > 0.0);

@@ -2,7 +2,7 @@
 //! `E` evaluations per entry where the nested adaptive reference spends hundreds, and checked
 //! against it (tests, `kiln verify`).
 //!
-//! `E_avg = 2 ∫_0^1 E(mu) mu dmu` (`physics.md`). In the adaptive table coordinate
+//! `E_avg = 2 ∫_0^1 E(mu) mu dmu` (`docs/physics.md`). In the adaptive table coordinate
 //! `t = (mu (1 + c alpha) / (mu + c alpha))^p` ([`MuMapping::Adaptive`]) the grazing boundary
 //! layer `mu ~ alpha` is smooth at every `alpha`, so the integral over `mu in [0, mu_c]`,
 //! `mu_c = min(8 alpha, 1)`, is taken in `t`, with `2 mu dmu = 2 mu (dmu/dt) dt`,

@@ -29,7 +29,7 @@ impl Estimate {
     }
 
     /// The mean of `R >= 2` independent replicate means of `1 - E`, with the standard error
-    /// `sqrt(Σ (I_r - Ī)^2 / (R (R - 1)))` (physics.md): the spread between independent scrambles,
+    /// `sqrt(Σ (I_r - Ī)^2 / (R (R - 1)))` (docs/physics.md): the spread between independent scrambles,
     /// never the spread inside one sequence, which QMC makes meaningless.
     #[must_use]
     pub fn from_replicates(one_minus_means: &[f64], samples: u64) -> Self {

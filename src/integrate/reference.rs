@@ -1,7 +1,7 @@
 //! The deterministic reference: `E`, `1 - E` and `E_avg` by nested adaptive Gauss-Kronrod
 //! quadrature, with an error estimate beside each value.
 //!
-//! Parametrisation (`physics.md`, "A deterministic reference"): microfacet normals `m` by azimuth
+//! Parametrisation (`docs/physics.md`, "A deterministic reference"): microfacet normals `m` by azimuth
 //! `phi in [0, pi]` (the integrand is symmetric under `phi -> -phi`; the result is doubled) and
 //! `x = ln(tan(theta_m) / alpha)`, in which the normal distribution's peak has the same width at
 //! every `alpha`. For a fixed `phi` the reflected direction `i = 2 (o.m) m - o` crosses the horizon

@@ -35,7 +35,7 @@
 //! Reciprocity in this convention: Walter's BTDF obeys `f(o, i) / n_i^2 = f(i, o) / n_o^2`, so the
 //! hemispherical averages of the transmitted energy from either side satisfy
 //! `T_avg(eta) = eta^2 T_avg(1 / eta)` (with a smooth surface: `1 - F_avg(eta) = eta^2 (1 -
-//! F_avg(1 / eta))`, the Fresnel reciprocity of `physics.md`).
+//! F_avg(1 / eta))`, the Fresnel reciprocity of `docs/physics.md`).
 
 use super::masking::Masking;
 use super::ndf::MicrofacetDistribution;

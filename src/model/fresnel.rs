@@ -2,7 +2,7 @@
 //!
 //! - Schlick's approximation with `F0` and `F90` per RGB channel: `F = F0 + (F90 - F0) (1 - c)^5`
 //!   (Schlick 1994, "An Inexpensive BRDF Model for Physically-based Rendering"), whose average has
-//!   the closed form `(20 F0 + F90) / 21` (`physics.md`).
+//!   the closed form `(20 F0 + F90) / 21` (`docs/physics.md`).
 //! - The exact unpolarised Fresnel reflectance of a dielectric interface with relative index
 //!   `eta = n_transmitted / n_incident` (`eta < 1`: light leaving the denser medium, with total
 //!   internal reflection beyond the critical angle): Walter, Marschner, Li and Torrance 2007,

@@ -1,7 +1,7 @@
 //! The Kulla-Conty multiple-scattering lobe, from the tables' `1 - E` and `1 - E_avg`.
 //!
 //! Kulla and Conty 2017, "Revisiting Physically Based Shading at Imageworks" (SIGGRAPH course
-//! notes), `physics.md` "Kulla-Conty quantities":
+//! notes), `docs/physics.md` "Kulla-Conty quantities":
 //! `f_ms(o, i) = (1 - E(mu_o)) (1 - E(mu_i)) / (pi (1 - E_avg))`. Its albedo,
 //! `∫ f_ms mu_i dω_i = (1 - E(mu_o)) 2 ∫ (1 - E(mu_i)) mu_i dmu_i / (1 - E_avg)`, is exactly
 //! `1 - E(mu_o)`: the energy single scattering loses (`kiln verify --furnace` checks it on tables).
@@ -33,7 +33,7 @@ pub fn multiple_scattering(one_minus_e_o: f64, one_minus_e_i: f64, one_minus_e_a
 }
 
 /// The colour multiplier of the additive `f_ms` lobe for a coloured Fresnel,
-/// `F_avg^2 E_avg / (1 - F_avg (1 - E_avg))` per channel (Kulla and Conty 2017; `physics.md`).
+/// `F_avg^2 E_avg / (1 - F_avg (1 - E_avg))` per channel (Kulla and Conty 2017; `docs/physics.md`).
 ///
 /// Why the square: a path that bounces `k + 1` times between microfacets keeps `F_avg^(k+1)`; with
 /// a fraction `1 - E_avg` of the energy going on to another bounce each time, the total albedo

@@ -2,9 +2,9 @@
 //! Schlick-GGX approximation engines evaluate.
 //!
 //! Sources: Heitz 2014, "Understanding the Masking-Shadowing Function in Microfacet-Based BRDFs",
-//! eqs. 98 (separable) and 99 (height-correlated); `physics.md`. Schlick-GGX: Schlick 1994's
+//! eqs. 98 (separable) and 99 (height-correlated); `docs/physics.md`. Schlick-GGX: Schlick 1994's
 //! `G1(v) = mu / (mu (1 - k) + k)` with Karis 2013's (UE4) `k = alpha / 2` for image-based
-//! lighting, as Godot and the GAMES202 homework evaluate it (`physics.md`, "Masking-shadowing").
+//! lighting, as Godot and the GAMES202 homework evaluate it (`docs/physics.md`, "Masking-shadowing").
 //!
 //! The estimators sample Smith's visible normals whatever the form, so every form is expressed
 //! as the loss `1 - G2 / G1_Smith(o)` of a sample ([`Masking::loss_at`]).
@@ -30,7 +30,7 @@ pub enum Masking {
 }
 
 impl Masking {
-    /// The two Smith forms, in a fixed order (the forms every property of `physics.md` holds
+    /// The two Smith forms, in a fixed order (the forms every property of `docs/physics.md` holds
     /// for; [`Masking::SchlickGgx`] is an approximation engines use).
     pub const ALL: [Masking; 2] = [Masking::HeightCorrelated, Masking::Separable];
 

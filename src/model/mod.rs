@@ -1,6 +1,6 @@
 //! The BRDF kiln tabulates: normal distributions, Smith masking, roughness conventions.
 //!
-//! The reflection BRDF (`physics.md`) is `f(o, i) = F(o.h) D(h) G2(o, i) / (4 |n.i| |n.o|)`;
+//! The reflection BRDF (`docs/physics.md`) is `f(o, i) = F(o.h) D(h) G2(o, i) / (4 |n.i| |n.o|)`;
 //! the tables here are for `F = 1`.
 
 pub mod dielectric;
@@ -24,7 +24,7 @@ pub use vector::Vec3;
 /// grazing boundary layer's similarity, `E(mu, alpha) = E(mu SMOOTH_ALPHA / alpha, SMOOTH_ALPHA)`
 /// ([`smooth_point`]), and `E_avg` is the mirror's 1.
 ///
-/// Why: as `alpha -> 0`, `E` depends on `mu / alpha` alone up to `O(alpha^2)` (`physics.md`,
+/// Why: as `alpha -> 0`, `E` depends on `mu / alpha` alone up to `O(alpha^2)` (`docs/physics.md`,
 /// "Hard cases": `E(mu = alpha) ~ 0.89` at every small `alpha`), so the rescaled point is exact
 /// to about `1e-14` here; below ~1e-12 the reference quadrature stops resolving `mu ~ alpha`
 /// in f64 (the view sits within `1e-12` rad of the horizon) and plain sampling would follow it.
@@ -49,7 +49,7 @@ pub fn smooth_point(alpha: f64, mu: f64) -> (f64, f64) {
 }
 
 /// Whether `E(mu, alpha) = 1` exactly, with nothing to integrate: a mirror (`alpha = 0`,
-/// `mu > 0`), and the height-correlated grazing limit `E(0) = 1` (`physics.md`: `G2 / G1(o) =
+/// `mu > 0`), and the height-correlated grazing limit `E(0) = 1` (`docs/physics.md`: `G2 / G1(o) =
 /// (1 + Lambda(o)) / (1 + Lambda(o) + Lambda(i)) -> 1` as `Lambda(o) -> infinity`). Every
 /// estimator returns these without sampling.
 #[must_use]

@@ -7,7 +7,7 @@
 //!
 //! Sources: Walter et al. 2007, "Microfacet Models for Refraction through Rough Surfaces" (D and
 //! Lambda of both distributions); Heitz 2014, "Understanding the Masking-Shadowing Function in
-//! Microfacet-Based BRDFs" (Smith Lambda, G1, G2); `physics.md` for the stable forms.
+//! Microfacet-Based BRDFs" (Smith Lambda, G1, G2); `docs/physics.md` for the stable forms.
 
 use super::special::{FRAC_1_SQRT_PI, erf_inv_uniform, erfc};
 use super::vector::Vec3;
@@ -158,7 +158,7 @@ impl MicrofacetDistribution for Beckmann {
     }
 
     /// Exact Smith Lambda, `a = 1 / (alpha tan(theta))` (Walter 2007, eq. 27 before the rational
-    /// fit; `physics.md`):
+    /// fit; `docs/physics.md`):
     ///
     /// `Lambda = (erf(a) - 1) / 2 + exp(-a^2) / (2 a sqrt(pi)) = (exp(-a^2) / (a sqrt(pi)) - erfc(a)) / 2`.
     ///
@@ -473,7 +473,7 @@ mod tests {
         }
     }
 
-    /// physics.md: `∫ (o.m)+ D(m) dω_m = mu_o (1 + Lambda(o))`, which holds for the exact Lambda.
+    /// docs/physics.md: `∫ (o.m)+ D(m) dω_m = mu_o (1 + Lambda(o))`, which holds for the exact Lambda.
     #[test]
     fn lambda_satisfies_the_projected_area_identity() {
         for &alpha in &[0.05, 0.3, 1.0, 1.6] {
@@ -566,7 +566,7 @@ mod tests {
             let series = (-a * a).exp() * FRAC_1_SQRT_PI / (2.0 * a) * sum;
             assert!(((series - erfc_form) / erfc_form).abs() < 1e-6, "a = {a}");
         }
-        // Beyond a = 6 Lambda is below 1e-17 (physics.md), and it never goes negative.
+        // Beyond a = 6 Lambda is below 1e-17 (docs/physics.md), and it never goes negative.
         assert!(b.lambda_from_tan2(tan2_at(6.0)) < 1e-17);
         assert!(b.lambda_from_tan2(tan2_at(30.0)) >= 0.0);
     }

@@ -1,6 +1,6 @@
 //! A minimal 3-vector for directions in the shading frame.
 //!
-//! Convention (as in `physics.md`): the macro-surface normal is `n = (0, 0, 1)`, so `z` is
+//! Convention (as in `docs/physics.md`): the macro-surface normal is `n = (0, 0, 1)`, so `z` is
 //! `mu = cos(theta)` of a unit direction; the view direction `o` lies in the xz-plane with `x >= 0`.
 
 use std::ops::{Add, Mul, Sub};

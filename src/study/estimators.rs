@@ -2,7 +2,7 @@
 //! not bake with, and kiln's own.
 //!
 //! All estimate `E(mu_o) = ∫ f(o, i) mu_i dω_i` with `f = D(h) G2(o, i) / (4 mu_i mu_o)`, `F = 1`
-//! (`physics.md`, "Microfacet BRDF" and "Estimating E"), from `n` points:
+//! (`docs/physics.md`, "Microfacet BRDF" and "Estimating E"), from `n` points:
 //!
 //! - uniform hemisphere sampling, pdf `1 / (2 pi)`: weight `2 pi f mu_i`;
 //! - cosine-weighted hemisphere sampling, pdf `mu_i / pi`: weight `pi f`;

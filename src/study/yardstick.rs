@@ -1,5 +1,5 @@
 //! The yardstick kiln's speed is quoted against: a 32 x 32 GGX `E` table estimated the way Blender
-//! Cycles bakes its own (`peers.md`: Owen-scrambled Sobol points, visible-normal sampling, the
+//! Cycles bakes its own (`docs/engines.md`: Owen-scrambled Sobol points, visible-normal sampling, the
 //! estimate of `E` itself rather than of `1 - E`, single-precision arithmetic), at a sample count
 //! the caller chooses (Cycles ships 2^23 per texel; the benchmark uses 2^16).
 //!
@@ -14,7 +14,7 @@ use crate::model::RoughnessConvention;
 use crate::table::axis::{Axis, Grid, MuMapping};
 use rayon::prelude::*;
 
-/// GGX `Lambda` from `tan^2(theta)` (`physics.md`), in `f32`.
+/// GGX `Lambda` from `tan^2(theta)` (`docs/physics.md`), in `f32`.
 fn lambda(alpha2: f32, tan2: f32) -> f32 {
     0.5 * ((1.0 + alpha2 * tan2).sqrt() - 1.0)
 }

@@ -24,7 +24,7 @@
 //!   `sqrt(2 (eta - 1))` and the inside tables change fastest. The axis always lists `eta >= 1`;
 //!   a table of light arriving from inside is computed at the relative index `1 / eta`.
 //!
-//! Why `adaptive`: at small `alpha`, `E` has a boundary layer at `mu ~ alpha` (`physics.md`,
+//! Why `adaptive`: at small `alpha`, `E` has a boundary layer at `mu ~ alpha` (`docs/physics.md`,
 //! "Hard cases"): `E(mu, alpha)` is, to `O(alpha^2)`, a function of `x = mu / alpha` alone that
 //! dips to 0.89 at `x ~ 1` (height-correlated GGX) whatever `alpha` is. No axis that ignores
 //! `alpha` can follow the dip as `alpha -> 0`; in `t` above, `x = c s / (1 + c alpha - s)` with

@@ -51,7 +51,7 @@ pub enum Quantity {
     EAvgDielectricInside,
     /// The exact dielectric Fresnel average `F_avg(eta) = 2 ∫ F(mu) mu dmu` for light arriving
     /// from outside, a 1-D table over the IOR axis; from inside it is
-    /// `1 - (1 - F_avg(eta)) / eta^2` (reciprocity, `physics.md`). The same for every model.
+    /// `1 - (1 - F_avg(eta)) / eta^2` (reciprocity, `docs/physics.md`). The same for every model.
     #[serde(rename = "F_avg")]
     #[cfg_attr(feature = "cli", value(name = "f-avg"))]
     FAvg,

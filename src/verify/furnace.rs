@@ -2,7 +2,7 @@
 //! Kulla-Conty multiple-scattering lobe must give back exactly the energy single scattering loses.
 //!
 //! Kulla and Conty 2017 ("Revisiting Physically Based Shading at Imageworks", SIGGRAPH course;
-//! `physics.md`, "Kulla-Conty quantities"):
+//! `docs/physics.md`, "Kulla-Conty quantities"):
 //! `f_ms(o, i) = (1 - E(mu_o)) (1 - E(mu_i)) / (pi (1 - E_avg))`, whose albedo is
 //! `∫ f_ms mu_i dω_i = (1 - E(mu_o)) (1 - Ē) / (1 - E_avg)` with `1 - Ē = 2 ∫ (1 - E(mu)) mu dmu`.
 //! So `E(mu_o) + ∫ f_ms mu_i dω_i - 1 = (1 - E(mu_o)) ((1 - Ē) / (1 - E_avg) - 1)`: the

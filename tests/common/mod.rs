@@ -1,5 +1,5 @@
 //! Test helpers: an independent deterministic quadrature of `E` and `E_avg` for checking the QMC
-//! estimators (physics.md, "A deterministic reference": microfacet-normal parametrisation
+//! estimators (docs/physics.md, "A deterministic reference": microfacet-normal parametrisation
 //! `x = ln(tan(theta_m) / alpha)`, mirror symmetry in phi, and a split at the horizon curve so
 //! every piece is smooth). It shares only `D` and `Lambda` with the code under test, which have
 //! their own identity tests.
@@ -57,7 +57,7 @@ fn e_quadrature<N: MicrofacetDistribution>(ndf: N, masking: Masking, mu: f64) ->
     let rule = gauss_legendre(24);
     // E = ∫ D(m) G2(o, i) (o.m) / mu_o dω_m over normals whose reflection is above the horizon.
     let inner = |phi: f64| {
-        // Horizon curve (physics.md): theta*(phi) = (pi - atan2(mu, sqrt(1 - mu^2) cos phi)) / 2.
+        // Horizon curve (docs/physics.md): theta*(phi) = (pi - atan2(mu, sqrt(1 - mu^2) cos phi)) / 2.
         let theta_star = (PI - mu.atan2(o.x * phi.cos())) / 2.0;
         let x_star = (theta_star.tan() / alpha).ln();
         let (sin_p, cos_p) = phi.sin_cos();
@@ -80,7 +80,7 @@ fn e_quadrature<N: MicrofacetDistribution>(ndf: N, masking: Masking, mu: f64) ->
 }
 
 /// `E(mu)` by deterministic quadrature, accurate to about 1e-9 for `mu >= 0.02` and
-/// `alpha >= 0.05` (it reproduces physics.md's eight-digit check values).
+/// `alpha >= 0.05` (it reproduces docs/physics.md's eight-digit check values).
 pub fn reference_e(model: Model, alpha: f64, mu: f64) -> f64 {
     match model.ndf {
         Ndf::Ggx => e_quadrature(Ggx { alpha }, model.masking, mu),
