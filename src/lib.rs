@@ -24,14 +24,20 @@
 //! assert!(e.value.iter().all(|&v| (0.0..=1.0).contains(&v)));
 //!
 //! let dir = tempfile::tempdir().unwrap();
-//! let written = kiln::format::write_tables(dir.path(), &tables, &[Format::Exr, Format::Json], Precision::F16)?;
+//! let written = kiln::format::write_tables(
+//!     dir.path(),
+//!     &tables,
+//!     &[Format::Exr, Format::Json],
+//!     Precision::F16,
+//!     kiln::format::replace::Replace::Refuse,
+//! )?;
 //! assert_eq!(written.len(), 4);
 //! # Ok::<(), kiln::Error>(())
 //! ```
 //!
 //! Conventions, everywhere: `mu = cos(theta)` of the view direction; roughness is either the
 //! perceptual `r` with `alpha = r^2` or `alpha` itself, and every table says which; grids put
-//! samples at texel centres `(i + 0.5) / N` (default) or at nodes `i / (N - 1)`.
+//! samples at nodes `i / (N - 1)` (the default) or at texel centres `(i + 0.5) / N`.
 
 pub mod bake;
 pub mod cache;

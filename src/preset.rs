@@ -108,6 +108,14 @@ impl Preset {
         }
     }
 
+    /// The name of kiln's JSON sidecar of one of the preset's tables:
+    /// `unreal-ggx-height-correlated-E.json` (the preset's name and the table's model and
+    /// quantity: the layout is the preset's, so kiln's own tables never share the name).
+    #[must_use]
+    pub fn sidecar_name(self, table: &Table) -> String {
+        format!("{}-{}.json", self.name(), table.spec.base_id())
+    }
+
     /// The file the preset writes (the engine's own name; the first, for a preset of two).
     #[must_use]
     pub fn file_name(self) -> &'static str {
@@ -398,7 +406,13 @@ impl Preset {
     fn decode_all(self, bytes: &[u8]) -> Result<Decoded> {
         let n = self.options().size;
         let mut extra = None;
-        let bad = |m: String| Error::InvalidInput(format!("not a {} table: {m}", self.name()));
+        let bad = |m: String| {
+            Error::InvalidInput(format!(
+                "not a {} file ({} in that engine's layout): {m}",
+                self.name(),
+                self.file_name()
+            ))
+        };
         let kiln_order = |engine: &[f64]| -> Vec<f64> {
             let mut out = vec![0.0; n * n];
             for r in 0..n {
@@ -453,43 +467,26 @@ impl Preset {
             )),
             #[cfg(feature = "containers")]
             Preset::Bevy => {
-                let reader = ::ktx2::Reader::new(bytes).map_err(|e| bad(format!("{e:?}")))?;
-                let header = reader.header();
-                let level = reader
-                    .levels()
-                    .next()
-                    .ok_or_else(|| bad("no level".into()))?;
-                let data: Vec<u8> = match header.supercompression_scheme {
-                    None => level.data.to_vec(),
-                    Some(::ktx2::SupercompressionScheme::Zstandard) => {
-                        let mut out = Vec::new();
-                        ruzstd::decoding::StreamingDecoder::new(level.data)
-                            .map_err(|e| bad(format!("zstd: {e}")))
-                            .and_then(|mut d| {
-                                std::io::Read::read_to_end(&mut d, &mut out)
-                                    .map_err(|e| bad(format!("zstd: {e}")))
-                            })?;
-                        out
-                    }
-                    Some(other) => {
-                        return Err(bad(format!(
-                            "supercompression {other:?}: kiln reads none or Zstandard"
-                        )));
-                    }
-                };
-                if header.format != Some(::ktx2::Format::R16G16_SFLOAT)
-                    || (header.pixel_width, header.pixel_height) != (n as u32, n as u32)
+                let texture = crate::format::ktx2::decode(bytes).map_err(bad)?;
+                if texture.channels.len() != 2
+                    || texture.precision != Precision::F16
+                    || texture.extent != (n, n, 1)
                 {
                     return Err(bad(format!(
-                        "expected {n} x {n} R16G16_SFLOAT, found {} x {} {:?}",
-                        header.pixel_width, header.pixel_height, header.format
+                        "expected {n} x {n} R16G16_SFLOAT, found {} x {} x {} with {} {} channels",
+                        texture.extent.0,
+                        texture.extent.1,
+                        texture.extent.2,
+                        texture.channels.len(),
+                        texture.precision.name()
                     )));
                 }
-                let bits = little_endian(&data);
-                Ok(vec![
-                    (Quantity::EScale, half_channel(&bits, 2, 0)),
-                    (Quantity::EBias, half_channel(&bits, 2, 1)),
-                ])
+                let mut channels = texture.channels.into_iter();
+                let (scale, bias) = (
+                    channels.next().unwrap_or_default(),
+                    channels.next().unwrap_or_default(),
+                );
+                Ok(vec![(Quantity::EScale, scale), (Quantity::EBias, bias)])
             }
             Preset::Three => {
                 let text = String::from_utf8_lossy(bytes);

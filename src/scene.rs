@@ -48,6 +48,10 @@ use crate::table::Quantity;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
+/// The file [`Scene::bake`] writes beside the tables: each material's `F_avg`, `E_avg` and
+/// colour multiplier.
+pub const MATERIALS_FILE: &str = "materials.json";
+
 /// Samples per axis of a scene's dielectric tables (IOR, roughness and `mu`).
 pub const DIELECTRIC_SIZE: usize = 16;
 
@@ -67,6 +71,9 @@ pub struct Scene {
     pub output: Option<Output>,
     #[serde(default, rename = "material")]
     pub materials: Vec<Material>,
+    /// The folder of the scene file ([`Scene::read`]): `output.dir` is relative to it.
+    #[serde(skip)]
+    pub base_dir: Option<std::path::PathBuf>,
 }
 
 /// Where and how to write the tables.
@@ -187,12 +194,43 @@ impl FresnelSpec {
     }
 }
 
+/// A TOML error in the words of the scene format: the file and line, what is wrong, and for a
+/// Fresnel model given without its parameters, the forms it takes.
+fn toml_message(error: &toml::de::Error, text: &str, origin: &str) -> String {
+    let line = error
+        .span()
+        .map(|span| text[..span.start.min(text.len())].matches('\n').count() + 1);
+    let source_line = line
+        .and_then(|n| text.lines().nth(n - 1))
+        .map(str::trim)
+        .unwrap_or("");
+    let mut message = error.message().trim().to_string();
+    if source_line.starts_with("fresnel") {
+        message = format!(
+            "'{source_line}': a Fresnel model is \"none\", {{ schlick = {{ f0 = 0.04 }} }} (f0 \
+             and an optional f90, one value or [r, g, b]), {{ dielectric = {{ ior = 1.5 }} }} or \
+             {{ conductor = {{ eta = [r, g, b], k = [r, g, b] }} }}"
+        );
+    } else if message.contains("untagged enum Roughness") {
+        message = format!(
+            "'{source_line}': roughness is one perceptual roughness in [0, 1] or a [min, max] \
+             range"
+        );
+    } else if !source_line.is_empty() {
+        message = format!("'{source_line}': {message}");
+    }
+    match line {
+        Some(line) => format!("{origin}, line {line}: {message}"),
+        None => format!("{origin}: {message}"),
+    }
+}
+
 impl Scene {
     /// Parses and checks a scene. A syntax error or an unknown key names the line and column
     /// and what was expected; an impossible value names the material and the value.
     pub fn parse(text: &str, origin: &str) -> Result<Scene> {
         let scene: Scene = toml::from_str(text)
-            .map_err(|e| Error::InvalidInput(format!("{origin}: {}", e.to_string().trim_end())))?;
+            .map_err(|e| Error::InvalidInput(toml_message(&e, text, origin)))?;
         scene.validate(origin)?;
         Ok(scene)
     }
@@ -204,7 +242,12 @@ impl Scene {
             action: "read the scene file",
             source: e,
         })?;
-        Scene::parse(&text, &path.display().to_string())
+        let mut scene = Scene::parse(&text, &path.display().to_string())?;
+        scene.base_dir = Some(
+            path.parent()
+                .map_or_else(std::path::PathBuf::new, Path::to_path_buf),
+        );
+        Ok(scene)
     }
 
     fn validate(&self, origin: &str) -> Result<()> {
@@ -306,10 +349,23 @@ impl Scene {
     /// The minimal set of tables the scene needs and the scalars of each material.
     #[must_use]
     pub fn plan(&self) -> Plan {
+        let specs: Vec<crate::TableSpec> = self
+            .bake_options()
+            .iter()
+            .flat_map(|options| options.resolved().specs())
+            .collect();
+        let spec_of = |model: Model, quantity: Quantity| {
+            specs
+                .iter()
+                .find(|spec| spec.model == model && spec.quantity == quantity)
+        };
         let planned = |model: Model, quantity, glass_only: bool| PlannedTable {
             ndf: model.ndf,
             masking: model.masking,
             quantity,
+            id: spec_of(model, quantity).map_or_else(String::new, crate::TableSpec::id),
+            estimated_core_seconds: spec_of(model, quantity)
+                .map_or(0.0, crate::bake::estimated_core_seconds),
             materials: self
                 .materials
                 .iter()
@@ -362,14 +418,21 @@ pub struct SceneBake {
 }
 
 impl Scene {
-    /// The directory the scene asks for (`output.dir`, default `tables`).
+    /// The directory the scene asks for: `output.dir` (default `tables`), relative to the
+    /// scene file's folder when the scene was [read](Scene::read) from a file (an absolute
+    /// path stays as it is), so a scene bakes to the same place from any working directory.
     #[must_use]
     pub fn output_dir(&self) -> std::path::PathBuf {
-        self.output
+        let dir: std::path::PathBuf = self
+            .output
             .as_ref()
             .and_then(|o| o.dir.clone())
             .unwrap_or_else(|| "tables".into())
-            .into()
+            .into();
+        match &self.base_dir {
+            Some(base) if dir.is_relative() => base.join(dir),
+            _ => dir,
+        }
     }
 
     /// The bake options of each NDF and masking combination in the plan, in plan order: its
@@ -408,9 +471,26 @@ impl Scene {
     /// Bakes the plan into `dir` in the scene's formats and precision (default: every format,
     /// f32), through the content-addressed cache in `dir/.kiln-cache` ([`crate::cache`]): a
     /// table whose key is unchanged is reused without integration. For a build script: no
-    /// command-line dependencies.
-    pub fn bake(&self, dir: &Path, progress: &(dyn Fn(u64) + Sync)) -> Result<SceneBake> {
+    /// command-line dependencies. Files of the same names made to other specs are refused or
+    /// replaced as `replace` says ([`crate::format::replace`]); a build script that owns its
+    /// output folder passes [`Replace::Force`](crate::format::replace::Replace::Force).
+    pub fn bake(
+        &self,
+        dir: &Path,
+        progress: &(dyn Fn(u64) + Sync),
+        replace: crate::format::replace::Replace,
+    ) -> Result<SceneBake> {
         crate::format::check_output_dir(dir)?;
+        let output = self.output.clone().unwrap_or_default();
+        let formats = output.formats.unwrap_or_else(|| Format::ALL.to_vec());
+        let precision = output.precision.unwrap_or(Precision::F32);
+        // Refuse at once, not after the integration.
+        let specs: Vec<crate::TableSpec> = self
+            .bake_options()
+            .iter()
+            .flat_map(|options| options.resolved().specs())
+            .collect();
+        crate::format::replace::precheck(dir, &specs, &formats, replace)?;
         let cache = crate::cache::Cache::new(&dir.join(".kiln-cache"));
         let mut report = crate::bake::BakeReport::default();
         for options in self.bake_options() {
@@ -419,11 +499,69 @@ impl Scene {
             report.baked.extend(part.baked);
             report.reused.extend(part.reused);
         }
-        let output = self.output.clone().unwrap_or_default();
-        let formats = output.formats.unwrap_or_else(|| Format::ALL.to_vec());
-        let precision = output.precision.unwrap_or(Precision::F32);
-        let written = crate::format::write_tables(dir, &report.tables, &formats, precision)?;
+        let mut files = crate::format::encode_all(&report.tables, &formats, precision)?;
+        if !self.materials.is_empty() {
+            files.push((
+                MATERIALS_FILE.to_string(),
+                self.materials_document(&report.tables),
+            ));
+        }
+        let written = crate::format::write_table_files(dir, &report.tables, &files, replace)?;
         Ok(SceneBake { report, written })
+    }
+
+    /// The per-material values a renderer needs beside the tables (written as
+    /// [`MATERIALS_FILE`]): for each material its model, roughness, Fresnel model and `F_avg`
+    /// per channel, the `E_avg` table it reads, and for a material of one roughness `E_avg`
+    /// there (the table's own lookup) and the Kulla-Conty colour multiplier
+    /// `F_avg^2 E_avg / (1 - F_avg (1 - E_avg))` per channel
+    /// ([`crate::model::kulla_conty::fresnel_colour`]); a roughness range takes it per pixel.
+    fn materials_document(&self, tables: &[crate::Table]) -> Vec<u8> {
+        let plan = self.plan();
+        let materials: Vec<serde_json::Value> = plan
+            .materials
+            .iter()
+            .map(|m| {
+                let average = tables.iter().find(|t| {
+                    t.spec.quantity == Quantity::EAvg
+                        && t.spec.model.ndf == m.ndf
+                        && t.spec.model.masking == m.masking
+                });
+                let mut object = serde_json::json!({
+                    "name": m.name,
+                    "ndf": m.ndf.name(),
+                    "masking": m.masking.name(),
+                    "roughness": m.roughness,
+                    "fresnel": m.fresnel,
+                    "transmission": m.transmission,
+                    "f_avg": m.f_avg,
+                    "e_avg_table": average.map(|t| t.spec.id()),
+                });
+                if let (Some(table), [lo, hi]) = (average, m.roughness)
+                    && lo == hi
+                {
+                    let e_avg = table.lookup(0.0, lo);
+                    object["e_avg"] = e_avg.into();
+                    object["colour_multiplier"] = m
+                        .f_avg
+                        .map(|f| crate::model::kulla_conty::fresnel_colour(f, e_avg))
+                        .to_vec()
+                        .into();
+                }
+                object
+            })
+            .collect();
+        let document = serde_json::json!({
+            "kind": "kiln-materials",
+            "kiln_version": crate::format::metadata::KILN_VERSION,
+            "colour_multiplier": "per channel, F_avg^2 E_avg / (1 - F_avg (1 - E_avg)): the \
+                                  factor of the Kulla-Conty lobe f_ms (E_avg looked up in \
+                                  e_avg_table at the material's roughness)",
+            "materials": materials,
+        });
+        let mut bytes = serde_json::to_vec_pretty(&document).unwrap_or_default();
+        bytes.push(b'\n');
+        bytes
     }
 }
 
@@ -441,6 +579,11 @@ pub struct PlannedTable {
     pub masking: Masking,
     pub quantity: Quantity,
     pub materials: Vec<String>,
+    /// The file-name stem the bake writes it under ([`crate::TableSpec::id`]).
+    pub id: String,
+    /// The estimated cost of baking it, in seconds of one core
+    /// ([`crate::bake::estimated_core_seconds`]; 0 when the cache holds it).
+    pub estimated_core_seconds: f64,
 }
 
 impl PlannedTable {
@@ -560,6 +703,7 @@ fresnel = { schlick = { f0 = 0.04 } }
             let no_glass = Scene {
                 materials: vec![scene.materials[0].clone()],
                 output: None,
+                base_dir: None,
             };
             no_glass.bake_options()[0].clone()
         });

@@ -36,7 +36,9 @@ fn build_script_example_bakes_and_includes_the_tables() {
         .unwrap_or_else(|| panic!("unexpected output: {text}"));
     let scene = kiln::scene::Scene::read(&root.join("examples/build-script/scene.toml")).unwrap();
     let dir = tempfile::tempdir().unwrap();
-    let baked = scene.bake(dir.path(), &|_| {}).unwrap();
+    let baked = scene
+        .bake(dir.path(), &|_| {}, kiln::format::replace::Replace::Refuse)
+        .unwrap();
     let table = &baked.report.tables[0];
     assert_eq!(table.spec.id(), "ggx-height-correlated-E");
     let expected = table.lookup(0.5, 0.5);

@@ -1,6 +1,7 @@
 //! Dielectric (reflection plus transmission over the IOR) and `F_avg(eta)` tables: baked in
 //! every format, read back, audited against the reference, looked up through the generated Rust.
 
+use kiln::format::replace::Replace;
 use kiln::format::{Format, Precision, write_tables};
 use kiln::verify::input::read_kiln;
 use kiln::verify::{Against, AuditSettings, audit};
@@ -103,7 +104,14 @@ fn every_format_round_trips() {
         Format::Rs,
         Format::Png,
     ];
-    write_tables(dir.path(), tables(), &formats, Precision::F32).unwrap();
+    write_tables(
+        dir.path(),
+        tables(),
+        &formats,
+        Precision::F32,
+        Replace::Refuse,
+    )
+    .unwrap();
     for t in tables() {
         let id = t.spec.id();
         for ext in ["exr", "bin", "json"] {
@@ -186,7 +194,14 @@ fn audit_against_the_reference() {
 #[test]
 fn generated_rust_lookup_matches_the_library() {
     let dir = tempfile::tempdir().unwrap();
-    write_tables(dir.path(), tables(), &[Format::Rs], Precision::F32).unwrap();
+    write_tables(
+        dir.path(),
+        tables(),
+        &[Format::Rs],
+        Precision::F32,
+        Replace::Refuse,
+    )
+    .unwrap();
     let points = [
         (0.3, 0.5, 1.2),
         (0.05, 0.9, 2.7),

@@ -108,6 +108,7 @@ fn weighted_integrals_are_consistent_with_e() {
 /// add up to `E` at every node, survive every output format, and refuse the adaptive mu axis.
 #[test]
 fn split_sum_tables_bake_verify_and_round_trip() {
+    use kiln::format::replace::Replace;
     use kiln::format::{Format, Precision, write_tables};
     use kiln::verify::input::read_kiln;
     use kiln::{BakeOptions, MuMapping, Quantity};
@@ -137,15 +138,23 @@ fn split_sum_tables_bake_verify_and_round_trip() {
     }
     // Every format writes them; kiln's readers give back the f32 values and the quantity.
     let dir = tempfile::tempdir().unwrap();
-    write_tables(dir.path(), &tables, &Format::ALL, Precision::F32).unwrap();
+    write_tables(
+        dir.path(),
+        &tables,
+        &Format::ALL,
+        Precision::F32,
+        Replace::Refuse,
+    )
+    .unwrap();
     for name in ["E_scale", "E_bias"] {
+        let original = if name == "E_scale" { scale } else { bias };
+        // The linear mu axis is in the name (not kiln's default layout).
+        let id = format!("ggx-height-correlated-{name}-mu-linear");
+        assert_eq!(original.spec.id(), id);
         for extension in ["json", "exr", "bin"] {
-            let path = dir
-                .path()
-                .join(format!("ggx-height-correlated-{name}.{extension}"));
+            let path = dir.path().join(format!("{id}.{extension}"));
             let back = read_kiln(&path).unwrap().expect("a kiln file");
             assert_eq!(back.spec.quantity.symbol(), name, "{extension}");
-            let original = if name == "E_scale" { scale } else { bias };
             for k in 0..original.spec.len() {
                 assert!(
                     (back.value[k] - original.value[k]).abs() <= 1e-7,
@@ -153,10 +162,11 @@ fn split_sum_tables_bake_verify_and_round_trip() {
                 );
             }
         }
-        let rust =
-            std::fs::read_to_string(dir.path().join(format!("ggx-height-correlated-{name}.rs")))
-                .unwrap();
-        assert!(rust.contains(&format!("GGX_HEIGHT_CORRELATED_{}", name.to_uppercase())));
+        let rust = std::fs::read_to_string(dir.path().join(format!("{id}.rs"))).unwrap();
+        assert!(rust.contains(&format!(
+            "GGX_HEIGHT_CORRELATED_{}_MU_LINEAR",
+            name.to_uppercase()
+        )));
     }
     let metadata = kiln::format::metadata::Metadata::new(bias, "f32");
     assert!(metadata.description.contains("Fc = (1 - o.h)^5"));
@@ -235,7 +245,7 @@ fn fresnel_weighted_tables_bake_for_the_model_named() {
         assert_eq!(table.spec.fresnel, Some(fresnel));
         assert_eq!(
             table.spec.id(),
-            format!("ggx-height-correlated-E_F-schlick-{f0}-{f90}")
+            format!("ggx-height-correlated-E_F-schlick-{f0}-{f90}-mu-sqrt")
         );
         assert!(table.node_errors.unwrap().max <= 1e-6);
         for k in 0..table.spec.len() {

@@ -180,7 +180,7 @@ fn damaged_engine_files_are_refused_with_a_reason() {
         .read_tables(b"KTX", "x")
         .unwrap_err()
         .to_string();
-    assert!(error.contains("not a bevy table"), "{error}");
+    assert!(error.contains("not a bevy file"), "{error}");
 }
 
 #[test]

@@ -1,6 +1,7 @@
 //! `kiln bake --scene` through the library: the content-addressed cache reuses unchanged tables
 //! (checked through the bake report, not a timer) and rebakes only what a change touches.
 
+use kiln::format::replace::Replace;
 use kiln::scene::Scene;
 
 fn scene(materials: &str) -> Scene {
@@ -15,7 +16,9 @@ const COAT: &str =
 #[test]
 fn second_bake_reuses_and_a_change_rebakes_only_its_tables() {
     let dir = tempfile::tempdir().unwrap();
-    let first = scene(STEEL).bake(dir.path(), &|_| {}).unwrap();
+    let first = scene(STEEL)
+        .bake(dir.path(), &|_| {}, Replace::Refuse)
+        .unwrap();
     assert_eq!(
         first.report.baked,
         ["ggx-height-correlated-E", "ggx-height-correlated-E_avg"]
@@ -30,9 +33,13 @@ fn second_bake_reuses_and_a_change_rebakes_only_its_tables() {
     // Unchanged: nothing integrated (the progress callback never runs), identical files.
     let calls = std::sync::atomic::AtomicU64::new(0);
     let second = scene(STEEL)
-        .bake(dir.path(), &|_| {
-            calls.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        })
+        .bake(
+            dir.path(),
+            &|_| {
+                calls.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            },
+            Replace::Refuse,
+        )
         .unwrap();
     assert!(second.report.baked.is_empty());
     assert_eq!(second.report.reused, first.report.baked);
@@ -47,7 +54,7 @@ fn second_bake_reuses_and_a_change_rebakes_only_its_tables() {
 
     // A new material with another masking: only its tables are baked.
     let third = scene(&format!("{STEEL}\n{COAT}"))
-        .bake(dir.path(), &|_| {})
+        .bake(dir.path(), &|_| {}, Replace::Refuse)
         .unwrap();
     assert_eq!(third.report.reused, first.report.baked);
     assert_eq!(
@@ -55,24 +62,42 @@ fn second_bake_reuses_and_a_change_rebakes_only_its_tables() {
         ["ggx-separable-E", "ggx-separable-E_avg"]
     );
 
-    // A different max error changes every key.
+    // A different max error changes every key, and the tables' specs: into the same folder
+    // the bake refuses (nothing written) unless told to replace, and then removes the files
+    // of the old spec it does not write (here the binaries), so no mixed set is left.
     let text = format!("[output]\nformats = [\"json\"]\nmax_error = 1e-5\n\n{STEEL}");
-    let tighter = Scene::parse(&text, "t.toml")
-        .unwrap()
-        .bake(dir.path(), &|_| {})
-        .unwrap();
-    assert_eq!(tighter.report.baked.len(), 2);
-    assert!(tighter.report.reused.is_empty());
+    let tighter = Scene::parse(&text, "t.toml").unwrap();
+    let sidecar = dir.path().join("ggx-height-correlated-E.json");
+    let before = std::fs::read(&sidecar).unwrap();
+    let refused = tighter
+        .bake(dir.path(), &|_| {}, Replace::Refuse)
+        .unwrap_err();
+    let message = refused.to_string();
+    assert!(
+        message.contains("ggx-height-correlated-E.{bin,json}") && message.contains("--force"),
+        "{message}"
+    );
+    assert_eq!(std::fs::read(&sidecar).unwrap(), before);
+    let replaced = tighter.bake(dir.path(), &|_| {}, Replace::Force).unwrap();
+    assert_eq!(replaced.report.baked.len(), 2);
+    assert!(replaced.report.reused.is_empty());
+    assert_ne!(std::fs::read(&sidecar).unwrap(), before);
+    assert!(!dir.path().join("ggx-height-correlated-E.bin").exists());
+    assert!(dir.path().join("ggx-separable-E.bin").exists());
 }
 
 /// A corrupt cache entry is a miss, never an error or a wrong table.
 #[test]
 fn a_damaged_cache_entry_is_rebaked() {
     let dir = tempfile::tempdir().unwrap();
-    scene(STEEL).bake(dir.path(), &|_| {}).unwrap();
+    scene(STEEL)
+        .bake(dir.path(), &|_| {}, Replace::Refuse)
+        .unwrap();
     for entry in std::fs::read_dir(dir.path().join(".kiln-cache")).unwrap() {
         std::fs::write(entry.unwrap().path(), b"{ not json").unwrap();
     }
-    let again = scene(STEEL).bake(dir.path(), &|_| {}).unwrap();
+    let again = scene(STEEL)
+        .bake(dir.path(), &|_| {}, Replace::Refuse)
+        .unwrap();
     assert_eq!(again.report.baked.len(), 2);
 }

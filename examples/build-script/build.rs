@@ -9,7 +9,10 @@ fn main() {
     println!("cargo::rerun-if-changed={}", scene_path.display());
     let scene = kiln::scene::Scene::read(&scene_path).expect("a valid scene");
     let start = std::time::Instant::now();
-    let result = scene.bake(&out, &|_| {}).expect("the bake succeeds");
+    // OUT_DIR is this build's own: a changed scene replaces what an earlier build wrote.
+    let result = scene
+        .bake(&out, &|_| {}, kiln::format::replace::Replace::Force)
+        .expect("the bake succeeds");
     if !result.report.baked.is_empty() {
         println!(
             "cargo::warning=kiln baked {} in {:.2} s",

@@ -85,7 +85,14 @@ pub fn encode(table: &Table) -> String {
     let _ = writeln!(
         out,
         " * {prefix}_HALF interleaves the value (R) and 1 - value (G) as IEEE half-float bits,\n \
-         * ready for an R16G16_SFLOAT / DXGI_FORMAT_R16G16_FLOAT upload: 2 * texel + channel.\n */"
+         * ready for an R16G16_SFLOAT / DXGI_FORMAT_R16G16_FLOAT upload: 2 * texel + channel.\n *"
+    );
+    // The metadata in machine form, for `kiln verify` (`*/` escaped as JSON allows: `*\/`).
+    let _ = writeln!(
+        out,
+        " * {}{}\n */",
+        super::metadata::EMBEDDED_PREFIX,
+        super::metadata::embedded_json(&meta).replace("*/", "*\\/")
     );
     let _ = writeln!(
         out,

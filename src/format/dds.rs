@@ -55,3 +55,28 @@ pub fn encode(texture: &Texture, precision: Precision) -> std::result::Result<Ve
     dds.write(&mut bytes).map_err(|e| e.to_string())?;
     Ok(bytes)
 }
+
+/// Reads a DDS file of one, two or four 16- or 32-bit float channels (DX10 header), one level.
+pub fn decode(bytes: &[u8]) -> std::result::Result<super::texture::DecodedTexture, String> {
+    let dds = Dds::read(bytes).map_err(|e| format!("not a DDS file ({e})"))?;
+    let format = dds.get_dxgi_format();
+    let (channels, precision) = match format {
+        Some(DxgiFormat::R16_Float) => (1, Precision::F16),
+        Some(DxgiFormat::R16G16_Float) => (2, Precision::F16),
+        Some(DxgiFormat::R16G16B16A16_Float) => (4, Precision::F16),
+        Some(DxgiFormat::R32_Float) => (1, Precision::F32),
+        Some(DxgiFormat::R32G32_Float) => (2, Precision::F32),
+        Some(DxgiFormat::R32G32B32A32_Float) => (4, Precision::F32),
+        other => {
+            return Err(format!(
+                "format {other:?}: kiln reads R, RG and RGBA DXGI float textures"
+            ));
+        }
+    };
+    let extent = (
+        dds.get_width().max(1) as usize,
+        dds.get_height().max(1) as usize,
+        dds.get_depth().max(1) as usize,
+    );
+    super::texture::DecodedTexture::from_interleaved(extent, channels, precision, &dds.data, None)
+}

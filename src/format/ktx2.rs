@@ -159,3 +159,63 @@ pub fn encode_with(
     out.extend_from_slice(&texels);
     Ok(out)
 }
+
+/// Reads a KTX2 file of one to four 16- or 32-bit float channels, one level, uncompressed or
+/// Zstandard-supercompressed, with kiln's metadata if it has a `kiln` key.
+#[cfg(feature = "containers")]
+pub fn decode(bytes: &[u8]) -> std::result::Result<super::texture::DecodedTexture, String> {
+    use ::ktx2::Format as F;
+    let reader = ::ktx2::Reader::new(bytes).map_err(|e| format!("not a KTX2 file ({e:?})"))?;
+    let header = reader.header();
+    let (channels, precision) = match header.format {
+        Some(F::R16_SFLOAT) => (1, Precision::F16),
+        Some(F::R16G16_SFLOAT) => (2, Precision::F16),
+        Some(F::R16G16B16A16_SFLOAT) => (4, Precision::F16),
+        Some(F::R32_SFLOAT) => (1, Precision::F32),
+        Some(F::R32G32_SFLOAT) => (2, Precision::F32),
+        Some(F::R32G32B32A32_SFLOAT) => (4, Precision::F32),
+        other => {
+            return Err(format!(
+                "format {other:?}: kiln reads R, RG and RGBA textures of 16- or 32-bit floats"
+            ));
+        }
+    };
+    let extent = (
+        header.pixel_width.max(1) as usize,
+        header.pixel_height.max(1) as usize,
+        header.pixel_depth.max(1) as usize,
+    );
+    // What the texels must take: decompression stops there, whatever the file claims.
+    let expected = extent
+        .0
+        .saturating_mul(extent.1)
+        .saturating_mul(extent.2)
+        .saturating_mul(channels * precision.bytes());
+    let level = reader.levels().next().ok_or("the file has no level")?;
+    let data: Vec<u8> = match header.supercompression_scheme {
+        None => level.data.to_vec(),
+        Some(::ktx2::SupercompressionScheme::Zstandard) => {
+            let mut out = Vec::new();
+            let decoder = ruzstd::decoding::StreamingDecoder::new(level.data)
+                .map_err(|e| format!("zstd: {e}"))?;
+            std::io::Read::read_to_end(
+                &mut std::io::Read::take(decoder, expected as u64 + 1),
+                &mut out,
+            )
+            .map_err(|e| format!("zstd: {e}"))?;
+            out
+        }
+        Some(other) => {
+            return Err(format!(
+                "supercompression {other:?}: kiln reads none or Zstandard"
+            ));
+        }
+    };
+    let metadata = reader
+        .key_value_data()
+        .find(|(key, _)| *key == "kiln")
+        .map(|(_, value)| {
+            String::from_utf8_lossy(value.strip_suffix(&[0]).unwrap_or(value)).into_owned()
+        });
+    super::texture::DecodedTexture::from_interleaved(extent, channels, precision, &data, metadata)
+}

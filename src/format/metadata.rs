@@ -1,7 +1,7 @@
 //! The description every output carries: model, axes, grid, samples, errors, provenance.
 
 use crate::table::axis::{Axis, Grid};
-use crate::table::{Table, TableSpec};
+use crate::table::{Quantity, Table, TableSpec};
 use serde::{Deserialize, Serialize};
 
 /// kiln's version, recorded in every table.
@@ -70,8 +70,11 @@ pub struct Metadata {
     pub estimator: String,
     /// QMC evaluations per texel (0 for the reference quadrature, which adapts per texel).
     pub samples_per_texel: u64,
-    pub scrambles: u32,
-    pub seed: u64,
+    /// QMC's independent scrambles and their base seed (absent for the quadrature).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scrambles: Option<u32>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub seed: Option<u64>,
     /// The largest per-texel standard error (the table's measured error).
     pub max_std_error: f64,
     pub rms_std_error: f64,
@@ -129,8 +132,17 @@ impl Metadata {
             kiln_version: KILN_VERSION.to_string(),
             quantity: spec.quantity.symbol().to_string(),
             description: spec.quantity.describe().to_string(),
-            ndf: spec.model.ndf.name().to_string(),
-            masking: spec.model.masking.name().to_string(),
+            // F_avg depends on the Fresnel model alone.
+            ndf: if spec.quantity == Quantity::FAvg {
+                "none (F_avg does not depend on the microfacet model)".to_string()
+            } else {
+                spec.model.ndf.name().to_string()
+            },
+            masking: if spec.quantity == Quantity::FAvg {
+                "none".to_string()
+            } else {
+                spec.model.masking.name().to_string()
+            },
             fresnel: match (spec.quantity.weight(), spec.quantity.has_ior()) {
                 (None, false) => match spec.fresnel {
                     Some(fresnel) => serde_json::to_string(&fresnel)
@@ -163,8 +175,8 @@ impl Metadata {
                 crate::table::Method::Qmc => spec.qmc.samples,
                 crate::table::Method::Reference => 0,
             },
-            scrambles: spec.qmc.scrambles,
-            seed: spec.qmc.seed,
+            scrambles: (spec.method == crate::table::Method::Qmc).then_some(spec.qmc.scrambles),
+            seed: (spec.method == crate::table::Method::Qmc).then_some(spec.qmc.seed),
             max_std_error: table.max_std_error(),
             rms_std_error: table.rms_std_error(),
             node_max_error: table.node_errors.map(|e| e.max),
@@ -186,4 +198,25 @@ impl Metadata {
             spec: table.spec.clone(),
         }
     }
+}
+
+/// What starts the comment line of a C header or Rust source that carries the table's metadata
+/// as one line of JSON, so that `kiln verify` can read those files without their sidecar.
+pub const EMBEDDED_PREFIX: &str = "kiln-metadata: ";
+
+/// The metadata as one line of JSON (for [`EMBEDDED_PREFIX`] comments).
+#[must_use]
+pub fn embedded_json(metadata: &Metadata) -> String {
+    serde_json::to_string(metadata).unwrap_or_default()
+}
+
+/// Finds the metadata line of a generated C header or Rust source (see [`EMBEDDED_PREFIX`]).
+pub fn find_embedded(text: &str) -> Option<std::result::Result<Metadata, String>> {
+    let line = text
+        .lines()
+        .take_while(|line| {
+            line.starts_with("//") || line.starts_with("/*") || line.starts_with(" *")
+        })
+        .find_map(|line| line.split_once(EMBEDDED_PREFIX).map(|(_, json)| json))?;
+    Some(serde_json::from_str(line.trim()).map_err(|e| format!("bad kiln metadata comment: {e}")))
 }

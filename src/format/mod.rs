@@ -14,6 +14,7 @@ pub mod json;
 pub mod ktx2;
 pub mod metadata;
 pub mod png;
+pub mod replace;
 pub mod rust;
 pub mod shader;
 pub mod texture;
@@ -90,8 +91,10 @@ impl Format {
 #[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum Precision {
+    /// IEEE single precision, 4 bytes.
     F32,
-    /// Half floats. Store and use `one_minus_E` near `E = 1`: f16 spacing below 1 is 2^-11.
+    /// IEEE half precision, 2 bytes (spacing 2^-11 just below 1: near 1, the `1 - value`
+    /// channel kiln stores beside the value keeps the precision the value loses).
     F16,
 }
 
@@ -245,13 +248,37 @@ pub fn write_files(dir: &Path, files: &[(String, Vec<u8>)]) -> Result<Vec<PathBu
     Ok(paths)
 }
 
-/// Encodes and writes tables: [`encode_all`] then [`write_files`].
+/// Encodes and writes tables: [`encode_all`], the replacement rule ([`replace::check`]), then
+/// [`write_files`].
 pub fn write_tables(
     dir: &Path,
     tables: &[Table],
     formats: &[Format],
     precision: Precision,
+    replace: replace::Replace,
 ) -> Result<Vec<PathBuf>> {
     let files = encode_all(tables, formats, precision)?;
-    write_files(dir, &files)
+    write_table_files(dir, tables, &files, replace)
+}
+
+/// Writes files holding `tables` (and perhaps others, an engine's own file) after checking the
+/// replacement rule ([`replace::check`]) for the tables' names.
+pub fn write_table_files(
+    dir: &Path,
+    tables: &[Table],
+    files: &[(String, Vec<u8>)],
+    replace: replace::Replace,
+) -> Result<Vec<PathBuf>> {
+    let names: Vec<String> = files.iter().map(|(name, _)| name.clone()).collect();
+    let specs: Vec<crate::table::TableSpec> = tables.iter().map(|t| t.spec.clone()).collect();
+    let stale = replace::check(dir, &specs, &names, replace)?;
+    let written = write_files(dir, files)?;
+    for path in stale {
+        std::fs::remove_file(&path).map_err(|source| Error::Io {
+            path: path.clone(),
+            action: "remove the replaced table's file",
+            source,
+        })?;
+    }
+    Ok(written)
 }

@@ -108,3 +108,65 @@ fn metadata_json(tables: &[&Table]) -> String {
     });
     object.to_string()
 }
+
+/// A float texture read back from a GPU container ([`super::ktx2::decode`],
+/// [`super::dds::decode`]): its extent, its channels de-interleaved, and kiln's metadata JSON
+/// when the container carries it (KTX2 does, DDS cannot).
+#[derive(Clone, Debug, PartialEq)]
+pub struct DecodedTexture {
+    /// `(width, height, depth)`, 1 for an absent dimension.
+    pub extent: (usize, usize, usize),
+    /// The storage precision of the texels.
+    pub precision: Precision,
+    /// Each channel's values in texel order (R, G, ...).
+    pub channels: Vec<Vec<f64>>,
+    /// kiln's metadata (the `kiln` key of a KTX2 file).
+    pub metadata: Option<String>,
+}
+
+impl DecodedTexture {
+    /// De-interleaves `count` little-endian float channels of `precision` from `data`, which
+    /// must hold exactly `width * height * depth` texels.
+    pub fn from_interleaved(
+        extent: (usize, usize, usize),
+        count: usize,
+        precision: Precision,
+        data: &[u8],
+        metadata: Option<String>,
+    ) -> std::result::Result<Self, String> {
+        let texels = extent
+            .0
+            .checked_mul(extent.1)
+            .and_then(|n| n.checked_mul(extent.2))
+            .ok_or("the texture's extent overflows")?;
+        let size = precision.bytes();
+        let expected = texels.saturating_mul(count).saturating_mul(size);
+        if data.len() != expected {
+            return Err(format!(
+                "{} bytes of texels where {} x {} x {} texels of {count} channels of {} bytes \
+                 need {expected}",
+                data.len(),
+                extent.0,
+                extent.1,
+                extent.2,
+                size
+            ));
+        }
+        let value = |k: usize| -> f64 {
+            let b = &data[k * size..(k + 1) * size];
+            match precision {
+                Precision::F32 => f64::from(f32::from_le_bytes([b[0], b[1], b[2], b[3]])),
+                Precision::F16 => f64::from(half::f16::from_le_bytes([b[0], b[1]]).to_f32()),
+            }
+        };
+        let channels = (0..count)
+            .map(|c| (0..texels).map(|t| value(t * count + c)).collect())
+            .collect();
+        Ok(Self {
+            extent,
+            precision,
+            channels,
+            metadata,
+        })
+    }
+}

@@ -39,20 +39,33 @@ impl QmcSettings {
     /// Eight scrambles: the standard error then has 7 degrees of freedom.
     pub const DEFAULT_SCRAMBLES: u32 = 8;
 
-    /// Checks the settings, saying what is wrong and what is allowed.
+    /// The most points one scramble takes (its Sobol index is 32 bits).
+    pub const MAX_POINTS_PER_SCRAMBLE: u64 = 1 << 32;
+
+    /// The sample counts these scrambles allow: powers of two from one point per scramble to
+    /// [`QmcSettings::MAX_POINTS_PER_SCRAMBLE`] per scramble.
+    #[must_use]
+    pub fn sample_range(&self) -> (u64, u64) {
+        let min = u64::from(self.scrambles.max(1));
+        (min, min.saturating_mul(Self::MAX_POINTS_PER_SCRAMBLE))
+    }
+
+    /// Checks the settings, saying what is wrong and what is allowed; messages start with the
+    /// flag (`--scrambles`, `--samples`): callers naming another flag replace `--samples`.
     pub fn validate(&self) -> Result<(), String> {
         if self.scrambles < 2 || !self.scrambles.is_power_of_two() || self.scrambles > 1024 {
             return Err(format!(
-                "scrambles must be a power of two in [2, 1024] (got {})",
+                "--scrambles must be a power of two from 2 to 1024 (got {})",
                 self.scrambles
             ));
         }
-        let min = self.scrambles as u64;
-        let max = min << 32;
+        let (min, max) = self.sample_range();
         if !self.samples.is_power_of_two() || self.samples < min || self.samples > max {
             return Err(format!(
-                "samples must be a power of two in [{min}, 2^{}] (got {})",
+                "--samples must be a power of two from {min} to 2^{} (one to 2^32 points for each \
+                 of the {} scrambles; got {})",
                 max.trailing_zeros(),
+                self.scrambles,
                 self.samples
             ));
         }

@@ -93,6 +93,14 @@ pub struct Model {
     pub masking: Masking,
 }
 
+/// `ggx height-correlated`: the distribution and the masking form, as tables and messages name
+/// a model.
+impl std::fmt::Display for Model {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} {}", self.ndf.name(), self.masking.name())
+    }
+}
+
 impl Model {
     /// Checks the combination: Schlick-GGX masking approximates GGX's Smith `G1` and is
     /// defined with GGX only.

@@ -98,7 +98,8 @@ pub enum MuMapping {
     /// `mu = t^2` (texture coordinate `sqrt(mu)`).
     Sqrt,
     /// `t = (mu (1 + c alpha) / (mu + c alpha))^p`, `c = 4`, `p = 0.4`: follows the grazing
-    /// boundary layer `mu ~ alpha` at every roughness (see the module docs). The default.
+    /// boundary layer `mu ~ alpha` at every roughness (see the module docs); kiln's default
+    /// for the tables it bakes.
     Adaptive,
 }
 
@@ -177,7 +178,7 @@ impl MuMapping {
 pub enum IorMapping {
     /// `eta = 1 + t (eta_max - 1)`.
     Linear,
-    /// Linear in `z = sqrt((eta - 1) / (eta + 1))` (Cycles' glass tables). The default.
+    /// Linear in `z = sqrt((eta - 1) / (eta + 1))` (Cycles' glass tables); kiln's default.
     Cycles,
 }
 

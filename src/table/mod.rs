@@ -4,7 +4,7 @@ pub mod axis;
 
 use crate::integrate::QmcSettings;
 use crate::model::{Model, RoughnessConvention};
-use axis::Axis;
+use axis::{Axis, Grid, IorMapping, MuMapping};
 use serde::{Deserialize, Serialize};
 
 /// What a table holds.
@@ -31,13 +31,13 @@ pub enum Quantity {
     #[serde(rename = "E_bias")]
     #[cfg_attr(feature = "cli", value(name = "e-bias"))]
     EBias,
-    /// The energy albedo `R + T` of a rough dielectric interface (reflection plus transmission,
-    /// [`crate::model::dielectric`]) for light arriving from outside, at relative index `eta`
-    /// from the IOR axis: a 3-D table over (eta, roughness, mu).
+    /// The energy albedo `R + T` of a rough dielectric interface (reflection plus transmission;
+    /// the model is in `model::dielectric`) for light arriving from outside, at relative index
+    /// `eta` from the IOR axis: a 3-D table over (eta, roughness, mu).
     #[serde(rename = "E_dielectric")]
     #[cfg_attr(feature = "cli", value(name = "e-dielectric"))]
     EDielectric,
-    /// As [`Quantity::EDielectric`], for light arriving from inside: relative index `1 / eta`.
+    /// As e-dielectric, for light arriving from inside: relative index `1 / eta`.
     #[serde(rename = "E_dielectric_inside")]
     #[cfg_attr(feature = "cli", value(name = "e-dielectric-inside"))]
     EDielectricInside,
@@ -51,12 +51,12 @@ pub enum Quantity {
     EAvgDielectricInside,
     /// The exact dielectric Fresnel average `F_avg(eta) = 2 ∫ F(mu) mu dmu` for light arriving
     /// from outside, a 1-D table over the IOR axis; from inside it is
-    /// `1 - (1 - F_avg(eta)) / eta^2` (reciprocity, `docs/physics.md`). The same for every model.
+    /// `1 - (1 - F_avg(eta)) / eta^2` (Fresnel reciprocity). The same for every model.
     #[serde(rename = "F_avg")]
     #[cfg_attr(feature = "cli", value(name = "f-avg"))]
     FAvg,
     /// The Fresnel-weighted albedo `E_F(mu, roughness) = ∫ F(o.h) f mu_i dω_i` for the table's
-    /// own Fresnel model ([`TableSpec::fresnel`], a grey one), a 2-D table.
+    /// own Fresnel model (a grey one: one value per parameter), a 2-D table.
     #[serde(rename = "E_F")]
     #[cfg_attr(feature = "cli", value(name = "e-f"))]
     EF,
@@ -228,8 +228,9 @@ pub enum Method {
     /// independent scrambles.
     #[default]
     Qmc,
-    /// The deterministic reference quadrature ([`crate::integrate::reference`]): absolute error
-    /// at most 1e-10; `std_error` holds its error estimate.
+    /// The deterministic reference quadrature (nested adaptive Gauss-Kronrod,
+    /// `integrate::reference`): absolute error at most 1e-10; `std_error` holds its error
+    /// estimate.
     Reference,
 }
 
@@ -363,27 +364,74 @@ impl TableSpec {
     }
 
     /// A file-name stem naming the table: `ggx-height-correlated-E` (`dielectric-F_avg` for
-    /// `F_avg`, which is the same for every model).
+    /// `F_avg`, which is the same for every model), then the Fresnel model's tag for `E_F`, then
+    /// a tag for each axis convention that differs from kiln's default layout, so that tables
+    /// a lookup reads differently never share a name: `-alpha` (roughness axis alpha), `-mu-linear`
+    /// or `-mu-sqrt`, `-centers` (texel-centre grid), `-ior-linear`. Sizes, ranges and accuracy
+    /// are not in the name: a bake refuses to replace a table of the same name made to another
+    /// spec (`format::replace`).
     #[must_use]
     pub fn id(&self) -> String {
-        if self.quantity == Quantity::FAvg {
-            return "dielectric-F_avg".to_string();
+        let mut id = self.base_id();
+        for tag in self.layout_tags() {
+            id = format!("{id}-{tag}");
         }
-        if let Some(fresnel) = self.fresnel {
-            return format!(
-                "{}-{}-{}-{}",
+        id
+    }
+
+    /// [`TableSpec::id`] without the layout tags: model, quantity and Fresnel model.
+    #[must_use]
+    pub fn base_id(&self) -> String {
+        let id = if self.quantity == Quantity::FAvg {
+            "dielectric-F_avg".to_string()
+        } else {
+            format!(
+                "{}-{}-{}",
                 self.model.ndf,
                 self.model.masking,
-                self.quantity.symbol(),
-                fresnel.tag()
-            );
+                self.quantity.symbol()
+            )
+        };
+        match self.fresnel {
+            Some(fresnel) => format!("{id}-{}", fresnel.tag()),
+            None => id,
         }
-        format!(
-            "{}-{}-{}",
-            self.model.ndf,
-            self.model.masking,
-            self.quantity.symbol()
-        )
+    }
+
+    /// The axis conventions that differ from kiln's default layout, as name tags (see
+    /// [`TableSpec::id`]).
+    #[must_use]
+    pub fn layout_tags(&self) -> Vec<&'static str> {
+        let mut tags = Vec::new();
+        if let Some(Axis::Roughness {
+            convention: RoughnessConvention::Alpha,
+            ..
+        }) = self.roughness
+        {
+            tags.push("alpha");
+        }
+        match self.mu {
+            Some(Axis::Mu {
+                mapping: MuMapping::Linear,
+                ..
+            }) => tags.push("mu-linear"),
+            Some(Axis::Mu {
+                mapping: MuMapping::Sqrt,
+                ..
+            }) => tags.push("mu-sqrt"),
+            _ => {}
+        }
+        if self.axes().iter().any(|axis| axis.grid() == Grid::Centers) {
+            tags.push("centers");
+        }
+        if let Some(Axis::Ior {
+            mapping: IorMapping::Linear,
+            ..
+        }) = self.ior
+        {
+            tags.push("ior-linear");
+        }
+        tags
     }
 
     /// Texel `index` (row-major, slowest axis first) split into its `[eta, roughness, mu]`

@@ -1,4 +1,5 @@
-//! Reading tables to audit: kiln's own files (JSON sidecar, EXR, binary) with their metadata, and
+//! Reading tables to audit: kiln's own files (JSON sidecar, EXR, binary, KTX2, DDS, C header, Rust
+//! source) with their metadata, and
 //! external tables (text, raw f32/f16, one EXR channel) whose layout the caller describes.
 
 use crate::error::{Error, Result};
@@ -122,6 +123,17 @@ fn parse_sidecar(path: &Path, bytes: &[u8]) -> Result<Option<Sidecar>> {
                     ),
                 ));
             }
+            // Not JSON at all, but naming itself a kiln table: cut short or damaged.
+            let marker = format!("\"kind\": \"{KIND}\"");
+            if value.is_none() && bytes.windows(marker.len()).any(|w| w == marker.as_bytes()) {
+                return Err(invalid(
+                    path,
+                    format!(
+                        "a damaged kiln sidecar, not valid JSON ({e}): it was cut short or \
+                         edited; bake it again (its command is in the other files' metadata)"
+                    ),
+                ));
+            }
             Ok(None)
         }
     }
@@ -176,6 +188,33 @@ pub fn read_kiln(path: &Path) -> Result<Option<Table>> {
                 .map_err(|e| invalid(path, format!("bad kiln metadata: {e}")))?;
             from_metadata(metadata, &image.channels).map(Some)
         }
+        "ktx2" => read_kiln_texture(path, &bytes, Container::Ktx2, &from_metadata),
+        "dds" => read_kiln_texture(path, &bytes, Container::Dds, &from_metadata),
+        "h" | "rs" => {
+            let Ok(text) = std::str::from_utf8(&bytes) else {
+                return Ok(None);
+            };
+            let metadata = match crate::format::metadata::find_embedded(text) {
+                Some(parsed) => parsed.map_err(|e| invalid(path, e))?,
+                None => match sidecar_beside(path)? {
+                    Some(metadata) => metadata,
+                    None => return Ok(None),
+                },
+            };
+            let prefix = metadata.spec.id().to_uppercase().replace('-', "_");
+            let c = extension == "h";
+            let mut channels = Vec::new();
+            for (suffix, name) in [
+                ("", metadata.quantity.clone()),
+                ("_ONE_MINUS", format!("one_minus_{}", metadata.quantity)),
+                ("_STD_ERROR", "std_error".to_string()),
+            ] {
+                if let Some(values) = source_array(text, &format!("{prefix}{suffix}"), c) {
+                    channels.push((name, values.map_err(|e| invalid(path, e))?));
+                }
+            }
+            from_metadata(metadata, &channels).map(Some)
+        }
         _ if bytes.starts_with(binary::MAGIC) => {
             let contents = binary::decode(&bytes).map_err(|e| invalid(path, e))?;
             let sidecar_path = path.with_extension("json");
@@ -199,6 +238,130 @@ pub fn read_kiln(path: &Path) -> Result<Option<Table>> {
         }
         _ => Ok(None),
     }
+}
+
+/// Builds a table from kiln's metadata and named channels (the reader of [`read_kiln`]).
+type FromMetadata<'a> = dyn Fn(Metadata, &[(String, Vec<f64>)]) -> Result<Table> + 'a;
+
+/// The GPU containers kiln writes.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Container {
+    Ktx2,
+    Dds,
+}
+
+/// The metadata in the kiln sidecar beside `path` (`NAME.json`), if there is one.
+fn sidecar_beside(path: &Path) -> Result<Option<Metadata>> {
+    let sidecar_path = path.with_extension("json");
+    let Ok(bytes) = std::fs::read(&sidecar_path) else {
+        return Ok(None);
+    };
+    Ok(parse_sidecar(&sidecar_path, &bytes)?.map(|sidecar| sidecar.metadata))
+}
+
+/// A kiln KTX2 (metadata inside) or DDS (metadata in the sidecar beside it): R = the value, G =
+/// one minus the value.
+fn read_kiln_texture(
+    path: &Path,
+    bytes: &[u8],
+    container: Container,
+    from_metadata: &FromMetadata<'_>,
+) -> Result<Option<Table>> {
+    #[cfg(not(feature = "containers"))]
+    {
+        let _ = (bytes, container, from_metadata);
+        Err(invalid(
+            path,
+            "reading KTX2 and DDS files needs kiln's `containers` feature",
+        ))
+    }
+    #[cfg(feature = "containers")]
+    {
+        let texture = match container {
+            Container::Ktx2 => crate::format::ktx2::decode(bytes),
+            Container::Dds => crate::format::dds::decode(bytes),
+        }
+        .map_err(|e| invalid(path, e))?;
+        let metadata = match (&texture.metadata, container) {
+            (Some(text), _) => {
+                // A texture's metadata lists its tables; kiln's own texture holds one.
+                let value: serde_json::Value = serde_json::from_str(text)
+                    .map_err(|e| invalid(path, format!("bad kiln metadata: {e}")))?;
+                let tables = value.get("tables").and_then(|t| t.as_array());
+                match tables.map(Vec::as_slice) {
+                    Some([one]) => serde_json::from_value::<Metadata>(one.clone())
+                        .map_err(|e| invalid(path, format!("bad kiln metadata: {e}")))?,
+                    Some(_) => {
+                        return Err(invalid(
+                            path,
+                            "a texture of several tables (an engine layout): read it with \
+                             --preset NAME",
+                        ));
+                    }
+                    None => return Err(invalid(path, "kiln metadata without its tables")),
+                }
+            }
+            (None, Container::Ktx2) => return Ok(None),
+            (None, Container::Dds) => match sidecar_beside(path)? {
+                Some(metadata) => metadata,
+                None => {
+                    return Err(invalid(
+                        path,
+                        format!(
+                            "a DDS file holds no metadata: keep kiln's sidecar {} beside it, or \
+                             give the layout with --preset NAME",
+                            path.with_extension("json").display()
+                        ),
+                    ));
+                }
+            },
+        };
+        let names = [
+            metadata.quantity.clone(),
+            format!("one_minus_{}", metadata.quantity),
+        ];
+        let channels: Vec<(String, Vec<f64>)> = names.into_iter().zip(texture.channels).collect();
+        from_metadata(metadata, &channels).map(Some)
+    }
+}
+
+/// The numbers of the array `name` in a generated C header (`static const float NAME[N] = {
+/// ... };`) or Rust source (`pub const NAME: [...] = [ ... ];`); `None` if there is no such
+/// array.
+fn source_array(text: &str, name: &str, c: bool) -> Option<std::result::Result<Vec<f64>, String>> {
+    let declaration = if c {
+        format!("static const float {name}[")
+    } else {
+        format!("pub const {name}: ")
+    };
+    let start = text.find(&declaration)? + declaration.len();
+    let rest = &text[start..];
+    let (open, close) = if c { ("= {", "};") } else { ("= ", "];") };
+    let body = rest
+        .find(open)
+        .map(|k| &rest[k + open.len()..])
+        .and_then(|body| body.find(close).map(|end| &body[..end]));
+    let Some(body) = body else {
+        return Some(Err(format!("the array {name} is not closed")));
+    };
+    let numbers = body
+        .split(|ch: char| ch.is_whitespace() || matches!(ch, ',' | '[' | ']'))
+        .filter(|token| !token.is_empty())
+        .map(|token| {
+            let digits = if c {
+                token.trim_end_matches('f')
+            } else {
+                token
+            };
+            // The generators print the shortest literal that round-trips to the f32 they
+            // store: parse it as that f32.
+            digits
+                .parse::<f32>()
+                .map(f64::from)
+                .map_err(|_| format!("the array {name} holds '{token}', not a number"))
+        })
+        .collect();
+    Some(numbers)
 }
 
 /// Reads an external table of bare numbers laid out as `layout` says.

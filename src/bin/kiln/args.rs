@@ -3,7 +3,12 @@
 
 use kiln::BakeOptions;
 
-/// The conventions every table follows, printed after `--help`.
+/// Where a subcommand's help sends the reader for the conventions (printed once, by `kiln
+/// --help`, rather than after every subcommand's help).
+pub const SEE_CONVENTIONS: &str =
+    "Conventions (mu, roughness r or alpha, nodes or centres, the mu axes, layout): kiln --help";
+
+/// The conventions every table follows, printed after `kiln --help`.
 pub const CONVENTIONS: &str = "\
 Conventions:
   mu         cos(theta) of the view direction, in [0, 1] (0 = grazing, 1 = normal incidence).
@@ -13,7 +18,8 @@ Conventions:
              ends, so lookups interpolate all the way to mu = 0 and 1 and r = 0 and 1; a GPU
              lookup must remap t' = (t (N - 1) + 0.5) / N before sampling. 'centers': sample i
              sits at texel centre t = (i + 0.5) / N, sampled at raw t by a GPU, but the outer
-             half texel on each side is clamped (errors up to 1e-2 at 32 x 32).
+             half texel on each side is clamped: at 32 x 32 the lookup error reaches 2.5e-2
+             there (E, adaptive mu axis; 1.4e-2 for E_avg), against 6.5e-4 on nodes.
   mu axis    'adaptive' (bake's default): look up at t = (mu (1 + 4 alpha) / (mu + 4 alpha))^0.4
              (t = 0 at mu = 0, t = 1 at alpha = 0 and mu > 0). It keeps the grazing boundary
              layer mu ~ alpha at the same t for every roughness: 6.5e-4 max lookup error at
@@ -38,26 +44,37 @@ pub fn parse_number(text: &str) -> Result<f64, String> {
     }
 }
 
-/// `mu = cos(theta)` in [0, 1].
-pub fn parse_mu(text: &str) -> Result<f64, String> {
-    let mu = parse_number(text)?;
-    if (0.0..=1.0).contains(&mu) {
-        Ok(mu)
+/// A finite number in `[lo, hi]`; the message says what the number is (`what`).
+fn parse_in(text: &str, lo: f64, hi: f64, what: &str) -> Result<f64, String> {
+    let value = parse_number(text)?;
+    if (lo..=hi).contains(&value) {
+        Ok(value)
     } else {
-        Err(format!(
-            "mu is cos(theta) and must be in [0, 1] (got {text})"
-        ))
+        Err(format!("{what} must be in [{lo}, {hi}] (got {text})"))
     }
 }
 
-/// A roughness (`r` or `alpha`) in [0, 1000].
+/// `mu = cos(theta)` in [0, 1].
+pub fn parse_mu(text: &str) -> Result<f64, String> {
+    parse_in(text, 0.0, 1.0, "mu is cos(theta) and")
+}
+
+/// A perceptual roughness `r` in [0, 1000].
 pub fn parse_roughness(text: &str) -> Result<f64, String> {
-    let value = parse_number(text)?;
-    if (0.0..=1e3).contains(&value) {
-        Ok(value)
-    } else {
-        Err(format!("roughness must be in [0, 1000] (got {text})"))
-    }
+    parse_in(text, 0.0, 1e3, "perceptual roughness r")
+}
+
+/// A slope-space roughness `alpha` in [0, 1000].
+pub fn parse_alpha(text: &str) -> Result<f64, String> {
+    parse_in(text, 0.0, 1e3, "alpha (slope-space roughness)")
+}
+
+/// The names of the flags given, from `(name, given)` pairs: for errors that list them.
+pub fn given<'a>(flags: &[(&'a str, bool)]) -> Vec<&'a str> {
+    flags
+        .iter()
+        .filter_map(|&(flag, given)| given.then_some(flag))
+        .collect()
 }
 
 /// A table size per axis.
@@ -76,17 +93,26 @@ pub fn parse_size(text: &str) -> Result<usize, String> {
     }
 }
 
-/// A QMC sample count: a power of two.
+/// A QMC sample count: a power of two. Its range depends on `--scrambles`
+/// (`QmcSettings::validate` checks it and names the flag).
 pub fn parse_samples(text: &str) -> Result<u64, String> {
-    let n: i128 = text
-        .trim()
-        .parse()
-        .map_err(|_| format!("'{text}' is not a whole number"))?;
-    if (2..=1 << 42).contains(&n) && (n as u64).is_power_of_two() {
+    let trimmed = text.trim();
+    // `65536` or `2^16`.
+    let n: i128 = match trimmed.split_once('^') {
+        Some(("2", power)) => match power.trim().parse::<u32>() {
+            Ok(k) if k <= 62 => 1 << k,
+            _ => return Err(format!("'{text}' is not a power of two up to 2^62")),
+        },
+        _ => trimmed
+            .parse()
+            .map_err(|_| format!("'{text}' is not a whole number (or 2^k)"))?,
+    };
+    if (1..=1 << 62).contains(&n) && (n as u64).is_power_of_two() {
         Ok(n as u64)
     } else {
         Err(format!(
-            "samples must be a power of two between 2 and 2^42 (got {text})"
+            "must be a power of two (e.g. 65536 = 2^16), from --scrambles to 2^32 times \
+             --scrambles (got {text})"
         ))
     }
 }

@@ -1,8 +1,9 @@
 //! `kiln bake`.
 
-use crate::args::{CONVENTIONS, parse_samples, parse_size};
+use crate::args::{SEE_CONVENTIONS, parse_samples, parse_size};
 use crate::fresnel_args::FresnelArgs;
 use clap::Args;
+use kiln::format::replace::Replace;
 use kiln::format::{self, Format, Precision};
 use kiln::{
     BakeOptions, Grid, IorMapping, Masking, Method, MuMapping, Ndf, QmcSettings, Quantity,
@@ -24,7 +25,7 @@ use std::time::Instant;
                   texel from independent scrambles. The metadata of every file states the model, \
                   axes, grid, method, error and the command that reproduces it. Output is \
                   byte-identical for any thread count.",
-    after_help = CONVENTIONS
+    after_help = SEE_CONVENTIONS
 )]
 pub struct BakeArgs {
     /// Normal distributions to bake, comma-separated: ggx,beckmann for both (Beckmann's
@@ -68,19 +69,21 @@ pub struct BakeArgs {
     /// The top of the IOR axis, above 1 (Unreal's glass table goes to 3; diamond is 2.42).
     #[arg(long, default_value_t = BakeOptions::DEFAULT_IOR_MAX, allow_negative_numbers = true)]
     ior_max: f64,
-    /// QMC samples per E texel, a power of two (split over the scrambles); implies --method qmc
-    /// [default: 2^16].
+    /// QMC samples per E texel, a power of two from --scrambles to 2^32 x --scrambles (split
+    /// over the scrambles); implies --method qmc [default: 2^19].
     #[arg(long, value_parser = parse_samples, allow_negative_numbers = true)]
     samples: Option<u64>,
-    /// QMC samples per E_avg entry, a power of two [default: 16 x --samples].
+    /// QMC samples per E_avg entry, a power of two in the same range; implies --method qmc
+    /// [default: 16 x --samples, at most 2^32 x --scrambles].
     #[arg(long, value_parser = parse_samples, allow_negative_numbers = true)]
     avg_samples: Option<u64>,
-    /// Independent scrambles per estimate, for the standard error: a power of two, 2 to 1024.
-    #[arg(long, default_value_t = QmcSettings::DEFAULT_SCRAMBLES, allow_negative_numbers = true)]
-    scrambles: u32,
-    /// Base seed of the scrambles.
-    #[arg(long, default_value_t = 0)]
-    seed: u64,
+    /// QMC: independent scrambles per estimate, for the standard error: a power of two, 2 to
+    /// 1024 [default: 8].
+    #[arg(long, allow_negative_numbers = true)]
+    scrambles: Option<u32>,
+    /// QMC: base seed of the scrambles [default: 0].
+    #[arg(long)]
+    seed: Option<u64>,
     /// Output directory, created if missing.
     /// [default: tables, or the scene's output.dir]
     #[arg(long)]
@@ -120,7 +123,8 @@ pub struct BakeArgs {
         default_value = "exr,bin,rs,json,png"
     )]
     format: Vec<Format>,
-    /// Storage precision of the value channels in EXR and binary files (std_error stays f32).
+    /// Storage precision of the value and 1 - value channels in EXR, binary, KTX2 and DDS files
+    /// (std_error stays f32; JSON is always f64, Rust, C and shader code always f32).
     #[arg(long, value_enum, default_value = "f32")]
     precision: Precision,
     /// Roughness axis: perceptual r (alpha = r^2) or alpha.
@@ -140,8 +144,9 @@ pub struct BakeArgs {
     /// full accuracy (error at most 1e-10).
     #[arg(long, value_enum)]
     method: Option<Method>,
-    /// With --method qmc: skip measuring each table's node error against the deterministic
-    /// reference after baking; the metadata then states only the standard errors.
+    /// With --method qmc (or --samples): skip measuring each table's node error against the
+    /// deterministic reference after baking; the metadata then states only the standard
+    /// errors. An error with any other method.
     #[arg(long)]
     no_reference_check: bool,
     /// Bake to this max error (1e-10 to 0.5) [default: 1e-7 unless --method or --samples is
@@ -155,24 +160,42 @@ pub struct BakeArgs {
         conflicts_with_all = ["method", "samples", "avg_samples", "no_reference_check"]
     )]
     max_error: Option<f64>,
+    /// Replace tables of the same name in --out that another bake made to a different spec
+    /// (another size, method or accuracy), and remove their files in formats this bake does
+    /// not write, so that the folder holds one consistent set. Without it such a bake stops
+    /// before writing anything. (Tables of other layouts have other names: `-mu-linear`,
+    /// `-centers`, `-alpha`; a preset's sidecars start with the preset's name.)
+    #[arg(long)]
+    force: bool,
     /// No progress bar and no summary.
     #[arg(long, short)]
     quiet: bool,
 }
 
+impl BakeArgs {
+    fn replace(&self) -> Replace {
+        if self.force {
+            Replace::Force
+        } else {
+            Replace::Refuse
+        }
+    }
+}
+
 pub fn run(args: BakeArgs) -> kiln::Result<()> {
     if let Some(path) = &args.scene {
-        return bake_scene(path, args.out.as_deref(), args.quiet);
+        return bake_scene(path, args.out.as_deref(), args.quiet, args.replace());
     }
     if let Some(preset) = args.preset {
         return bake_preset(preset, &args);
     }
     let out = args.out.clone().unwrap_or_else(|| PathBuf::from("tables"));
+    check_method_flags(&args)?;
+    let replace = args.replace();
     // Naming a method or a sample count asks for that method; otherwise a max error decides.
-    let explicit_method = args.method.is_some()
-        || args.samples.is_some()
-        || args.avg_samples.is_some()
-        || args.no_reference_check;
+    let explicit_method =
+        args.method.is_some() || args.samples.is_some() || args.avg_samples.is_some();
+    let scrambles = args.scrambles.unwrap_or(QmcSettings::DEFAULT_SCRAMBLES);
     let max_error = match args.max_error {
         Some(x) => Some(x),
         None if explicit_method => None,
@@ -196,9 +219,17 @@ pub fn run(args: BakeArgs) -> kiln::Result<()> {
         },
         size: args.size,
         samples,
-        average_samples: args.avg_samples.unwrap_or(16 * samples),
-        scrambles: args.scrambles,
-        seed: args.seed,
+        average_samples: args.avg_samples.unwrap_or_else(|| {
+            let (_, most) = QmcSettings {
+                samples,
+                scrambles,
+                seed: 0,
+            }
+            .sample_range();
+            samples.saturating_mul(16).min(most)
+        }),
+        scrambles,
+        seed: args.seed.unwrap_or(0),
         roughness_convention: args.roughness_axis,
         mu_mapping: args.mu_axis,
         grid: args.grid,
@@ -215,13 +246,16 @@ pub fn run(args: BakeArgs) -> kiln::Result<()> {
     formats.dedup();
     // Fail on an unusable output directory now, not after minutes of integration.
     format::check_output_dir(&out)?;
+    // A folder of tables this bake may not replace: refused now, not after the integration.
+    format::replace::precheck(&out, &options.resolved().specs(), &formats, replace)?;
+    crate::announce_cost(options.estimated_core_seconds(), args.quiet);
 
     let bar = crate::progress_bar(args.quiet, options.total_samples(), "integrating");
     let start = Instant::now();
     let tables = options.bake(&|samples| bar.inc(samples))?;
     bar.finish_and_clear();
     let seconds = start.elapsed().as_secs_f64();
-    let written = format::write_tables(&out, &tables, &formats, args.precision)?;
+    let written = format::write_tables(&out, &tables, &formats, args.precision, replace)?;
     if !args.quiet {
         for table in &tables {
             let shape: Vec<String> = table.spec.shape().iter().map(|n| n.to_string()).collect();
@@ -249,6 +283,39 @@ pub fn run(args: BakeArgs) -> kiln::Result<()> {
     Ok(())
 }
 
+/// Flags that only QMC reads are errors with a method that does not read them, rather than
+/// being ignored or switching the method.
+fn check_method_flags(args: &BakeArgs) -> kiln::Result<()> {
+    let qmc_chosen = args.method == Some(Method::Qmc)
+        || (args.method.is_none() && (args.samples.is_some() || args.avg_samples.is_some()));
+    if args.no_reference_check && !qmc_chosen {
+        return Err(kiln::Error::InvalidInput(
+            "--no-reference-check applies to QMC bakes only: add --method qmc (and --samples N) \
+             to bake by QMC without the node check, or drop it (the default bake is checked \
+             against the reference to --max-error)"
+                .into(),
+        ));
+    }
+    if args.method == Some(Method::Reference) {
+        let qmc_only = crate::args::given(&[
+            ("--samples", args.samples.is_some()),
+            ("--avg-samples", args.avg_samples.is_some()),
+            ("--scrambles", args.scrambles.is_some()),
+            ("--seed", args.seed.is_some()),
+        ]);
+        if !qmc_only.is_empty() {
+            return Err(kiln::Error::InvalidInput(format!(
+                "{} {} QMC's sampling; --method reference is a deterministic quadrature that \
+                 chooses its own evaluations: drop {} or use --method qmc",
+                qmc_only.join(", "),
+                if qmc_only.len() == 1 { "sets" } else { "set" },
+                if qmc_only.len() == 1 { "it" } else { "them" }
+            )));
+        }
+    }
+    Ok(())
+}
+
 /// `kiln bake --preset NAME`.
 fn bake_preset(preset: kiln::preset::Preset, args: &BakeArgs) -> kiln::Result<()> {
     let out = args.out.clone().unwrap_or_else(|| PathBuf::from("tables"));
@@ -258,16 +325,26 @@ fn bake_preset(preset: kiln::preset::Preset, args: &BakeArgs) -> kiln::Result<()
     };
     options.validate()?;
     format::check_output_dir(&out)?;
+    crate::announce_cost(options.estimated_core_seconds(), args.quiet);
     let bar = crate::progress_bar(args.quiet, options.total_samples(), "integrating");
     let start = Instant::now();
     let tables = options.bake(&|samples| bar.inc(samples))?;
     bar.finish_and_clear();
     let (mut files, extra) = preset.files_and_extra(&tables)?;
-    files.extend(format::encode_all(
-        &tables,
-        &[Format::Json],
-        Precision::F32,
-    )?);
+    let engine_files: Vec<String> = files.iter().map(|(name, _)| name.clone()).collect();
+    // kiln's sidecars of the tables the engine file holds, named after the preset (the layout
+    // is the preset's), listing the engine's file(s) they describe.
+    for table in &tables {
+        let described = [(preset.name().to_string(), engine_files.join(", "))]
+            .into_iter()
+            .collect();
+        let sidecar = format::json::sidecar(table, "f32", described);
+        let bytes = format::json::encode(&sidecar).map_err(|message| kiln::Error::Format {
+            path: out.join(preset.sidecar_name(table)),
+            message,
+        })?;
+        files.push((preset.sidecar_name(table), bytes));
+    }
     let written = format::write_files(&out, &files)?;
     if !args.quiet {
         for table in &tables {
@@ -304,9 +381,25 @@ fn bake_scene(
     path: &std::path::Path,
     out: Option<&std::path::Path>,
     quiet: bool,
+    replace: Replace,
 ) -> kiln::Result<()> {
     let scene = kiln::scene::Scene::read(path)?;
+    if scene.materials.is_empty() {
+        eprintln!(
+            "kiln: warning: {} names no materials: nothing to bake (add [[material]] entries)",
+            path.display()
+        );
+    }
     let dir = out.map_or_else(|| scene.output_dir(), std::path::Path::to_path_buf);
+    crate::announce_cost(
+        scene
+            .plan()
+            .tables
+            .iter()
+            .map(|t| t.estimated_core_seconds)
+            .sum(),
+        quiet,
+    );
     let total: u64 = scene
         .bake_options()
         .iter()
@@ -314,7 +407,7 @@ fn bake_scene(
         .sum();
     let bar = crate::progress_bar(quiet, total, "integrating");
     let start = Instant::now();
-    let result = scene.bake(&dir, &|samples| bar.inc(samples))?;
+    let result = scene.bake(&dir, &|samples| bar.inc(samples), replace)?;
     bar.finish_and_clear();
     if !quiet {
         let list = |ids: &[String]| {

@@ -1,6 +1,6 @@
 //! `kiln eval`.
 
-use crate::args::{CONVENTIONS, parse_mu, parse_roughness, parse_samples};
+use crate::args::{SEE_CONVENTIONS, parse_alpha, parse_mu, parse_roughness, parse_samples};
 use crate::fresnel_args::FresnelArgs;
 use clap::{Args, ValueEnum};
 use kiln::integrate::reference::{ReferenceSettings, reference_albedo, reference_average_albedo};
@@ -46,7 +46,7 @@ pub enum EvalQuantity {
                   samples its integrand evaluations. For F_avg, value is a number when the model \
                   is the same in every channel and [R, G, B] otherwise; value_rgb is always the \
                   three channels.",
-    after_help = CONVENTIONS
+    after_help = SEE_CONVENTIONS
 )]
 pub struct EvalArgs {
     /// Normal distribution.
@@ -56,7 +56,7 @@ pub struct EvalArgs {
     #[arg(long, value_enum, default_value = "height-correlated")]
     masking: Masking,
     /// Slope-space roughness alpha, >= 0 (give this or --roughness).
-    #[arg(long, value_parser = parse_roughness, conflicts_with = "roughness", allow_negative_numbers = true)]
+    #[arg(long, value_parser = parse_alpha, conflicts_with = "roughness", allow_negative_numbers = true)]
     alpha: Option<f64>,
     /// Perceptual roughness r >= 0, alpha = r^2 (give this or --alpha).
     #[arg(long, value_parser = parse_roughness, allow_negative_numbers = true)]
@@ -126,7 +126,19 @@ pub fn run(args: EvalArgs) -> kiln::Result<()> {
             )));
         }
         (q, Some(mu)) if q.has_mu() => Some(mu),
-        _ => None,
+        (q, Some(mu)) => {
+            return Err(kiln::Error::InvalidInput(format!(
+                "--mu {mu} does not apply to --quantity {}: it is an average over mu (2 * \
+                 integral of E(mu) mu dmu); drop --mu, or use --quantity {} for one mu",
+                q.cli_name(),
+                if q == Quantity::EAvg {
+                    "e"
+                } else {
+                    "e-dielectric"
+                }
+            )));
+        }
+        (_, None) => None,
     };
     if quantity.has_ior() {
         let Fresnel::Dielectric { eta } = fresnel else {
@@ -212,7 +224,7 @@ pub fn run(args: EvalArgs) -> kiln::Result<()> {
         println!(
             "{symbol}({at}alpha = {alpha}) = {value:.12} ± {error:.1e} (1 - {symbol} = \
              {one_minus_value:.6e}; {}, {what}, {seconds:.3} s)",
-            model.ndf
+            model
         );
         if !converged {
             eprintln!(
@@ -225,16 +237,12 @@ pub fn run(args: EvalArgs) -> kiln::Result<()> {
 
 /// `kiln eval --quantity f-avg`: `F_avg` per channel for the `--fresnel` model.
 fn fresnel_average(args: &EvalArgs, fresnel: Fresnel) -> kiln::Result<()> {
-    let irrelevant: Vec<&str> = [
+    let irrelevant = crate::args::given(&[
         ("--alpha", args.alpha.is_some()),
         ("--roughness", args.roughness.is_some()),
         ("--mu", args.mu.is_some()),
         ("--samples", args.samples.is_some()),
-    ]
-    .iter()
-    .filter(|(_, given)| *given)
-    .map(|(name, _)| *name)
-    .collect();
+    ]);
     if !irrelevant.is_empty() {
         return Err(kiln::Error::InvalidInput(format!(
             "F_avg depends on the Fresnel model only: drop {}",
@@ -372,7 +380,7 @@ fn fresnel_weighted(
             "E_F(mu = {mu}, alpha = {alpha}; {} Fresnel) = {shown} ± {error:.1e} ({}, {method}, \
              {samples} evaluations, {seconds:.3} s)",
             fresnel.name(),
-            model.ndf
+            model
         );
     }
     Ok(())
@@ -481,7 +489,7 @@ fn dielectric(
     } else {
         println!(
             "{symbol} = {value:.10} (1 - {symbol} = {one_minus_value:.4e}), {} {error:.2e}, \
-             eta {eta}, alpha {alpha}{}",
+             {model}, eta {eta}, alpha {alpha}{}",
             if args.method == Method::Qmc {
                 "std error"
             } else {

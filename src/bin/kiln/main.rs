@@ -14,7 +14,16 @@ use std::process::ExitCode;
 
 /// Bakes the lookup tables energy-conserving microfacet materials need (Kulla-Conty E, E_avg).
 #[derive(Parser, Debug)]
-#[command(name = "kiln", version, about, after_help = args::CONVENTIONS)]
+#[command(
+    name = "kiln",
+    version,
+    about,
+    arg_required_else_help = true,
+    after_help = "Start with `kiln bake` (the default tables into tables/), `kiln bake --preset \
+                  NAME` (an engine's own file) or `kiln verify FILE`; `kiln help COMMAND` \
+                  explains each. `kiln --help` adds the conventions every table follows.",
+    after_long_help = args::CONVENTIONS
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -50,22 +59,78 @@ pub fn progress_bar(quiet: bool, total: u64, what: &str) -> indicatif::ProgressB
     bar
 }
 
+/// A `.toml` file given where no positional argument is taken (`kiln plan scene.toml`).
+fn stray_scene_file(e: &clap::Error) -> Option<String> {
+    use clap::error::{ContextKind, ContextValue};
+    if e.kind() != clap::error::ErrorKind::UnknownArgument {
+        return None;
+    }
+    match e.get(ContextKind::InvalidArg) {
+        Some(ContextValue::String(arg)) if arg.ends_with(".toml") && !arg.starts_with('-') => {
+            Some(arg.clone())
+        }
+        _ => None,
+    }
+}
+
+/// `0.4 s`, `12 s`, `3.5 min`, `1.2 h`.
+pub fn human_seconds(seconds: f64) -> String {
+    if seconds < 10.0 {
+        format!("{seconds:.1} s")
+    } else if seconds < 120.0 {
+        format!("{seconds:.0} s")
+    } else if seconds < 7200.0 {
+        format!("{:.1} min", seconds / 60.0)
+    } else {
+        format!("{:.1} h", seconds / 3600.0)
+    }
+}
+
+/// Says on stderr, before a bake of more than a few seconds starts, how long it should take
+/// (on any stderr: a log or CI output needs it as much as a terminal); nothing with `quiet`.
+pub fn announce_cost(core_seconds: f64, quiet: bool) {
+    let threads = rayon::current_num_threads();
+    let seconds = core_seconds / threads as f64;
+    if !quiet && seconds > 5.0 {
+        eprintln!(
+            "kiln: estimated {} on {threads} threads (a rough figure; interrupting writes \
+             nothing)",
+            human_seconds(seconds)
+        );
+    }
+}
+
 fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => {
             use clap::error::ErrorKind;
-            if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) {
+            if matches!(
+                e.kind(),
+                ErrorKind::DisplayHelp
+                    | ErrorKind::DisplayVersion
+                    | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand
+            ) {
                 e.exit();
             }
-            // One line: what was wrong, and the allowed values (clap's first paragraph, joined).
+            // One line: what was wrong, and the allowed values (clap's first paragraph, joined),
+            // then clap's tips ("a similar argument exists") and the usage line.
             let rendered = e.render().to_string();
-            let message: Vec<&str> = rendered
-                .lines()
-                .map(str::trim)
+            let lines: Vec<&str> = rendered.lines().map(str::trim).collect();
+            let message: Vec<&str> = lines
+                .iter()
+                .copied()
                 .take_while(|line| !line.is_empty())
                 .collect();
             eprintln!("kiln: {}", message.join(" ").trim_start_matches("error: "));
+            for line in &lines[message.len()..] {
+                if line.starts_with("tip:") || line.starts_with("Usage:") {
+                    eprintln!("  {line}");
+                }
+            }
+            if let Some(scene) = stray_scene_file(&e) {
+                eprintln!("  tip: name a scene file with --scene {scene}");
+            }
             return ExitCode::from(2);
         }
     };

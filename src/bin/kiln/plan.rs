@@ -12,9 +12,12 @@ use std::path::PathBuf;
                   tables its materials need, each once with the materials that need it: E and \
                   E_avg for every NDF and masking combination in use. Per material, the scalars \
                   it needs: F_avg per channel for its Fresnel model (the Kulla-Conty colour \
-                  term). With --json, one object with a `tables` array (ndf, masking, quantity, \
-                  materials) and a `materials` array (name, ndf, masking, roughness, fresnel, \
-                  f_avg)."
+                  term), which `kiln bake --scene` writes to materials.json. Each table with its \
+                  estimated bake time on this machine's threads (a rough figure: seconds or \
+                  minutes). output.dir is relative to the scene file. With --json, one object \
+                  with a `tables` array (ndf, masking, quantity, materials, id, \
+                  estimated_core_seconds) and a `materials` array (name, ndf, masking, \
+                  roughness, fresnel, f_avg)."
 )]
 pub struct PlanArgs {
     /// The scene file.
@@ -35,15 +38,34 @@ pub fn run(args: PlanArgs) -> kiln::Result<()> {
         );
         return Ok(());
     }
+    if plan.materials.is_empty() {
+        eprintln!(
+            "kiln: warning: {} names no materials, so it needs no tables; add [[material]] \
+             entries (name, ndf, roughness, fresnel; see kiln plan --help)",
+            args.scene.display()
+        );
+    }
+    let threads = rayon::current_num_threads();
+    let total = plan
+        .tables
+        .iter()
+        .fold(0.0, |sum, t| sum + t.estimated_core_seconds);
     println!(
-        "{}: {} materials need {} tables",
+        "{}: {} materials need {} tables (estimated {} on {threads} threads, less what the \
+         cache in {} holds)",
         args.scene.display(),
         plan.materials.len(),
-        plan.tables.len()
+        plan.tables.len(),
+        crate::human_seconds(total / threads as f64),
+        scene.output_dir().join(".kiln-cache").display()
     );
     for t in &plan.tables {
-        let id = format!("{}-{}-{}", t.ndf, t.masking, t.quantity.symbol());
-        println!("  {id:<46} for {}", t.materials.join(", "));
+        println!(
+            "  {:<46} ~{:>8}  for {}",
+            t.id,
+            crate::human_seconds(t.estimated_core_seconds / threads as f64),
+            t.materials.join(", ")
+        );
     }
     for m in &plan.materials {
         let [r, g, b] = m.f_avg;

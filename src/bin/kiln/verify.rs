@@ -1,6 +1,6 @@
 //! `kiln verify`.
 
-use crate::args::{CONVENTIONS, parse_error_bound, parse_number};
+use crate::args::{SEE_CONVENTIONS, parse_error_bound, parse_number};
 use crate::fresnel_args::FresnelArgs;
 use clap::Args;
 use kiln::format::Precision;
@@ -19,10 +19,12 @@ use std::path::{Path, PathBuf};
                   node_rms_error) and of its bilinear lookup, with its own grid convention, on a \
                   dense set of points between the nodes including the axis ends \
                   (lookup_max_error, lookup_rms_error, lookup_p99_error), each with the worst \
-                  point. kiln's own files (.json sidecar, .exr, .bin beside its sidecar) carry \
-                  their layout; for any other table give it with --shape, --order, --grid, \
-                  --roughness-axis, --mu-axis, --clamp-min and the model flags.",
-    after_help = CONVENTIONS
+                  point. Every file kiln writes carries its layout (JSON, EXR, KTX2, C and Rust \
+                  in themselves; binary and DDS through the JSON sidecar beside them); for any \
+                  other table give it with --shape, --order, --grid, --roughness-axis, \
+                  --mu-axis, --clamp-min and the model flags, and for an engine's own file name \
+                  its layout with --preset. --max-error X --quiet makes it a build gate.",
+    after_help = SEE_CONVENTIONS
 )]
 pub struct VerifyArgs {
     /// The table to audit: a kiln output, a text file of numbers (whitespace or commas, '#'
@@ -50,7 +52,8 @@ pub struct VerifyArgs {
     /// tables against the reference for the model the engine evaluates (GGX, height-correlated;
     /// Godot: separable Schlick-GGX); a blue channel (Filament's and Godot's cloth, HDRP's
     /// Disney diffuse) is compared with kiln's values at its texels (node errors only).
-    #[arg(long, value_enum, conflicts_with_all = ["furnace", "shape", "channel", "dtype"])]
+    #[arg(long, value_enum, conflicts_with_all = ["furnace", "shape", "channel", "dtype",
+        "order", "grid", "roughness_axis", "mu_axis", "ndf", "masking", "quantity"])]
     preset: Option<kiln::preset::Preset>,
     /// Exit with status 1 when node_max_error exceeds this.
     #[arg(long, value_parser = parse_error_bound, allow_negative_numbers = true)]
@@ -67,34 +70,37 @@ pub struct VerifyArgs {
     /// External tables: read this channel of an EXR file.
     #[arg(long, conflicts_with = "dtype")]
     channel: Option<String>,
-    /// External tables: sizes, slowest-varying axis first: 32x32 for E, 32 for E_avg.
+    /// External tables: sizes, slowest-varying axis first: 32x32 for E, 32 for E_avg (one size
+    /// means an E_avg table unless --quantity says otherwise).
     #[arg(long, value_parser = parse_shape)]
     shape: Option<Shape>,
     /// External tables: the axes, slowest-varying first [default: r,mu for E; r for E_avg].
     #[arg(long, value_enum, value_delimiter = ',')]
     order: Option<Vec<AxisName>>,
-    /// External tables: where samples sit.
-    #[arg(long, value_enum, default_value = "centers")]
-    grid: Grid,
-    /// External tables: the roughness axis, r (alpha = r^2) or alpha.
-    #[arg(long, value_enum, default_value = "r")]
-    roughness_axis: RoughnessConvention,
-    /// External tables: the mu axis spacing.
-    #[arg(long, value_enum, default_value = "linear")]
-    mu_axis: MuMapping,
-    /// External tables: the normal distribution.
-    #[arg(long, value_enum, default_value = "ggx")]
-    ndf: Ndf,
-    /// External tables: the Smith G2 form.
-    #[arg(long, value_enum, default_value = "height-correlated")]
-    masking: Masking,
+    /// External tables: where samples sit [default: centers, as GPU textures are sampled].
+    #[arg(long, value_enum)]
+    grid: Option<Grid>,
+    /// External tables: the roughness axis, r (alpha = r^2) or alpha [default: r].
+    #[arg(long, value_enum)]
+    roughness_axis: Option<RoughnessConvention>,
+    /// External tables: the mu axis spacing [default: linear, as engines' tables are].
+    #[arg(long, value_enum)]
+    mu_axis: Option<MuMapping>,
+    /// External tables: the normal distribution [default: ggx].
+    #[arg(long, value_enum)]
+    ndf: Option<Ndf>,
+    /// External tables: the Smith G2 form [default: height-correlated].
+    #[arg(long, value_enum)]
+    masking: Option<Masking>,
     /// External tables: what the numbers are (e-f: the Fresnel-weighted albedo of the model
-    /// the Fresnel flags name).
-    #[arg(long, value_enum, default_value = "e")]
-    quantity: Quantity,
+    /// the Fresnel flags name) [default: e-avg for a one-size --shape, else e].
+    #[arg(long, value_enum)]
+    quantity: Option<Quantity>,
     #[command(flatten)]
     fresnel: FresnelArgs,
-    /// No progress bar.
+    /// Print nothing but errors: the exit status says whether the table passed --max-error
+    /// (0 passed, 1 failed, 2 could not be read), and a failing check prints one line on
+    /// stderr. For build gates.
     #[arg(long, short)]
     quiet: bool,
 }
@@ -131,19 +137,48 @@ fn parse_shape(text: &str) -> Result<Shape, String> {
 }
 
 impl VerifyArgs {
-    fn layout(&self) -> kiln::Result<Layout> {
+    /// The external-layout flags given on the command line: a kiln file carries its own layout,
+    /// so these are errors with one.
+    fn layout_flags_given(&self) -> Vec<&'static str> {
+        crate::args::given(&[
+            ("--shape", self.shape.is_some()),
+            ("--order", self.order.is_some()),
+            ("--grid", self.grid.is_some()),
+            ("--roughness-axis", self.roughness_axis.is_some()),
+            ("--mu-axis", self.mu_axis.is_some()),
+            ("--ndf", self.ndf.is_some()),
+            ("--masking", self.masking.is_some()),
+            ("--quantity", self.quantity.is_some()),
+            ("the Fresnel flags", self.fresnel.given()),
+        ])
+    }
+
+    /// The quantity of an external table: `--quantity`, else `E_avg` for a one-size shape and
+    /// `E` otherwise.
+    fn quantity(&self, shape: &[usize]) -> Quantity {
+        self.quantity.unwrap_or(if shape.len() == 1 {
+            Quantity::EAvg
+        } else {
+            Quantity::E
+        })
+    }
+
+    fn layout(&self, path: &Path) -> kiln::Result<Layout> {
         let Shape(shape) = self.shape.clone().ok_or_else(|| {
             kiln::Error::InvalidInput(format!(
-                "{} is not a kiln table: give its layout, at least --shape (e.g. --shape 32x32 --order mu,r)",
-                self.file.display()
+                "{} is not a kiln table (no kiln metadata in it or a sidecar beside it): give \
+                 its layout, at least --shape (e.g. --shape 32x32 --order mu,r for an E table, \
+                 --shape 32 for E_avg), or --preset NAME for an engine's file",
+                path.display()
             ))
         })?;
-        let order = self.order.clone().unwrap_or(if self.quantity.has_mu() {
+        let quantity = self.quantity(&shape);
+        let order = self.order.clone().unwrap_or(if quantity.has_mu() {
             vec![AxisName::R, AxisName::Mu]
         } else {
             vec![AxisName::R]
         });
-        let fresnel = match (self.quantity, self.fresnel.given()) {
+        let fresnel = match (quantity, self.fresnel.given()) {
             (Quantity::EF, true) => {
                 let model = self.fresnel.model()?;
                 if !model.is_grey() {
@@ -165,29 +200,50 @@ impl VerifyArgs {
             (_, true) => {
                 return Err(kiln::Error::InvalidInput(format!(
                     "the Fresnel flags apply to --quantity e-f only (a {} table is for F = 1)",
-                    self.quantity.symbol()
+                    quantity.symbol()
                 )));
             }
             (_, false) => None,
         };
         Ok(Layout {
             model: Model {
-                ndf: self.ndf,
-                masking: self.masking,
+                ndf: self.ndf.unwrap_or(Ndf::Ggx),
+                masking: self.masking.unwrap_or(Masking::HeightCorrelated),
             },
-            quantity: self.quantity,
+            quantity,
             fresnel,
             shape,
             order,
-            grid: self.grid,
-            roughness: self.roughness_axis,
-            mu_mapping: self.mu_axis,
+            grid: self.grid.unwrap_or(Grid::Centers),
+            roughness: self
+                .roughness_axis
+                .unwrap_or(RoughnessConvention::Perceptual),
+            mu_mapping: self.mu_axis.unwrap_or(MuMapping::Linear),
         })
     }
 
     fn load(&self, path: &Path) -> kiln::Result<Table> {
         if self.channel.is_none() && self.dtype.is_none() {
             if let Some(table) = read_kiln(path)? {
+                let given = self.layout_flags_given();
+                if !given.is_empty() {
+                    return Err(kiln::Error::InvalidInput(format!(
+                        "{} is a kiln table and carries its own layout ({} {}, {}); {} describe \
+                         external tables and would be ignored: drop {}",
+                        path.display(),
+                        table.spec.model,
+                        table.spec.quantity.symbol(),
+                        table
+                            .spec
+                            .shape()
+                            .iter()
+                            .map(ToString::to_string)
+                            .collect::<Vec<_>>()
+                            .join("x"),
+                        given.join(", "),
+                        if given.len() == 1 { "it" } else { "them" }
+                    )));
+                }
                 return Ok(table);
             }
         }
@@ -206,7 +262,7 @@ impl VerifyArgs {
             (None, Some(dtype)) => Encoding::Raw(dtype),
             (None, None) => Encoding::Text,
         };
-        read_external(path, &encoding, &self.layout()?)
+        read_external(path, &encoding, &self.layout(path)?)
     }
 }
 
@@ -262,6 +318,10 @@ fn run_furnace(args: &VerifyArgs, table: &Table) -> kiln::Result<bool> {
         println!("{object}");
         return Ok(passed);
     }
+    if args.quiet {
+        quiet_verdict(args, passed, "furnace max deviation", report.max_deviation);
+        return Ok(passed);
+    }
     let convention = table.spec.roughness_convention().name();
     println!(
         "{} with {}: white furnace test of the Kulla-Conty lobe, {} roughness values",
@@ -313,6 +373,16 @@ fn print_verdict(bound: Option<f64>, passed: bool, what: &str, value: f64) {
     }
 }
 
+/// With `--quiet`: one line on stderr when the check failed, nothing otherwise.
+fn quiet_verdict(args: &VerifyArgs, passed: bool, what: &str, value: f64) {
+    if let (false, Some(bound)) = (passed, args.max_error) {
+        eprintln!(
+            "kiln: {}: {what} {value:.2e} exceeds --max-error {bound:e}",
+            args.file.display()
+        );
+    }
+}
+
 /// A report as one JSON object, with the file and the `--max-error` verdict.
 fn json_report(
     report: &impl serde::Serialize,
@@ -336,17 +406,34 @@ pub fn run(args: VerifyArgs) -> kiln::Result<bool> {
             action: "read",
             source,
         })?;
-        let tables = preset.read_tables(&bytes, &args.file.display().to_string())?;
+        // Name the file in what the layout's reader says.
+        let in_file = |e: kiln::Error| match e {
+            kiln::Error::InvalidInput(m) if !m.contains(&args.file.display().to_string()) => {
+                kiln::Error::InvalidInput(format!("{}: {m}", args.file.display()))
+            }
+            other => other,
+        };
+        let tables = preset
+            .read_tables(&bytes, &args.file.display().to_string())
+            .map_err(in_file)?;
         let mut passed = true;
         for table in &tables {
             passed &= audit_one(&args, table)?;
         }
-        if let Some(audit) = preset.audit_extra(&bytes)? {
+        if let Some(audit) = preset.audit_extra(&bytes).map_err(in_file)? {
             passed &= audit_extra(&args, &audit);
         }
         return Ok(passed);
     }
     let table = args.load(&args.file)?;
+    if args.furnace && table.spec.quantity != Quantity::E {
+        return Err(kiln::Error::InvalidInput(format!(
+            "--furnace tests an E table with its E_avg: {} holds {}; give the E file (NAME-E.EXT), \
+             whose E_avg is found beside it or given with --average",
+            args.file.display(),
+            table.spec.quantity.symbol()
+        )));
+    }
     if args.furnace {
         return run_furnace(&args, &table);
     }
@@ -374,6 +461,8 @@ fn audit_extra(args: &VerifyArgs, audit: &kiln::preset::ExtraAudit) -> bool {
             object["passed"] = passed.into();
         }
         println!("{object}");
+    } else if args.quiet {
+        quiet_verdict(args, passed, "blue channel node max error", audit.max_error);
     } else {
         println!(
             "{}: blue channel, {} ({} texels, against kiln's values, error estimate {:.0e})",
@@ -433,6 +522,8 @@ fn audit_one(args: &VerifyArgs, table: &Table) -> kiln::Result<bool> {
         .is_none_or(|bound| report.node_max_error <= bound);
     if args.json {
         println!("{}", json_report(&report, args, passed));
+    } else if args.quiet {
+        quiet_verdict(args, passed, "node max error", report.node_max_error);
     } else {
         let shape: Vec<String> = report.shape.iter().map(|n| n.to_string()).collect();
         println!(
