@@ -69,7 +69,7 @@ impl Default for BakeOptions {
         Self {
             ndfs: vec![Ndf::Ggx],
             maskings: vec![Masking::HeightCorrelated],
-            quantities: vec![Quantity::E, Quantity::EAvg],
+            quantities: Self::DEFAULT_QUANTITIES.to_vec(),
             size: Self::DEFAULT_SIZE,
             samples: QmcSettings::DEFAULT_SAMPLES,
             average_samples: 16 * QmcSettings::DEFAULT_SAMPLES,
@@ -97,6 +97,9 @@ impl BakeOptions {
 
     /// The default table size, 32 x 32.
     pub const DEFAULT_SIZE: usize = 32;
+    /// The tables baked per model by default: `E`, `E_avg` and the lookup-consistent
+    /// normalisation of the Kulla-Conty lobe (`f_ms_norm`, [`crate::table::normalisation`]).
+    pub const DEFAULT_QUANTITIES: [Quantity; 3] = [Quantity::E, Quantity::EAvg, Quantity::FMsNorm];
     /// The largest size accepted per axis.
     pub const MAX_SIZE: usize = 4096;
     /// The default IOR axis size, 16 (Cycles' glass tables are 16 x 16 x 16).
@@ -178,6 +181,13 @@ impl BakeOptions {
         }
         for model in self.models() {
             model.validate().map_err(Error::InvalidInput)?;
+        }
+        if self.quantities.contains(&Quantity::FMsNorm) && !self.quantities.contains(&Quantity::E) {
+            return Err(Error::InvalidInput(
+                "--quantity f-ms-norm is derived from the E table's lookup: bake e with it \
+                 (--quantity e,f-ms-norm)"
+                    .into(),
+            ));
         }
         if self.ndfs.is_empty() || self.maskings.is_empty() || self.quantities.is_empty() {
             return Err(Error::InvalidInput(
@@ -292,26 +302,36 @@ impl BakeOptions {
                 self.quantities()
                     .into_iter()
                     .filter(move |&q| q != Quantity::FAvg || Some(model) == first)
-                    .map(move |quantity| TableSpec {
-                        reference_digits,
-                        model,
-                        quantity,
-                        ior: quantity.has_ior().then_some(ior),
-                        fresnel: self.fresnel.filter(|_| quantity == Quantity::EF),
-                        roughness: quantity.has_roughness().then_some(roughness),
-                        mu: quantity.has_mu().then_some(mu),
-                        method: self.method,
-                        qmc: qmc(if quantity.has_mu() {
-                            self.samples
-                        } else {
-                            self.average_samples
-                        }),
+                    .map(move |quantity| {
+                        let spec = |quantity: Quantity| TableSpec {
+                            reference_digits,
+                            lookup_of: None,
+                            model,
+                            quantity,
+                            ior: quantity.has_ior().then_some(ior),
+                            fresnel: self.fresnel.filter(|_| quantity == Quantity::EF),
+                            roughness: quantity.has_roughness().then_some(roughness),
+                            mu: quantity.has_mu().then_some(mu),
+                            method: self.method,
+                            qmc: qmc(if quantity.has_mu() {
+                                self.samples
+                            } else {
+                                self.average_samples
+                            }),
+                        };
+                        match quantity {
+                            Quantity::FMsNorm => {
+                                crate::table::normalisation::spec_for(&spec(Quantity::E))
+                            }
+                            _ => spec(quantity),
+                        }
                     })
             })
             .collect()
     }
 
-    /// The quantities baked per model, in the order given, each once.
+    /// The quantities baked per model, in the order given, each once, except that `f_ms_norm`
+    /// comes last: it is derived from the `E` table.
     #[must_use]
     pub fn quantities(&self) -> Vec<Quantity> {
         let mut quantities: Vec<Quantity> = Vec::new();
@@ -320,14 +340,15 @@ impl BakeOptions {
                 quantities.push(q);
             }
         }
+        quantities.sort_by_key(|&q| q == Quantity::FMsNorm);
         quantities
     }
 
-    /// ` --quantity ...` for a command line, empty for the default `e,e-avg`, with the IOR axis
+    /// ` --quantity ...` for a command line, empty for the default `e,e-avg,f-ms-norm`, with the IOR axis
     /// flags when a quantity has that axis.
     fn quantity_flag(&self) -> String {
         let quantities = self.quantities();
-        if quantities == [Quantity::E, Quantity::EAvg] {
+        if quantities == Self::DEFAULT_QUANTITIES {
             return String::new();
         }
         let names: Vec<&str> = quantities.iter().map(|q| q.cli_name()).collect();
@@ -426,6 +447,22 @@ impl BakeOptions {
                 report.tables.push(table);
                 continue;
             }
+            if spec.quantity == Quantity::FMsNorm {
+                // Derived from the lookup of the E table baked (or reused) just before it.
+                let source = spec.lookup_of.as_deref();
+                let e = report
+                    .tables
+                    .iter()
+                    .find(|t| Some(&t.spec) == source)
+                    .expect("validate() requires E, and quantities() orders it first");
+                let table = crate::table::normalisation::derive(e, command);
+                if let Some(cache) = cache {
+                    cache.store(&key, &table)?;
+                }
+                report.baked.push(table.spec.id());
+                report.tables.push(table);
+                continue;
+            }
             let mut table = bake_table(spec, command, progress);
             table.requested_max_error = self.max_error;
             if let Some(bound) = self.max_error {
@@ -474,6 +511,7 @@ impl BakeOptions {
         self.resolved()
             .specs()
             .iter()
+            .filter(|s| s.quantity != Quantity::FMsNorm)
             .map(|s| s.len() as u64 * s.qmc.samples)
             .sum()
     }
@@ -635,6 +673,8 @@ pub fn estimated_core_seconds(spec: &TableSpec) -> f64 {
                 (Quantity::EAvgDielectric, _) => 0.1,
                 (Quantity::EAvgDielectricInside, _) => 1.0,
                 (Quantity::FAvg, _) => 1e-5,
+                // Integrals of the E table's lookup, not of the BRDF.
+                (Quantity::FMsNorm, _) => 0.2e-3,
                 _ => 0.3e-3,
             };
             let digits = spec.reference_digits.unwrap_or(10);

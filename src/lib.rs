@@ -31,7 +31,7 @@
 //!     Precision::F16,
 //!     kiln::format::replace::Replace::Refuse,
 //! )?;
-//! assert_eq!(written.len(), 4);
+//! assert_eq!(written.len(), 6); // E, E_avg and f_ms_norm, each as EXR and JSON
 //! # Ok::<(), kiln::Error>(())
 //! ```
 //!

@@ -29,8 +29,8 @@
 //! transmission = true           # glass: light refracts through (needs a dielectric fresnel)
 //! ```
 //!
-//! The plan ([`Scene::plan`]) lists each table once, with the materials that need it: `E` and
-//! `E_avg` for every NDF and masking combination in use (the Kulla-Conty lobe needs both, whatever
+//! The plan ([`Scene::plan`]) lists each table once, with the materials that need it: `E`,
+//! `E_avg` and `f_ms_norm` for every NDF and masking combination in use (the Kulla-Conty lobe needs them, whatever
 //! the Fresnel model), for the combinations a transmissive material uses the dielectric tables
 //! `E_dielectric`, `E_dielectric_inside` and their averages over (eta, roughness[, mu]) (energy
 //! compensation of glass, [`crate::model::dielectric`]), and per material the scalars it needs:
@@ -381,6 +381,7 @@ impl Scene {
                 let mut tables = vec![
                     planned(model, Quantity::E, false),
                     planned(model, Quantity::EAvg, false),
+                    planned(model, Quantity::FMsNorm, false),
                 ];
                 if transmissive.contains(&model) {
                     tables.extend(DIELECTRIC_QUANTITIES.map(|q| planned(model, q, true)));
@@ -649,13 +650,13 @@ fresnel = { schlick = { f0 = 0.04 } }
         let output = scene.output.as_ref().unwrap();
         assert_eq!(output.precision, Some(Precision::F16));
         let plan = scene.plan();
-        // GGX height-correlated (steel, plastic) and Beckmann height-correlated (varnish): E and
-        // E_avg each, merged.
-        assert_eq!(plan.tables.len(), 4);
+        // GGX height-correlated (steel, plastic) and Beckmann height-correlated (varnish): E,
+        // E_avg and f_ms_norm each, merged.
+        assert_eq!(plan.tables.len(), 6);
         let ggx_e = &plan.tables[0];
         assert_eq!((ggx_e.ndf, ggx_e.quantity), (Ndf::Ggx, Quantity::E));
         assert_eq!(ggx_e.materials, ["brushed_steel", "plastic"]);
-        assert_eq!(plan.tables[2].materials, ["varnish"]);
+        assert_eq!(plan.tables[3].materials, ["varnish"]);
         let varnish = &plan.materials[1];
         assert!((varnish.f_avg[0] - 0.091_777_959_3).abs() < 1e-9);
         assert_eq!(plan.materials[2].f_avg, [(20.0 * 0.04 + 1.0) / 21.0; 3]);
@@ -683,16 +684,18 @@ fresnel = { schlick = { f0 = 0.04 } }
             [
                 (Ndf::Ggx, Quantity::E),
                 (Ndf::Ggx, Quantity::EAvg),
+                (Ndf::Ggx, Quantity::FMsNorm),
                 (Ndf::Ggx, Quantity::EDielectric),
                 (Ndf::Ggx, Quantity::EDielectricInside),
                 (Ndf::Ggx, Quantity::EAvgDielectric),
                 (Ndf::Ggx, Quantity::EAvgDielectricInside),
                 (Ndf::Beckmann, Quantity::E),
                 (Ndf::Beckmann, Quantity::EAvg),
+                (Ndf::Beckmann, Quantity::FMsNorm),
             ]
         );
         assert_eq!(plan.tables[0].materials, ["steel", "window", "gem"]);
-        assert_eq!(plan.tables[2].materials, ["window", "gem"]);
+        assert_eq!(plan.tables[3].materials, ["window", "gem"]);
         assert!(plan.materials[1].transmission && !plan.materials[3].transmission);
         // The IOR axis reaches the gem's 3.4; the E tables' options are those of a scene
         // without glass (their cache keys do not change when glass is added).
@@ -723,7 +726,7 @@ fresnel = { schlick = { f0 = 0.04 } }
         )
         .unwrap();
         let plan = twins.plan();
-        assert_eq!(plan.tables.len(), 2);
+        assert_eq!(plan.tables.len(), 3);
         assert_eq!(plan.tables[1].materials, ["a", "b"]);
         assert_eq!(plan.materials[0].f_avg, [1.0; 3]);
     }

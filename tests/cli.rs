@@ -324,7 +324,11 @@ fn plan_lists_each_needed_table_once() {
     let (_, one) = plan("one.toml", &material("steel", "ggx", ""));
     assert_eq!(
         ids(&one),
-        ["ggx-height-correlated-E", "ggx-height-correlated-E_avg"]
+        [
+            "ggx-height-correlated-E",
+            "ggx-height-correlated-E_avg",
+            "ggx-height-correlated-f_ms_norm"
+        ]
     );
     assert_eq!(one["materials"][0]["name"], "steel");
     let (_, both) = plan(
@@ -336,8 +340,10 @@ fn plan_lists_each_needed_table_once() {
         [
             "ggx-height-correlated-E",
             "ggx-height-correlated-E_avg",
+            "ggx-height-correlated-f_ms_norm",
             "beckmann-separable-E",
-            "beckmann-separable-E_avg"
+            "beckmann-separable-E_avg",
+            "beckmann-separable-f_ms_norm"
         ]
     );
     let (_, twins) = plan(
@@ -345,7 +351,7 @@ fn plan_lists_each_needed_table_once() {
         &(material("a", "ggx", "fresnel = { schlick = { f0 = 0.04 } }")
             + &material("b", "ggx", "fresnel = { dielectric = { ior = 1.5 } }")),
     );
-    assert_eq!(twins["tables"].as_array().unwrap().len(), 2);
+    assert_eq!(twins["tables"].as_array().unwrap().len(), 3);
     assert_eq!(
         twins["tables"][0]["materials"],
         serde_json::json!(["a", "b"])
@@ -458,6 +464,7 @@ fn scene_bake_reports_reuse() {
             ".kiln-cache",
             "ggx-height-correlated-E.json",
             "ggx-height-correlated-E_avg.json",
+            "ggx-height-correlated-f_ms_norm.json",
             "materials.json"
         ]
     );
@@ -608,7 +615,7 @@ fn results_are_byte_identical_for_any_thread_count_and_run() {
     let default = run("default", None);
     let again = run("again", None);
     let names = files_in(&one);
-    assert_eq!(names.len(), 18);
+    assert_eq!(names.len(), 26);
     for other in [&three, &default, &again] {
         assert_eq!(files_in(other), names);
         for name in &names {

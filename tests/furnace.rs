@@ -18,7 +18,7 @@ fn furnace_integrates_the_lookup_and_reports_the_identity() {
     let e = committed("ggx-height-correlated-E");
     let avg = committed("ggx-height-correlated-E_avg");
     let report = furnace(&e, &avg, 2).unwrap();
-    assert_eq!(report.rows.len(), 65);
+    assert_eq!(report.normalisation, "E_avg");
     let Some(kiln::table::axis::Axis::Mu { mapping, .. }) = e.spec.mu else {
         unreachable!()
     };
@@ -45,12 +45,12 @@ fn furnace_integrates_the_lookup_and_reports_the_identity() {
     }
 }
 
-/// What kiln promises of its default tables: from r = 0.25 up the lobe restores energy within
-/// the E table's lookup-error goal (1e-3). Below, `1 - E_avg` is under 1.3e-2 and its relative
-/// mismatch is multiplied by `1 - E` of up to 0.11 in the grazing layer: the README gives the
-/// figures. At r = 0 (a mirror) there is no loss and no lobe (up to the limit row's residue).
+/// With the exact `E_avg`, the lobe restores energy within 1e-3 from r = 0.25 up only. Below,
+/// `1 - E_avg` is under 1.3e-2 and its relative mismatch with the lookup's average is
+/// multiplied by `1 - E` of up to 0.11 in the grazing layer (docs/verify.md gives the figures):
+/// why kiln ships `f_ms_norm`. At r = 0 (a mirror) there is no loss and no lobe.
 #[test]
-fn default_tables_restore_energy_from_r_one_quarter() {
+fn the_exact_average_restores_energy_from_r_one_quarter_only() {
     let e = committed("ggx-height-correlated-E");
     let avg = committed("ggx-height-correlated-E_avg");
     let report = furnace(&e, &avg, 2).unwrap();
@@ -60,13 +60,85 @@ fn default_tables_restore_energy_from_r_one_quarter() {
             assert!(row.deviation.abs() <= 1e-3, "{row:?}");
         }
     }
-    // The r = 0 row of E holds the limit alpha -> 0+, evaluated at alpha = 1e-7 where
-    // 1 - E <= 2 alpha^2 (1 + 1 / mu^2) away from grazing (4e-14 at mu = 1): no more than that.
-    assert!(
-        report.rows[0].deviation.abs() < 4e-14,
-        "{:?}",
-        report.rows[0]
-    );
+    assert!(report.max_deviation > 0.1, "{:?}", report.worst);
+    assert!(report.worst.roughness < 0.05, "{:?}", report.worst);
+    // The r = 0 row of E holds the limit alpha -> 0+; at mu = 1 that is the mirror, which
+    // loses nothing.
+    assert_eq!(report.rows[0].deviation, 0.0, "{:?}", report.rows[0]);
+}
+
+/// The goal of the lookup-consistent normalisation: with `f_ms_norm` the lobe closes the
+/// furnace within 1e-3 at every roughness of the ladder (quarter texels, 400 steps below
+/// r = 0.1, the midpoints of f_ms_norm's nodes) and every mu, 0 included.
+#[test]
+fn the_lookup_consistent_normalisation_closes_the_furnace() {
+    let e = committed("ggx-height-correlated-E");
+    let norm = committed("ggx-height-correlated-f_ms_norm");
+    let report = furnace(&e, &norm, 4).unwrap();
+    assert_eq!(report.normalisation, "f_ms_norm");
+    assert!(report.rows.len() > 1000);
+    assert!(report.max_deviation <= 1e-3, "{:?}", report.worst);
+    for band in &report.bands {
+        assert!(band.max_deviation <= 1e-3, "{band:?}");
+    }
+}
+
+/// The same, in half floats: the files of an f16 bake (f_ms_norm derived from the E values as
+/// stored) read back and tested as a renderer would sample them.
+#[test]
+fn the_normalisation_closes_the_furnace_in_half_floats() {
+    use kiln::format::replace::Replace;
+    use kiln::format::{Format, Precision, write_tables};
+    let tables = kiln::BakeOptions::default().bake(&|_| {}).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    write_tables(
+        dir.path(),
+        &tables,
+        &[Format::Exr],
+        Precision::F16,
+        Replace::Refuse,
+    )
+    .unwrap();
+    let read = |name: &str| {
+        read_kiln(&dir.path().join(format!("{name}.exr")))
+            .unwrap()
+            .unwrap()
+    };
+    let e = read("ggx-height-correlated-E");
+    let norm = read("ggx-height-correlated-f_ms_norm");
+    let report = furnace(&e, &norm, 4).unwrap();
+    assert!(report.max_deviation <= 1e-3, "{:?}", report.worst);
+}
+
+/// The lobe's albedo integrated independently: `E(mu_o) + ∫ f_ms mu_i dω_i`, with `E` the
+/// table's lookup, `f_ms` normalised by `f_ms_norm`'s lookup, and the integral over `mu_i` by a
+/// midpoint rule over geometrically spaced `mu` (not the furnace's Gauss-Kronrod split at the
+/// lookup's nodes), must be 1 within 1e-3 at low and high roughness, between nodes, at grazing
+/// and normal views.
+#[test]
+fn the_lobe_restores_the_lost_energy_by_an_independent_integral() {
+    use kiln::table::normalisation::normalisation_lookup;
+    let e = committed("ggx-height-correlated-E");
+    let norm = committed("ggx-height-correlated-f_ms_norm");
+    for r in [3e-4, 1e-3, 4.1e-3, 0.01, 0.02, 0.033, 0.05, 0.1, 0.3, 0.77] {
+        let alpha = r * r;
+        let one_minus_e_avg = normalisation_lookup(&norm, r);
+        // mu from 1e-14 to 1 in 2^17 geometric cells (below 1e-14 the weight mu dmu is nil).
+        let cells = 1 << 17;
+        let mu_at = |k: usize| 10f64.powf(-14.0 + 14.0 * k as f64 / cells as f64);
+        let mut average = 0.0;
+        for k in 0..cells {
+            let (mu0, mu1) = (mu_at(k), mu_at(k + 1));
+            average += e.lookup_one_minus((mu0 + mu1) / 2.0, r) * (mu1 * mu1 - mu0 * mu0);
+        }
+        for mu_o in [0.0, 1e-6, alpha, 0.05, 0.5, 1.0] {
+            let loss = e.lookup_one_minus(mu_o, r);
+            // ∫ f_ms mu_i dω_i = 2 pi ∫ loss_o loss_i mu_i dmu_i / (pi (1 - E_avg)).
+            let lobe = loss * average / one_minus_e_avg;
+            let deviation = lobe - loss;
+            assert!(deviation.abs() <= 1e-3, "r {r}, mu {mu_o}: {deviation:e}");
+        }
+    }
 }
 
 /// A mismatched pair is caught, with the sign of the energy error: an `E_avg` table whose

@@ -1,8 +1,10 @@
 //! The committed Rust tables compile when `include!`d, and hold the JSON sidecar's values.
 
+#[allow(dead_code)] // the f_ms_norm file's ONE_MINUS, STD_ERROR and axis constants are not read here
 mod ggx {
     include!("../tables/ggx-height-correlated-E.rs");
     include!("../tables/ggx-height-correlated-E_avg.rs");
+    include!("../tables/ggx-height-correlated-f_ms_norm.rs");
 }
 
 use kiln::format::json::Sidecar;
@@ -94,5 +96,31 @@ fn generated_lookups_match_the_library_lookup() {
         let got =
             ggx::ggx_height_correlated_e_avg_lookup(&ggx::GGX_HEIGHT_CORRELATED_E_AVG, r as f32);
         assert!(close(got, avg.lookup(1.0, r)), "E_avg at r {r}");
+    }
+}
+
+/// The generated `f_ms_norm` lookup gives back `1 - Ē`, as the library's `normalisation_lookup`
+/// does (in f32), at 2000 roughness values: the multiplication by `r` included. A lookup that
+/// forgot it would be off by a factor `1 / r`.
+#[test]
+fn generated_normalisation_lookup_matches_the_library() {
+    use kiln::table::normalisation::normalisation_lookup;
+    let path = format!(
+        "{}/tables/ggx-height-correlated-f_ms_norm.json",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let norm = read_kiln(std::path::Path::new(&path)).unwrap().unwrap();
+    for k in 0..=2000 {
+        // Denser near 0, where 1 - Ē spans orders of magnitude.
+        let r = (f64::from(k) / 2000.0).powi(2);
+        let got = f64::from(ggx::ggx_height_correlated_f_ms_norm_lookup(
+            &ggx::GGX_HEIGHT_CORRELATED_F_MS_NORM,
+            r as f32,
+        ));
+        let want = normalisation_lookup(&norm, r);
+        assert!(
+            (got - want).abs() <= 1e-5 * want + 1e-12,
+            "r {r}: {got} vs {want}"
+        );
     }
 }

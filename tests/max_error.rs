@@ -25,7 +25,11 @@ fn max_error_is_met_by_the_method_kiln_picks() {
         };
         assert_eq!(options.resolved().method, method, "{bound}");
         let tables = bake(bound);
-        for table in &tables {
+        // f_ms_norm is derived from the E table's lookup, not from the BRDF: no node check.
+        for table in tables
+            .iter()
+            .filter(|t| t.spec.quantity != Quantity::FMsNorm)
+        {
             assert_eq!(table.requested_max_error, Some(bound));
             let measured = table
                 .node_errors

@@ -98,7 +98,10 @@ fn bakes_and_refuses_beckmann() {
     };
     let tables = options.bake(&|_| {}).unwrap();
     assert_eq!(tables[0].spec.id(), "ggx-schlick-ggx-E");
-    for t in &tables {
+    for t in tables
+        .iter()
+        .filter(|t| t.spec.quantity != Quantity::FMsNorm)
+    {
         assert!(t.node_errors.unwrap().max <= 1e-6);
     }
     // Its split-sum channels add up to its E (Godot imports this model's DFG table).

@@ -398,8 +398,9 @@ fn max_error_gates_a_build_and_tables_compare_with_each_other() {
     assert!(report["against"].as_str().unwrap().starts_with("table"));
 }
 
-/// `--furnace` finds the E_avg table beside the E file (or takes --average), reports JSON, and
-/// gates on --max-error; a file not named like a kiln E table asks for --average.
+/// `--furnace` finds the normalisation beside the E file (`f_ms_norm`, else `E_avg`; or takes
+/// --average), reports JSON, and gates on --max-error; a file not named like a kiln E table
+/// asks for --average.
 #[test]
 fn furnace_flag_finds_the_average_and_gates() {
     let tables = Path::new(env!("CARGO_MANIFEST_DIR")).join("tables");
@@ -410,22 +411,60 @@ fn furnace_flag_finds_the_average_and_gates() {
         report["average"]
             .as_str()
             .unwrap()
-            .ends_with("ggx-height-correlated-E_avg.json")
+            .ends_with("ggx-height-correlated-f_ms_norm.json")
     );
+    assert_eq!(report["normalisation"], "f_ms_norm");
     let max = number(&report, "max_deviation");
-    assert!(max > 0.0 && max < 1.0, "{report}");
-    let (status, report) = verify(&["--furnace", e.to_str().unwrap(), "--max-error", "1e-9"]);
+    // Both forms by default; the worst of them is max_deviation. Turquin's 1 / E scaling
+    // leaves the lookup's relative error, E_true / E_lookup - 1: at least the audit's absolute
+    // lookup error (E <= 1), at most that over the smallest E (0.3 at r = 1, mu = 1).
+    let forms = report["forms"].as_array().unwrap();
+    assert_eq!(forms.len(), 2);
+    assert_eq!(forms[0]["form"], "kulla-conty");
+    assert_eq!(forms[1]["form"], "turquin");
+    let kulla_conty = number(&forms[0], "max_deviation");
+    assert!(kulla_conty > 0.0 && kulla_conty < 1e-3, "{kulla_conty}");
+    let turquin = number(&forms[1], "max_deviation");
+    assert_eq!(max, kulla_conty.max(turquin));
+    let (_, audit) = verify(&[e.to_str().unwrap()]);
+    let lookup = number(&audit, "lookup_max_error");
+    assert!(
+        turquin >= lookup && turquin <= lookup / 0.3,
+        "{turquin} vs {lookup}"
+    );
+    let (status, report) = verify(&[
+        "--furnace",
+        e.to_str().unwrap(),
+        "--form",
+        "kulla-conty",
+        "--max-error",
+        "1e-9",
+    ]);
     assert_eq!((status, &report["passed"]), (Some(1), &Value::Bool(false)));
-    // The binary copy, with its E_avg given explicitly: the same test within f32 rounding.
+    // The binary copies: the same test within f32 rounding.
     let bin = tables.join("ggx-height-correlated-E.bin");
-    let avg = tables.join("ggx-height-correlated-E_avg.bin");
+    let norm = tables.join("ggx-height-correlated-f_ms_norm.bin");
     let (_, from_bin) = verify(&[
         "--furnace",
         bin.to_str().unwrap(),
+        "--form",
+        "kulla-conty",
+        "--average",
+        norm.to_str().unwrap(),
+    ]);
+    assert!((number(&from_bin, "max_deviation") - kulla_conty).abs() < 0.05 * kulla_conty);
+    // With the exact E_avg instead, the lookup's mismatch shows at low roughness.
+    let avg = tables.join("ggx-height-correlated-E_avg.json");
+    let (_, exact) = verify(&[
+        "--furnace",
+        e.to_str().unwrap(),
+        "--form",
+        "kulla-conty",
         "--average",
         avg.to_str().unwrap(),
     ]);
-    assert!((number(&from_bin, "max_deviation") - max).abs() < 1e-4 * max);
+    assert_eq!(exact["normalisation"], "E_avg");
+    assert!(number(&exact, "max_deviation") > 0.1, "{exact}");
     let renamed = tempfile::tempdir().unwrap();
     let other = renamed.path().join("mine.json");
     std::fs::copy(&e, &other).unwrap();

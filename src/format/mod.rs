@@ -145,7 +145,8 @@ pub fn encode_all(
     precision: Precision,
 ) -> Result<Vec<(String, Vec<u8>)>> {
     let mut files = Vec::new();
-    for table in tables {
+    let tables = as_stored(tables, precision);
+    for table in &tables {
         let id = table.spec.id();
         let fail = |format: Format, message: String| Error::Format {
             path: PathBuf::from(format!("{id}.{}", format.name())),
@@ -190,6 +191,33 @@ pub fn encode_all(
         }
     }
     Ok(files)
+}
+
+/// The tables as files of `precision` hold them, where that changes what another table must
+/// say: the lookup-consistent normalisation (`f_ms_norm`) of an E table stored in half floats
+/// is derived from the E table's values as stored (rounded to f16, [`f16::encode`]), so that
+/// it is the average of the lookup a renderer of those files really makes.
+#[must_use]
+pub fn as_stored(tables: &[Table], precision: Precision) -> Vec<Table> {
+    tables
+        .iter()
+        .map(|table| {
+            let source = table.spec.lookup_of.as_deref();
+            let e = tables.iter().find(|t| Some(&t.spec) == source);
+            match (precision, table.spec.quantity, e) {
+                (Precision::F16, crate::table::Quantity::FMsNorm, Some(e)) => {
+                    let round = |v: &f64| f64::from(f16::encode(*v).0.to_f32());
+                    let stored = Table {
+                        value: e.value.iter().map(round).collect(),
+                        one_minus_value: e.one_minus_value.iter().map(round).collect(),
+                        ..e.clone()
+                    };
+                    crate::table::normalisation::derive(&stored, table.command.clone())
+                }
+                _ => table.clone(),
+            }
+        })
+        .collect()
 }
 
 /// Checks that `dir` exists or can be created, and that kiln can create files in it: called

@@ -166,7 +166,15 @@ fn write_lookup(out: &mut String, table: &Table, prefix: &str, ty: &str) {
             let _ = writeln!(out, "    let p = {t_r};");
             let _ = writeln!(out, "    let i = (p as usize).min({});", n_r - 2);
             let _ = writeln!(out, "    let f = p - i as f32;");
-            let _ = writeln!(out, "    table[i] * (1.0 - f) + table[i + 1] * f");
+            if spec.quantity == crate::table::Quantity::FMsNorm {
+                // (1 - Ē) / r is stored: give back 1 - Ē (crate::table::normalisation).
+                let _ = writeln!(
+                    out,
+                    "    roughness.clamp(0.0, 1.0) * (table[i] * (1.0 - f) + table[i + 1] * f)"
+                );
+            } else {
+                let _ = writeln!(out, "    table[i] * (1.0 - f) + table[i + 1] * f");
+            }
             let _ = writeln!(out, "}}");
         }
         Some(mu_axis) => {
@@ -436,5 +444,44 @@ pub fn encode(table: &Table) -> String {
         let _ = writeln!(out, ";");
     }
     write_lookup(&mut out, table, &prefix, &ty);
+    write_compensation(&mut out, table, &ty);
     out
+}
+
+/// Energy compensation beside the lookups (`crate::model::kulla_conty`): for an `f_ms_norm`
+/// table the Kulla-Conty lobe normalised by it and the lobe's Fresnel colour; for an `E` table
+/// (F = 1) Turquin's factor.
+fn write_compensation(out: &mut String, table: &Table, ty: &str) {
+    let stem = const_prefix(table).to_lowercase();
+    let lookup = lookup_name(table);
+    match table.spec.quantity {
+        crate::table::Quantity::FMsNorm => {
+            let _ = writeln!(
+                out,
+                "\n/// The Kulla-Conty lobe `f_ms(o, i) = (1 - E(mu_o)) (1 - E(mu_i)) / (pi (1 - Ebar))`, \
+                 normalised by this\n/// table (the average of the E table's own lookup): 0 on a \
+                 mirror, where `1 - Ebar` is 0.\n#[allow(clippy::all)]\npub fn {stem}_f_ms(table: \
+                 &{ty}, one_minus_e_o: f32, one_minus_e_i: f32, roughness: f32) -> f32 {{\n    \
+                 let norm = {lookup}(table, roughness);\n    if norm > 1e-30 {{\n        \
+                 one_minus_e_o * one_minus_e_i / (core::f32::consts::PI * norm)\n    }} else \
+                 {{\n        0.0\n    }}\n}}"
+            );
+            let _ = writeln!(
+                out,
+                "\n/// The colour of the lobe for a Fresnel model, per channel: `F_avg^2 E_avg / (1 - \
+                 F_avg (1 - E_avg))`\n/// (`E_avg` from the E_avg table).\n#[allow(clippy::all)]\n\
+                 pub fn {stem}_fresnel_colour(f_avg: [f32; 3], e_avg: f32) -> [f32; 3] {{\n    \
+                 f_avg.map(|f| f * f * e_avg / (1.0 - f * (1.0 - e_avg)).max(1e-30))\n}}"
+            );
+        }
+        crate::table::Quantity::E if table.spec.fresnel.is_none() => {
+            let _ = writeln!(
+                out,
+                "\n/// Turquin's energy compensation: scale single scattering by `1 + F0 (1 / E - 1)`, \
+                 `E` from this table.\n#[allow(clippy::all)]\npub fn {stem}_turquin(e: f32, f0: \
+                 [f32; 3]) -> [f32; 3] {{\n    f0.map(|f| 1.0 + f * (1.0 / e.max(1e-30) - 1.0))\n}}"
+            );
+        }
+        _ => {}
+    }
 }

@@ -201,6 +201,9 @@ pub fn encode(table: &Table, language: Language) -> String {
     let params = parameters(language, table);
     if axes.len() == 1 {
         write_array_lookup(&mut out, language, table, &stem, &params);
+        if spec.quantity == crate::table::Quantity::FMsNorm {
+            write_lobe(&mut out, language, &stem);
+        }
         return out;
     }
     let _ = writeln!(
@@ -268,7 +271,70 @@ pub fn encode(table: &Table, language: Language) -> String {
     if language != Language::Glsl {
         out += "}\n";
     }
+    if spec.quantity == crate::table::Quantity::E && spec.fresnel.is_none() {
+        write_turquin(&mut out, language, &stem);
+    }
     out
+}
+
+/// The Kulla-Conty lobe and its Fresnel colour term, beside an `f_ms_norm` lookup
+/// (`crate::model::kulla_conty`): `NAME_f_ms(1 - E(mu_o), 1 - E(mu_i), roughness)` normalised
+/// by this table's `1 - Ē` (0 where that is 0: a mirror loses nothing), and
+/// `NAME_fresnel_colour(F_avg, E_avg)` = `F_avg^2 E_avg / (1 - F_avg (1 - E_avg))` per channel.
+fn write_lobe(out: &mut String, language: Language, stem: &str) {
+    let f = language.float();
+    let v3 = language.vector(3);
+    let _ = writeln!(
+        out,
+        "\n// The Kulla-Conty lobe f_ms(o, i) = (1 - E(mu_o)) (1 - E(mu_i)) / (pi (1 - Ebar)), \
+         normalised by this table\n// (the average of the E table's own lookup), 0 on a mirror."
+    );
+    let params = [
+        ("one_minus_e_o", f.to_string()),
+        ("one_minus_e_i", f.to_string()),
+        ("roughness", f.to_string()),
+    ];
+    *out += &language.function(&format!("{stem}_f_ms"), &params, f);
+    *out += &language.local("norm", &format!("{stem}_lookup(roughness)"));
+    let _ = writeln!(
+        out,
+        "    return {};\n}}",
+        language.select(
+            "norm > 1e-30",
+            "one_minus_e_o * one_minus_e_i / (3.14159265 * norm)",
+            "0.0"
+        )
+    );
+    let _ = writeln!(
+        out,
+        "\n// The colour of the lobe for a Fresnel model: F_avg^2 E_avg / (1 - F_avg (1 - E_avg)) \
+         per channel\n// (E_avg from the E_avg table, F_avg per channel)."
+    );
+    let params = [("f_avg", v3.clone()), ("e_avg", f.to_string())];
+    *out += &language.function(&format!("{stem}_fresnel_colour"), &params, &v3);
+    let _ = writeln!(
+        out,
+        "    return f_avg * f_avg * e_avg / max({v3}(1.0, 1.0, 1.0) - f_avg * (1.0 - e_avg), \
+         {v3}(1e-30, 1e-30, 1e-30));\n}}"
+    );
+}
+
+/// Turquin's compensation factor beside an `E` lookup: single scattering times
+/// `1 + F0 (1 / E - 1)` (Turquin 2019; Fdez-Aguera 2019 for the split-sum form).
+fn write_turquin(out: &mut String, language: Language, stem: &str) {
+    let f = language.float();
+    let v3 = language.vector(3);
+    let _ = writeln!(
+        out,
+        "\n// Turquin's energy compensation: scale single scattering by 1 + F0 (1 / E - 1), E \
+         from this table."
+    );
+    let params = [("e", f.to_string()), ("f0", v3.clone())];
+    *out += &language.function(&format!("{stem}_turquin"), &params, &v3);
+    let _ = writeln!(
+        out,
+        "    return {v3}(1.0, 1.0, 1.0) + f0 * (1.0 / max(e, 1e-30) - 1.0);\n}}"
+    );
 }
 
 /// A 1-D table as a constant array with its linear interpolation (no texture).
@@ -303,6 +369,7 @@ fn write_array_lookup(
         Language::Glsl | Language::Hlsl => "int",
     };
     let i_value = format!("min({int}(floor(p)), {})", n - 2);
+    let scale = array_scale(table);
     match language {
         Language::Wgsl => {
             let _ = writeln!(out, "    let i = {i_value};");
@@ -311,7 +378,8 @@ fn write_array_lookup(
             let _ = writeln!(out, "    var values = {constant};");
             let _ = writeln!(
                 out,
-                "    return values[i] * (1.0 - f) + values[i + 1] * f;\n}}"
+                "    return {}(values[i] * (1.0 - f) + values[i + 1] * f);\n}}",
+                array_scale(table)
             );
             return;
         }
@@ -322,6 +390,16 @@ fn write_array_lookup(
     }
     let _ = writeln!(
         out,
-        "    return {constant}[i] * (1.0 - f) + {constant}[i + 1] * f;\n}}"
+        "    return {scale}({constant}[i] * (1.0 - f) + {constant}[i + 1] * f);\n}}"
     );
+}
+
+/// What the interpolated value of a 1-D table is multiplied by: the roughness coordinate for
+/// `f_ms_norm`, which stores `(1 - Ē) / r` ([`crate::table::normalisation`]), nothing otherwise.
+fn array_scale(table: &Table) -> &'static str {
+    if table.spec.quantity == crate::table::Quantity::FMsNorm {
+        "clamp(t, 0.0, 1.0) * "
+    } else {
+        ""
+    }
 }

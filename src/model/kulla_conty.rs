@@ -14,6 +14,19 @@
 //! 0 (a mirror; kiln stores exactly 0 at `alpha = 0`) or below f64's normal range, there is no
 //! loss to restore and `f_ms` is 0.
 
+//!
+//! Which `1 - E_avg` to pass: the one that matches the `E` the renderer looks up. The exact
+//! `E_avg` closes the furnace only for the exact `E`; with a table's bilinear lookup of `E`, the
+//! lobe must be normalised by the average of that lookup, `1 - Ē`, or it adds or removes energy
+//! in proportion to the mismatch. For kiln's default 32 x 32 GGX table the mismatch of the exact
+//! `E_avg` reaches +119 % at r = 1/31 (`1 - E_avg` 8.0e-6 against the lookup's 1.74e-5), an
+//! energy error of 0.128 at grazing views; with kiln's `f_ms_norm` table
+//! ([`crate::table::normalisation`], `normalisation_lookup`) the error stays below 1.2e-4 at
+//! every roughness and `mu` (`kiln verify --furnace tables/ggx-height-correlated-E.json`, 1018
+//! roughness values, quarter-texel and finer). So: `f_ms_norm` for the lobe's denominator, the
+//! `E_avg` table for the colour term [`fresnel_colour`] (where the physical average belongs)
+//! and for anything else that wants the true average.
+
 use std::f64::consts::PI;
 
 /// `1 / (pi (1 - E_avg))`, the lobe's normalisation: 0 where `1 - E_avg` is 0 or subnormal.

@@ -1,6 +1,7 @@
 //! Tables: what was computed (the spec), the values with their errors, and how to look them up.
 
 pub mod axis;
+pub mod normalisation;
 
 use crate::integrate::QmcSettings;
 use crate::model::{Model, RoughnessConvention};
@@ -60,6 +61,15 @@ pub enum Quantity {
     #[serde(rename = "E_F")]
     #[cfg_attr(feature = "cli", value(name = "e-f"))]
     EF,
+    /// The lookup-consistent normalisation of the Kulla-Conty lobe, `(1 - Ē(r)) / r`: `Ē` is
+    /// the cosine-weighted average of the E table's own bilinear lookup at roughness `r`, so
+    /// that `f_ms = (1 - E(mu_o)) (1 - E(mu_i)) / (pi (1 - Ē))` gives back exactly what that
+    /// lookup loses. Divided by `r` (its leading power), it interpolates linearly down to 0;
+    /// the lookup multiplies by `r` again. A 1-D table over a fine roughness axis, derived
+    /// from the E table of the same bake (needs e).
+    #[serde(rename = "f_ms_norm")]
+    #[cfg_attr(feature = "cli", value(name = "f-ms-norm"))]
+    FMsNorm,
 }
 
 impl Quantity {
@@ -77,6 +87,7 @@ impl Quantity {
             Quantity::EAvgDielectricInside => "E_avg_dielectric_inside",
             Quantity::FAvg => "F_avg",
             Quantity::EF => "E_F",
+            Quantity::FMsNorm => "f_ms_norm",
         }
     }
 
@@ -94,6 +105,7 @@ impl Quantity {
             Quantity::EAvgDielectricInside => "e-avg-dielectric-inside",
             Quantity::FAvg => "f-avg",
             Quantity::EF => "e-f",
+            Quantity::FMsNorm => "f-ms-norm",
         }
     }
 
@@ -149,6 +161,14 @@ impl Quantity {
                  directions i, F the table's Fresnel model (see fresnel), F = 1 inside f; \
                  one_minus_E_F is 1 - E_F"
             }
+            Quantity::FMsNorm => {
+                "lookup-consistent Kulla-Conty normalisation (1 - Ebar(r)) / r, Ebar(r) = 2 * \
+                 integral of E_lookup(mu, r) mu dmu the average of the E table's own bilinear \
+                 lookup (the table in lookup_of); multiply the lookup by r (the roughness \
+                 coordinate) to get 1 - Ebar, the denominator of f_ms = (1 - E(mu_o)) \
+                 (1 - E(mu_i)) / (pi (1 - Ebar)); not E_avg, which is the exact average; \
+                 one_minus_f_ms_norm is 1 - the value"
+            }
         }
     }
 
@@ -161,6 +181,7 @@ impl Quantity {
                 | Quantity::EAvgDielectric
                 | Quantity::EAvgDielectricInside
                 | Quantity::FAvg
+                | Quantity::FMsNorm
         )
     }
 
@@ -285,6 +306,9 @@ pub struct TableSpec {
     /// reference's own 1e-11).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub reference_digits: Option<u32>,
+    /// For a table derived from another table's lookup (`f_ms_norm`): that table's spec.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lookup_of: Option<Box<TableSpec>>,
 }
 
 impl TableSpec {
@@ -402,6 +426,10 @@ impl TableSpec {
     /// [`TableSpec::id`]).
     #[must_use]
     pub fn layout_tags(&self) -> Vec<&'static str> {
+        // A derived table is named after the layout of the table it derives from.
+        if let Some(source) = &self.lookup_of {
+            return source.layout_tags();
+        }
         let mut tags = Vec::new();
         if let Some(Axis::Roughness {
             convention: RoughnessConvention::Alpha,
@@ -486,18 +514,25 @@ impl TableSpec {
 
     /// The physical point `(alpha, mu)` at texture coordinates `t_roughness` and `t_mu` (the
     /// latter ignored for `E_avg`). On the row `alpha = 0` of an `adaptive` mu axis this is the
-    /// boundary layer's limit, taken at [`axis::LAYER_LIMIT_ALPHA`] (see [`axis`]).
+    /// boundary layer's limit, taken at [`axis::LAYER_LIMIT_ALPHA`] (see [`axis`]), except at
+    /// `t_mu = 1`, where the limit is the mirror at normal incidence (`alpha = 0`, `mu = 1`).
     #[must_use]
     pub fn point(&self, t_roughness: f64, t_mu: f64) -> (f64, Option<f64>) {
         debug_assert!(self.roughness.is_some(), "F_avg has no roughness axis");
         let alpha = self.roughness_convention().to_alpha(t_roughness);
         match self.mu {
             Some(Axis::Mu { mapping, .. }) => {
-                let alpha = if alpha == 0.0 && mapping.depends_on_roughness() {
-                    axis::LAYER_LIMIT_ALPHA
-                } else {
-                    alpha
-                };
+                if alpha == 0.0 && mapping.depends_on_roughness() {
+                    // The layer's limit at fixed t; at t = 1 (mu = 1 for every alpha > 0) that
+                    // limit is the mirror's: loss exactly 0, not the 2e-14 of alpha = 1e-7.
+                    if t_mu >= 1.0 {
+                        return (0.0, Some(1.0));
+                    }
+                    return (
+                        axis::LAYER_LIMIT_ALPHA,
+                        Some(mapping.mu(t_mu, axis::LAYER_LIMIT_ALPHA)),
+                    );
+                }
                 (alpha, Some(mapping.mu(t_mu, alpha)))
             }
             _ => (alpha, None),
@@ -641,6 +676,7 @@ mod tests {
     fn synthetic(grid: Grid, mapping: MuMapping) -> Table {
         let spec = TableSpec {
             reference_digits: None,
+            lookup_of: None,
             model: Model {
                 ndf: Ndf::Ggx,
                 masking: Masking::HeightCorrelated,

@@ -14,10 +14,13 @@
 //! What it shows: the deviation is `1 - E(mu_o)` times the relative mismatch of `1 - E_avg`. At
 //! small roughness `1 - E_avg` is tiny (7.4e-6 at `alpha = 1e-3`, GGX) while `1 - E(mu_o)`
 //! reaches 0.11 in the grazing layer, so a lookup error far below the table's `E` error becomes
-//! a visible energy error there.
+//! a visible energy error there (0.128 for the default tables with the exact `E_avg`). Normalised
+//! by kiln's `f_ms_norm` instead ([`crate::table::normalisation`]), the average of the lookup
+//! itself, the lobe closes the furnace to 1.2e-4. [`turquin`] checks the other compensation
+//! form, single scattering scaled by `1 / E`.
 
-use crate::integrate::gauss_kronrod::integrate_pieces;
 use crate::table::axis::Axis;
+use crate::table::normalisation::{normalisation_lookup, one_minus_lookup_average};
 use crate::table::{Quantity, Table};
 use crate::{Error, Result};
 use serde::Serialize;
@@ -28,7 +31,8 @@ pub struct FurnaceRow {
     /// Roughness in the `E` table's convention.
     pub roughness: f64,
     pub alpha: f64,
-    /// `1 - E_avg` from the `E_avg` table's lookup.
+    /// The lobe's normalisation `1 - E_avg` as the renderer looks it up: from the `f_ms_norm`
+    /// table, or from an `E_avg` table.
     pub one_minus_e_avg: f64,
     /// `1 - Ē = 2 ∫ (1 - E(mu)) mu dmu` of the `E` table's lookup.
     pub one_minus_e_avg_of_e: f64,
@@ -40,71 +44,105 @@ pub struct FurnaceRow {
     pub deviation: f64,
 }
 
+/// The roughness bands the report summarises (in the E table's roughness coordinate).
+pub const BAND_EDGES: [f64; 7] = [0.0, 0.01, 0.05, 0.1, 0.25, 0.5, 1.0];
+
+/// The worst deviation in one roughness band `[from, to)` (`[from, 1]` for the last).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct FurnaceBand {
+    pub from: f64,
+    pub to: f64,
+    pub max_deviation: f64,
+    pub worst_roughness: f64,
+    pub worst_mu: f64,
+}
+
 /// The furnace test over a roughness ladder.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct FurnaceReport {
+    /// What normalised the lobe: `f_ms_norm` (the average of the E table's lookup) or `E_avg`.
+    pub normalisation: String,
+    /// The worst deviation per roughness band ([`BAND_EDGES`]).
+    pub bands: Vec<FurnaceBand>,
     pub rows: Vec<FurnaceRow>,
     /// The largest `|deviation|` over every row.
     pub max_deviation: f64,
     pub worst: FurnaceRow,
 }
 
-/// Runs the furnace test of `e` (an `E` table) with `e_avg` (the `E_avg` table of the same
-/// model) at roughness `t = j / (density N)`, `j = 0 ..= density N` of the `E` table's axis, and
-/// at each roughness over `mu` at the same density plus grazing probes down to `mu = 0`.
+/// The roughness ladder of the furnace test of an E table with `rows` rows: steps of
+/// `1 / (density (rows - 1))` (at least four per texel) over [0, 1], 400 more steps below 0.1,
+/// where the loss of a mirror-like surface hides in the grazing layer, and the midpoints
+/// between the nodes of the `f_ms_norm` table of a nodes-grid E table.
+#[must_use]
+pub fn roughness_ladder(rows: usize, density: usize) -> Vec<f64> {
+    let steps = density.max(4) * (rows.max(2) - 1);
+    let mut ladder: Vec<f64> = (0..=steps).map(|j| j as f64 / steps as f64).collect();
+    ladder.extend((1..400).map(|j| 0.1 * j as f64 / 400.0));
+    // Halfway between the nodes of the f_ms_norm table, where its interpolation errs most.
+    let fine = crate::table::normalisation::SUBDIVISIONS * (rows.max(2) - 1);
+    ladder.extend((0..fine).map(|j| (j as f64 + 0.5) / fine as f64));
+    ladder.sort_by(f64::total_cmp);
+    ladder.dedup();
+    ladder
+}
+
+/// Runs the furnace test of `e` (an `E` table) with `normalisation`, the table that gives the
+/// lobe's `1 - E_avg`: kiln's `f_ms_norm` (the average of `e`'s own lookup,
+/// [`crate::table::normalisation`]) or an `E_avg` table of the same model (the exact average),
+/// at every roughness of [`roughness_ladder`] and at each over `mu` at the same density plus
+/// grazing probes down to `mu = 0`.
 ///
 /// # Errors
-/// When the tables are not an `E` and an `E_avg` table of the same model.
-pub fn furnace(e: &Table, e_avg: &Table, density: usize) -> Result<FurnaceReport> {
-    if e.spec.quantity != Quantity::E || e_avg.spec.quantity != Quantity::EAvg {
+/// When the tables are not an `E` table and an `E_avg` or `f_ms_norm` table of the same model.
+pub fn furnace(e: &Table, normalisation: &Table, density: usize) -> Result<FurnaceReport> {
+    let quantity = normalisation.spec.quantity;
+    if e.spec.quantity != Quantity::E || !matches!(quantity, Quantity::EAvg | Quantity::FMsNorm) {
         return Err(Error::InvalidInput(format!(
-            "the furnace test needs an E table and an E_avg table (got {} and {})",
+            "the furnace test needs an E table and its E_avg or f_ms_norm table (got {} and {})",
             e.spec.quantity.symbol(),
-            e_avg.spec.quantity.symbol()
+            quantity.symbol()
         )));
     }
-    if e.spec.model != e_avg.spec.model {
+    if e.spec.model != normalisation.spec.model {
         return Err(Error::InvalidInput(format!(
-            "the E table is for {} {} but the E_avg table for {} {}",
-            e.spec.model.ndf, e.spec.model.masking, e_avg.spec.model.ndf, e_avg.spec.model.masking
+            "the E table is for {} but the {} table for {}",
+            e.spec.model,
+            quantity.symbol(),
+            normalisation.spec.model
         )));
     }
     let Some(Axis::Mu {
         size: n_mu,
         mapping,
-        grid,
+        grid: _,
     }) = e.spec.mu
     else {
         unreachable!("an E table has a mu axis")
     };
     let convention = e.spec.roughness_convention();
-    let avg_convention = e_avg.spec.roughness_convention();
-    let steps = |n: usize| density.max(1) * n;
-    let rows: Vec<FurnaceRow> = (0..=steps(e.spec.roughness_axis().size()))
-        .map(|j| {
-            let roughness = j as f64 / steps(e.spec.roughness_axis().size()) as f64;
+    let norm_convention = normalisation.spec.roughness_convention();
+    let mu_steps = density.max(4) * n_mu;
+    let rows: Vec<FurnaceRow> = roughness_ladder(e.spec.roughness_axis().size(), density)
+        .into_iter()
+        .map(|roughness| {
             let alpha = convention.to_alpha(roughness);
             let loss = |mu: f64| e.lookup_one_minus(mu, roughness);
-            // The E lookup is smooth between the mu of its nodes (and of the clamp edges).
-            let mut breaks: Vec<f64> = (0..n_mu)
-                .map(|i| mapping.mu(grid.coordinate(i, n_mu), alpha))
-                .chain([0.0, 1.0])
-                .collect();
-            breaks.sort_by(f64::total_cmp);
-            breaks.dedup();
-            let integral =
-                integrate_pieces(&mut |mu: f64| [2.0 * mu * loss(mu)], &breaks, 1e-16, 20_000);
-            let of_e = integral.value[0];
-            let one_minus_e_avg = e_avg.lookup_one_minus(1.0, avg_convention.from_alpha(alpha));
+            let (of_e, _) = one_minus_lookup_average(e, roughness);
+            let at = norm_convention.from_alpha(alpha);
+            let one_minus_e_avg = match quantity {
+                Quantity::FMsNorm => normalisation_lookup(normalisation, at),
+                _ => normalisation.lookup_one_minus(1.0, at),
+            };
             // The lobe's albedo is (1 - E(mu_o)) * ratio; where 1 - E_avg = 0 (a mirror) f_ms is
             // taken as 0 (`kulla_conty::multiple_scattering`), so the ratio is 0.
-            let ratio = if one_minus_e_avg > 0.0 {
+            let ratio = if one_minus_e_avg >= f64::MIN_POSITIVE {
                 of_e / one_minus_e_avg
             } else {
                 0.0
             };
-            let mut mus: Vec<f64> = (0..=steps(n_mu))
-                .map(|k| mapping.mu(k as f64 / steps(n_mu) as f64, alpha))
+            let mut mus: Vec<f64> = (0..=mu_steps)
+                .map(|k| mapping.mu(k as f64 / mu_steps as f64, alpha))
                 .collect();
             mus.extend(super::grazing_probes());
             let (worst_mu, deviation) = mus
@@ -134,9 +172,189 @@ pub fn furnace(e: &Table, e_avg: &Table, density: usize) -> Result<FurnaceReport
         .iter()
         .max_by(|a, b| a.deviation.abs().total_cmp(&b.deviation.abs()))
         .expect("rows");
+    let bands = BAND_EDGES
+        .windows(2)
+        .filter_map(|edge| {
+            let (from, to) = (edge[0], edge[1]);
+            rows.iter()
+                .filter(|row| row.roughness >= from && (row.roughness < to || to == 1.0))
+                .max_by(|a, b| a.deviation.abs().total_cmp(&b.deviation.abs()))
+                .map(|row| FurnaceBand {
+                    from,
+                    to,
+                    max_deviation: row.deviation.abs(),
+                    worst_roughness: row.roughness,
+                    worst_mu: row.worst_mu,
+                })
+        })
+        .collect();
     Ok(FurnaceReport {
+        bands,
+        normalisation: quantity.symbol().to_string(),
         max_deviation: worst.deviation.abs(),
         worst,
         rows,
+    })
+}
+
+/// The audit of an `f_ms_norm` table against what it stands for: the average of its E table's
+/// lookup, `1 - Ē`, recomputed at its nodes and halfway between them (relative errors of
+/// [`normalisation_lookup`]; `x = 0`, where both are 0, is left out).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct NormalisationAudit {
+    pub quantity: String,
+    pub nodes: usize,
+    pub node_max_relative_error: f64,
+    pub lookup_points: usize,
+    pub lookup_max_relative_error: f64,
+    /// Where the lookup's relative error is largest.
+    pub worst_roughness: f64,
+}
+
+/// Audits `norm` (an `f_ms_norm` table) against the lookup of `e`, the E table it was derived
+/// from ([`NormalisationAudit`]).
+///
+/// # Errors
+/// When `norm` is not an `f_ms_norm` table derived from `e`.
+pub fn audit_normalisation(e: &Table, norm: &Table) -> Result<NormalisationAudit> {
+    if norm.spec.quantity != Quantity::FMsNorm || norm.spec.lookup_of.as_deref() != Some(&e.spec) {
+        return Err(Error::InvalidInput(format!(
+            "{} was not derived from the E table {} (another size, axis, model or accuracy)",
+            norm.spec.id(),
+            e.spec.id()
+        )));
+    }
+    let n = norm.spec.len();
+    let grid = norm.spec.roughness_axis().grid();
+    let relative = |x: f64| -> f64 {
+        let (truth, _) = one_minus_lookup_average(e, x);
+        let table = normalisation_lookup(norm, x);
+        if truth == 0.0 {
+            table.abs()
+        } else {
+            (table / truth - 1.0).abs()
+        }
+    };
+    let nodes: Vec<f64> = (1..n).map(|i| grid.coordinate(i, n)).collect();
+    let between: Vec<f64> = (0..n - 1)
+        .map(|i| (grid.coordinate(i, n) + grid.coordinate(i + 1, n)) / 2.0)
+        .collect();
+    let node_max_relative_error = nodes.iter().map(|&x| relative(x)).fold(0.0, f64::max);
+    let (worst_roughness, lookup_max_relative_error) = between
+        .iter()
+        .map(|&x| (x, relative(x)))
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+        .unwrap_or((0.0, 0.0));
+    Ok(NormalisationAudit {
+        quantity: Quantity::FMsNorm.symbol().to_string(),
+        nodes: nodes.len(),
+        node_max_relative_error,
+        lookup_points: between.len(),
+        lookup_max_relative_error,
+        worst_roughness,
+    })
+}
+
+/// The energy-compensation forms the furnace test checks.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+pub enum Form {
+    /// Kulla and Conty 2017: an added lobe `f_ms`, normalised by the `E_avg` or `f_ms_norm`
+    /// table.
+    KullaConty,
+    /// Turquin 2019 (Filament, Unreal 5, Bevy, three.js, Cycles 4): single scattering scaled by
+    /// `1 / E(mu_o)` (for `F = 1`; `1 + F0 (1 / E - 1)` in general), checked as
+    /// `E_true(mu_o) / E_lookup(mu_o) - 1`.
+    Turquin,
+}
+
+impl Form {
+    /// The name in reports.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Form::KullaConty => "kulla-conty",
+            Form::Turquin => "turquin",
+        }
+    }
+}
+
+/// The worst deviation of one compensation form.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct FormReport {
+    pub form: Form,
+    pub max_deviation: f64,
+    pub worst_mu: f64,
+    pub worst_roughness: f64,
+    /// Where the worst deviation is: the compensated albedo's excess over 1 (negative: energy
+    /// still lost).
+    pub deviation: f64,
+}
+
+impl FormReport {
+    /// The Kulla-Conty form's summary of a [`FurnaceReport`].
+    #[must_use]
+    pub fn of_kulla_conty(report: &FurnaceReport) -> Self {
+        Self {
+            form: Form::KullaConty,
+            max_deviation: report.max_deviation,
+            worst_mu: report.worst.worst_mu,
+            worst_roughness: report.worst.roughness,
+            deviation: report.worst.deviation,
+        }
+    }
+}
+
+/// The furnace test of Turquin's compensation with an E table's lookup: single scattering
+/// scaled by `1 / E_lookup(mu_o)` returns `E_true(mu_o) / E_lookup(mu_o)` of the incident
+/// energy (`F = 1`), so the deviation is `E_true / E_lookup - 1`, the relative error of the
+/// lookup. Checked at the points of `kiln verify`'s lookup audit ([`super::lookup_coordinates`]:
+/// a ladder of `1 / density` texel over both axes, ends included, and grazing probes down to
+/// `mu = 0` on every roughness rung) against the reference quadrature; in parallel,
+/// deterministic. `progress` is called once per point.
+///
+/// # Errors
+/// When `e` is not an `E` table.
+pub fn turquin(
+    e: &Table,
+    settings: &super::AuditSettings,
+    progress: &(dyn Fn() + Sync),
+) -> Result<FormReport> {
+    use rayon::prelude::*;
+    if e.spec.quantity != Quantity::E {
+        return Err(Error::InvalidInput(format!(
+            "Turquin's compensation divides by E: the furnace test needs an E table (got {})",
+            e.spec.quantity.symbol()
+        )));
+    }
+    let convention = e.spec.roughness_convention();
+    let reference = crate::integrate::reference::ReferenceSettings::default();
+    let deviations: Vec<(f64, f64, f64)> = super::lookup_coordinates(&e.spec, settings)
+        .into_par_iter()
+        .map(|at| {
+            let roughness = convention.from_alpha(at.alpha);
+            let mu = at.mu.unwrap_or(1.0);
+            let truth = super::reference_value(&e.spec, at.alpha, at.mu, None, &reference).value;
+            let lookup = e.lookup(mu, roughness);
+            progress();
+            let deviation = if lookup > 0.0 {
+                truth / lookup - 1.0
+            } else {
+                0.0
+            };
+            (mu, roughness, deviation)
+        })
+        .collect();
+    let (worst_mu, worst_roughness, deviation) = deviations
+        .into_iter()
+        .max_by(|a, b| a.2.abs().total_cmp(&b.2.abs()))
+        .unwrap_or((0.0, 0.0, 0.0));
+    Ok(FormReport {
+        form: Form::Turquin,
+        max_deviation: deviation.abs(),
+        worst_mu,
+        worst_roughness,
+        deviation,
     })
 }

@@ -451,6 +451,7 @@ fn spec_and_values(
     };
     let spec = |roughness, mu| TableSpec {
         reference_digits: None,
+        lookup_of: None,
         model: layout.model,
         quantity: layout.quantity,
         fresnel: layout.fresnel,

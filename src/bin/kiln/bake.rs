@@ -48,8 +48,9 @@ pub struct BakeArgs {
     /// outside, relative index eta, and from inside, 1 / eta), e-avg-dielectric and
     /// e-avg-dielectric-inside over (eta, roughness), and f-avg, the exact dielectric F_avg(eta).
     /// e-f: the Fresnel-weighted albedo E_F = integral of F(o.h) f mu_i for the model the
-    /// Fresnel flags name (one channel: one value per parameter) [default: e,e-avg, or e-f when
-    /// a Fresnel flag is given].
+    /// Fresnel flags name (one channel: one value per parameter). f-ms-norm: the
+    /// lookup-consistent normalisation of the Kulla-Conty lobe, (1 - average of the E lookup)
+    /// / r, derived from e [default: e,e-avg,f-ms-norm, or e-f when a Fresnel flag is given].
     #[arg(long, value_enum, value_delimiter = ',')]
     quantity: Option<Vec<Quantity>>,
     #[command(flatten)]
@@ -209,7 +210,7 @@ pub fn run(args: BakeArgs) -> kiln::Result<()> {
             if args.fresnel.given() {
                 vec![Quantity::EF]
             } else {
-                vec![Quantity::E, Quantity::EAvg]
+                BakeOptions::DEFAULT_QUANTITIES.to_vec()
             }
         }),
         fresnel: if args.fresnel.given() {

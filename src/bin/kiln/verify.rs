@@ -33,12 +33,17 @@ pub struct VerifyArgs {
     /// What to compare with: 'reference' (the deterministic quadrature) or another table's file.
     #[arg(long, default_value = "reference")]
     against: String,
-    /// White furnace test instead of an audit: with FILE's E table and its E_avg table (found
-    /// beside it, `...-E_avg` with the same extension, or given with --average), check that
-    /// the Kulla-Conty lobe f_ms restores exactly the energy E loses, over roughness and mu.
-    /// Reports the worst deviation E + albedo(f_ms) - 1; --max-error applies to it.
+    /// White furnace test instead of an audit: does energy compensation with FILE's E table
+    /// give back exactly what single scattering loses? kulla-conty: the lobe f_ms normalised
+    /// by the f_ms_norm table (else E_avg) found beside FILE or given with --average,
+    /// E + albedo(f_ms) - 1 over a fine roughness and mu ladder; turquin: single scattering
+    /// scaled by 1 / E_lookup, E_true / E_lookup - 1 at the lookup audit's points (against the
+    /// reference: seconds). --max-error applies to the worst over the forms checked.
     #[arg(long, conflicts_with = "against")]
     furnace: bool,
+    /// With --furnace: the compensation forms to check, comma-separated [default: both].
+    #[arg(long, value_enum, value_delimiter = ',', requires = "furnace")]
+    form: Option<Vec<kiln::verify::furnace::Form>>,
     /// The E_avg table for --furnace (default: beside FILE).
     #[arg(long, requires = "furnace")]
     average: Option<PathBuf>,
@@ -289,50 +294,142 @@ fn describe(point: &Point, convention: &str) -> String {
     )
 }
 
-/// Where the `E_avg` table of a kiln `E` file is: `NAME-E.EXT` -> `NAME-E_avg.EXT`.
-fn sibling_average(path: &Path) -> kiln::Result<PathBuf> {
+/// The file beside a kiln `E` table's file (`NAME.EXT`, named as kiln names it) holding its
+/// normalisation: `f_ms_norm` if it is there, else `E_avg`.
+fn sibling_normalisation(path: &Path, table: &Table) -> kiln::Result<PathBuf> {
     let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("");
     let extension = path.extension().and_then(|e| e.to_str()).unwrap_or("");
-    match stem.strip_suffix("-E") {
-        Some(base) => Ok(path.with_file_name(format!("{base}-E_avg.{extension}"))),
-        None => Err(kiln::Error::InvalidInput(format!(
-            "{} is not named like a kiln E table (NAME-E.EXT): give its E_avg table with --average",
-            path.display()
-        ))),
+    if stem != table.spec.id() {
+        return Err(kiln::Error::InvalidInput(format!(
+            "{} is not named as kiln names its E table ({}.{extension}): give its f_ms_norm or \
+             E_avg table with --average",
+            path.display(),
+            table.spec.id()
+        )));
     }
+    let norm = kiln::table::normalisation::spec_for(&table.spec).id();
+    let average = kiln::TableSpec {
+        quantity: Quantity::EAvg,
+        mu: None,
+        ..table.spec.clone()
+    }
+    .id();
+    let candidates = [norm, average].map(|id| path.with_file_name(format!("{id}.{extension}")));
+    candidates
+        .iter()
+        .find(|candidate| candidate.is_file())
+        .cloned()
+        .ok_or_else(|| {
+            kiln::Error::InvalidInput(format!(
+                "found neither {} nor {} beside {}: give the normalisation with --average",
+                candidates[0].display(),
+                candidates[1].display(),
+                path.display()
+            ))
+        })
 }
 
 fn run_furnace(args: &VerifyArgs, table: &Table) -> kiln::Result<bool> {
-    let average_path = match &args.average {
-        Some(path) => path.clone(),
-        None => sibling_average(&args.file)?,
+    use kiln::verify::furnace::{Form, FormReport, turquin};
+    let forms = args
+        .form
+        .clone()
+        .unwrap_or_else(|| vec![Form::KullaConty, Form::Turquin]);
+    let kulla_conty = match forms.contains(&Form::KullaConty) {
+        true => {
+            let average_path = match &args.average {
+                Some(path) => path.clone(),
+                None => sibling_normalisation(&args.file, table)?,
+            };
+            let average = args.load(&average_path)?;
+            Some((
+                average_path,
+                furnace(table, &average, args.density as usize)?,
+            ))
+        }
+        false => None,
     };
-    let average = args.load(&average_path)?;
-    let report = furnace(table, &average, args.density as usize)?;
-    let passed = args
-        .max_error
-        .is_none_or(|bound| report.max_deviation <= bound);
+    let turquin_report = match forms.contains(&Form::Turquin) {
+        true => {
+            let settings = AuditSettings {
+                clamp_min: args.clamp_min,
+                density: args.density as usize,
+            };
+            let bar = crate::progress_bar(
+                args.quiet || args.json,
+                kiln::verify::lookup_coordinates(&table.spec, &settings).len() as u64,
+                "turquin",
+            );
+            let report = turquin(table, &settings, &|| bar.inc(1))?;
+            bar.finish_and_clear();
+            Some(report)
+        }
+        false => None,
+    };
+    let form_reports: Vec<FormReport> = kulla_conty
+        .iter()
+        .map(|(_, report)| FormReport::of_kulla_conty(report))
+        .chain(turquin_report)
+        .collect();
+    let max_deviation = form_reports
+        .iter()
+        .fold(0.0, |max: f64, f| max.max(f.max_deviation));
+    let passed = args.max_error.is_none_or(|bound| max_deviation <= bound);
     if args.json {
-        let mut object = json_report(&report, args, passed);
-        object["average"] = average_path.display().to_string().into();
+        let mut object = match &kulla_conty {
+            Some((path, report)) => {
+                let mut object = json_report(report, args, passed);
+                object["average"] = path.display().to_string().into();
+                object
+            }
+            None => json_report(&serde_json::json!({}), args, passed),
+        };
+        object["max_deviation"] = max_deviation.into();
+        object["forms"] = serde_json::to_value(&form_reports).expect("reports serialise");
         println!("{object}");
         return Ok(passed);
     }
     if args.quiet {
-        quiet_verdict(args, passed, "furnace max deviation", report.max_deviation);
+        quiet_verdict(args, passed, "furnace max deviation", max_deviation);
         return Ok(passed);
     }
+    if let Some((path, report)) = &kulla_conty {
+        print_kulla_conty(args, table, path, report);
+    }
+    if let Some(t) = turquin_report {
+        println!(
+            "{}: white furnace test of Turquin's 1 / E scaling: max |E_true / E_lookup - 1| = \
+             {:.2e} at mu = {:.3e}, {} = {:.4} (the lookup audit's points against the reference)",
+            args.file.display(),
+            t.max_deviation,
+            t.worst_mu,
+            table.spec.roughness_convention().name(),
+            t.worst_roughness
+        );
+    }
+    print_verdict(args.max_error, passed, "max deviation", max_deviation);
+    Ok(passed)
+}
+
+/// The text report of the Kulla-Conty form.
+fn print_kulla_conty(
+    args: &VerifyArgs,
+    table: &Table,
+    average_path: &Path,
+    report: &kiln::verify::furnace::FurnaceReport,
+) {
     let convention = table.spec.roughness_convention().name();
     println!(
-        "{} with {}: white furnace test of the Kulla-Conty lobe, {} roughness values",
+        "{} with {} ({}): white furnace test of the Kulla-Conty lobe, {} roughness values",
         args.file.display(),
         average_path.display(),
+        report.normalisation,
         report.rows.len()
     );
     let w = &report.worst;
     println!(
         "  max |E + albedo(f_ms) - 1| = {:.2e} at mu = {:.3e}, {convention} = {:.4} (alpha {:.3e}): \
-         1 - E_avg is {:.4e} in the table, {:.4e} as the average of the E lookup (mismatch {:+.2e})",
+         the lobe's 1 - E_avg is {:.4e}, the average of the E lookup {:.4e} (mismatch {:+.2e})",
         report.max_deviation,
         w.worst_mu,
         w.roughness,
@@ -342,27 +439,15 @@ fn run_furnace(args: &VerifyArgs, table: &Table) -> kiln::Result<bool> {
         w.relative_mismatch
     );
     println!(
-        "  {convention:>8} {:>12} {:>12} {:>11} {:>11}",
-        "1-E_avg", "1-avg(E)", "mismatch", "deviation"
+        "  {:>15} {:>13} {:>10} {:>10}",
+        convention, "max |dev|", "at r", "at mu"
     );
-    let step = (report.rows.len() / 16).max(1);
-    for row in report.rows.iter().step_by(step) {
+    for band in &report.bands {
         println!(
-            "  {:>8.4} {:>12.4e} {:>12.4e} {:>+11.2e} {:>+11.2e}",
-            row.roughness,
-            row.one_minus_e_avg,
-            row.one_minus_e_avg_of_e,
-            row.relative_mismatch,
-            row.deviation
+            "  {:>6.2} - {:<6.2} {:>13.2e} {:>10.5} {:>10.3e}",
+            band.from, band.to, band.max_deviation, band.worst_roughness, band.worst_mu
         );
     }
-    print_verdict(
-        args.max_error,
-        passed,
-        "max deviation",
-        report.max_deviation,
-    );
-    Ok(passed)
 }
 
 /// The `--max-error` line of the text report.
@@ -428,8 +513,8 @@ pub fn run(args: VerifyArgs) -> kiln::Result<bool> {
     let table = args.load(&args.file)?;
     if args.furnace && table.spec.quantity != Quantity::E {
         return Err(kiln::Error::InvalidInput(format!(
-            "--furnace tests an E table with its E_avg: {} holds {}; give the E file (NAME-E.EXT), \
-             whose E_avg is found beside it or given with --average",
+            "--furnace tests an E table with its normalisation: {} holds {}; give the E file \
+             (NAME-E.EXT), whose f_ms_norm or E_avg is found beside it or given with --average",
             args.file.display(),
             table.spec.quantity.symbol()
         )));
@@ -437,7 +522,74 @@ pub fn run(args: VerifyArgs) -> kiln::Result<bool> {
     if args.furnace {
         return run_furnace(&args, &table);
     }
+    if table.spec.quantity == Quantity::FMsNorm && args.against == "reference" {
+        return run_normalisation_audit(&args, &table);
+    }
     audit_one(&args, &table)
+}
+
+/// Audits an `f_ms_norm` table against the average of its E table's lookup (the E table beside
+/// it, named as kiln names it), and prints the report; whether it passed `--max-error`
+/// (relative error of the lookup).
+fn run_normalisation_audit(args: &VerifyArgs, table: &Table) -> kiln::Result<bool> {
+    let source = table.spec.lookup_of.as_deref().ok_or_else(|| {
+        kiln::Error::InvalidInput(format!("{}: no lookup_of in its spec", args.file.display()))
+    })?;
+    let extension = args
+        .file
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("json");
+    let e_path = args
+        .file
+        .with_file_name(format!("{}.{extension}", source.id()));
+    if !e_path.is_file() {
+        return Err(kiln::Error::InvalidInput(format!(
+            "{} is the normalisation of an E table's lookup: its E table {} must be beside it",
+            args.file.display(),
+            e_path.display()
+        )));
+    }
+    let e = args.load(&e_path)?;
+    let report = kiln::verify::furnace::audit_normalisation(&e, table)?;
+    let passed = args
+        .max_error
+        .is_none_or(|bound| report.lookup_max_relative_error <= bound);
+    if args.json {
+        println!("{}", json_report(&report, args, passed));
+    } else if args.quiet {
+        quiet_verdict(
+            args,
+            passed,
+            "lookup relative error",
+            report.lookup_max_relative_error,
+        );
+    } else {
+        println!(
+            "{}: f_ms_norm, {} entries, against the average of the lookup of {}",
+            args.file.display(),
+            report.nodes + 1,
+            e_path.display()
+        );
+        println!(
+            "  nodes   {:>6}: max relative error {:.2e}",
+            report.nodes, report.node_max_relative_error
+        );
+        println!(
+            "  lookups {:>6}: max relative error {:.2e} at {} = {:.6}",
+            report.lookup_points,
+            report.lookup_max_relative_error,
+            table.spec.roughness_convention().name(),
+            report.worst_roughness
+        );
+        print_verdict(
+            args.max_error,
+            passed,
+            "lookup relative error",
+            report.lookup_max_relative_error,
+        );
+    }
+    Ok(passed)
 }
 
 /// Audits an engine file's channel that is not one of kiln's tables (Filament's and Godot's

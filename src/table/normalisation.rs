@@ -1,0 +1,123 @@
+//! The lookup-consistent normalisation of the Kulla-Conty lobe (`f_ms_norm`).
+//!
+//! Kulla and Conty 2017 ("Revisiting Physically Based Shading at Imageworks"; `docs/physics.md`,
+//! "Kulla-Conty quantities") normalise `f_ms(o, i) = (1 - E(mu_o)) (1 - E(mu_i)) / (pi (1 -
+//! E_avg))` so that its albedo is exactly `1 - E(mu_o)` when `1 - E_avg = 2 ∫ (1 - E(mu)) mu
+//! dmu`. A renderer evaluates `E` through a table's bilinear lookup, whose average `Ē` differs
+//! from the true `E_avg`; at low roughness, where `1 - E_avg` is tiny (7.4e-6 at `alpha = 1e-3`)
+//! while `1 - E(mu_o)` stays near 0.11 in the grazing layer, that relative mismatch becomes an
+//! energy error of up to 0.12 (`kiln verify --furnace` with `E_avg`, `docs/verify.md`). The
+//! normalisation that closes the furnace for the lookup the renderer really uses is
+//! `1 - Ē(r) = 2 ∫ (1 - E_lookup(mu, r)) mu dmu`.
+//!
+//! Its table: `g(x) = (1 - Ē(x)) / x` over the E table's roughness coordinate `x` (`r` or
+//! `alpha`), on nodes that subdivide every cell of the E table's roughness axis
+//! [`SUBDIVISIONS`] times (497 entries for a 32-row table; so the kinks of the bilinear lookup, at the E table's rows, fall on
+//! nodes and the linear interpolation between them is smooth). Why divided by `x`: between the
+//! E table's first two rows the lookup blends row 1 in with weight proportional to `x`, so
+//! `1 - Ē` starts linearly in `x` (3.4e-5 x for the default GGX table) and then grows like
+//! `alpha`; divided by `x` it is close to linear over the first cell, where `1 - Ē` itself
+//! varies over orders of magnitude. `g(0)` is the limit, the slope of `1 - Ē` at 0; the product
+//! `x g(x)` is 0 at `x = 0` (a mirror loses nothing). The lookup is
+//! [`normalisation_lookup`]: `x` times the linear interpolation of `g`.
+
+use super::axis::{Axis, Grid};
+use super::{Quantity, Table, TableSpec};
+use crate::integrate::gauss_kronrod::integrate_pieces;
+
+/// Nodes of the normalisation table per cell of the E table's roughness axis.
+pub const SUBDIVISIONS: usize = 16;
+
+/// `1 - Ē(roughness) = 2 ∫ (1 - E_lookup(mu, roughness)) mu dmu` of an E table's bilinear
+/// lookup ([`Table::lookup_one_minus`]), integrated by adaptive Gauss-Kronrod over `mu`, split
+/// at the `mu` of the table's columns at that roughness (where the lookup has kinks), to an
+/// absolute accuracy of 1e-16. Returns the value and the quadrature's error estimate.
+#[must_use]
+pub fn one_minus_lookup_average(e: &Table, roughness: f64) -> (f64, f64) {
+    let Some(Axis::Mu {
+        size,
+        mapping,
+        grid,
+    }) = e.spec.mu
+    else {
+        return (0.0, 0.0);
+    };
+    let alpha = e.spec.roughness_convention().to_alpha(roughness);
+    let mut breaks: Vec<f64> = (0..size)
+        .map(|i| mapping.mu(grid.coordinate(i, size), alpha))
+        .chain([0.0, 1.0])
+        .collect();
+    breaks.sort_by(f64::total_cmp);
+    breaks.dedup();
+    let integral = integrate_pieces(
+        &mut |mu: f64| [2.0 * mu * e.lookup_one_minus(mu, roughness)],
+        &breaks,
+        1e-16,
+        20_000,
+    );
+    (integral.value[0], integral.error)
+}
+
+/// The spec of the normalisation table of the E table `e`.
+#[must_use]
+pub fn spec_for(e: &TableSpec) -> TableSpec {
+    let rows = e.roughness_axis();
+    let size = match rows.grid() {
+        Grid::Nodes => (rows.size() - 1) * SUBDIVISIONS + 1,
+        // Row j at (j + 0.5) / N is node (j + 1/2) * SUBDIVISIONS of N * SUBDIVISIONS.
+        Grid::Centers => rows.size() * SUBDIVISIONS + 1,
+    };
+    TableSpec {
+        quantity: Quantity::FMsNorm,
+        ior: None,
+        mu: None,
+        fresnel: None,
+        roughness: Some(Axis::Roughness {
+            size,
+            convention: e.roughness_convention(),
+            grid: Grid::Nodes,
+        }),
+        lookup_of: Some(Box::new(e.clone())),
+        ..e.clone()
+    }
+}
+
+/// The normalisation table of the E table `e` (see the module docs); `command` is recorded in
+/// it. Its `std_error` holds the quadrature's error estimate divided by `x`.
+#[must_use]
+pub fn derive(e: &Table, command: String) -> Table {
+    let spec = spec_for(&e.spec);
+    let n = spec.len();
+    let grid = Grid::Nodes;
+    let mut value = vec![0.0; n];
+    let mut std_error = vec![0.0; n];
+    for i in 1..n {
+        let x = grid.coordinate(i, n);
+        let (loss, error) = one_minus_lookup_average(e, x);
+        value[i] = loss / x;
+        std_error[i] = error / x;
+    }
+    // g(0) is the limit of (1 - Ē(x)) / x, the slope of 1 - Ē at 0: taken at a point 1e-4 of
+    // the first cell in (where the next term of 1 - Ē, of order x^2, is 1e-4 times smaller).
+    let x = 1e-4 * grid.coordinate(1, n);
+    let (loss, error) = one_minus_lookup_average(e, x);
+    value[0] = loss / x;
+    std_error[0] = error / x;
+    Table {
+        one_minus_value: value.iter().map(|v| 1.0 - v).collect(),
+        value,
+        std_error,
+        spec,
+        command,
+        node_errors: None,
+        requested_max_error: None,
+    }
+}
+
+/// `1 - Ē` at `roughness` (in the table's convention) from a normalisation table: `roughness`
+/// times its linear interpolation. The denominator of `f_ms` is `pi` times this
+/// ([`crate::model::kulla_conty::normalisation`]).
+#[must_use]
+pub fn normalisation_lookup(norm: &Table, roughness: f64) -> f64 {
+    roughness.clamp(0.0, 1.0) * norm.lookup(0.0, roughness)
+}
