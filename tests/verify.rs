@@ -472,3 +472,42 @@ fn furnace_flag_finds_the_average_and_gates() {
     assert_eq!(output.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&output.stderr).contains("--average"));
 }
+
+/// `--furnace --plot` draws the deviation maps (SVG text names each form and its worst
+/// deviation); a plot file that is neither .svg nor .png is refused before any work.
+#[test]
+fn furnace_plot_draws_each_form() {
+    let tables = Path::new(env!("CARGO_MANIFEST_DIR")).join("tables");
+    let e = tables.join("ggx-height-correlated-E.json");
+    let dir = tempfile::tempdir().unwrap();
+    let svg = dir.path().join("furnace.svg");
+    let output = kiln(&[
+        "verify",
+        "--furnace",
+        e.to_str().unwrap(),
+        "--form",
+        "kulla-conty",
+        "--plot",
+        svg.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert_eq!(
+        output.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert!(text.starts_with("<svg") && text.contains("kulla-conty: max |deviation|"));
+    let bad = dir.path().join("furnace.txt");
+    let output = kiln(&[
+        "verify",
+        "--furnace",
+        e.to_str().unwrap(),
+        "--plot",
+        bad.to_str().unwrap(),
+    ]);
+    assert_eq!(output.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&output.stderr).contains(".svg or .png"));
+    assert!(!bad.exists());
+}

@@ -358,3 +358,106 @@ pub fn turquin(
         deviation,
     })
 }
+
+/// The deviation of each compensation form over a grid, for a picture: rows of roughness
+/// `r_j = j / (rows - 1)`, columns of the E table's mu coordinate `t_k = k / (columns - 1)`
+/// (so that the grazing layer, at fixed `t` on an adaptive axis, stays visible at every
+/// roughness), `map[j][k]` the deviation there. Kulla-Conty with `normalisation` as
+/// [`furnace`] computes it; Turquin as [`turquin`] (against the reference: `rows * columns`
+/// reference evaluations, in parallel).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct FurnaceMap {
+    pub form: Form,
+    pub rows: usize,
+    pub columns: usize,
+    pub deviation: Vec<Vec<f64>>,
+}
+
+/// [`FurnaceMap`]s of the forms asked for (Kulla-Conty needs `normalisation`).
+///
+/// # Errors
+/// As [`furnace`] and [`turquin`].
+pub fn furnace_maps(
+    e: &Table,
+    normalisation: Option<&Table>,
+    forms: &[Form],
+    rows: usize,
+    columns: usize,
+) -> Result<Vec<FurnaceMap>> {
+    use rayon::prelude::*;
+    let Some(Axis::Mu { mapping, .. }) = e.spec.mu else {
+        return Err(Error::InvalidInput("a furnace map needs an E table".into()));
+    };
+    let convention = e.spec.roughness_convention();
+    let coordinate = |n: usize, i: usize| i as f64 / (n.max(2) - 1) as f64;
+    let reference = crate::integrate::reference::ReferenceSettings::default();
+    let mut maps = Vec::new();
+    for &form in forms {
+        let deviation: Vec<Vec<f64>> = (0..rows)
+            .into_par_iter()
+            .map(|j| {
+                let roughness = coordinate(rows, j);
+                let alpha = convention.to_alpha(roughness);
+                let ratio = match (form, normalisation) {
+                    (Form::KullaConty, Some(norm)) => {
+                        let (of_e, _) = one_minus_lookup_average(e, roughness);
+                        let at = norm.spec.roughness_convention().from_alpha(alpha);
+                        let n = match norm.spec.quantity {
+                            Quantity::FMsNorm => normalisation_lookup(norm, at),
+                            _ => norm.lookup_one_minus(1.0, at),
+                        };
+                        if n >= f64::MIN_POSITIVE {
+                            of_e / n
+                        } else {
+                            0.0
+                        }
+                    }
+                    _ => 1.0,
+                };
+                (0..columns)
+                    .map(|k| {
+                        let mu = mapping.mu(coordinate(columns, k), alpha);
+                        match form {
+                            Form::KullaConty => {
+                                let loss = e.lookup_one_minus(mu, roughness);
+                                if loss == 0.0 {
+                                    0.0
+                                } else {
+                                    loss * (ratio - 1.0)
+                                }
+                            }
+                            Form::Turquin => {
+                                let truth = super::reference_value(
+                                    &e.spec,
+                                    alpha,
+                                    Some(mu),
+                                    None,
+                                    &reference,
+                                )
+                                .value;
+                                let lookup = e.lookup(mu, roughness);
+                                if lookup > 0.0 {
+                                    truth / lookup - 1.0
+                                } else {
+                                    0.0
+                                }
+                            }
+                        }
+                    })
+                    .collect()
+            })
+            .collect();
+        if form == Form::KullaConty && normalisation.is_none() {
+            return Err(Error::InvalidInput(
+                "the Kulla-Conty map needs the lobe's normalisation table".into(),
+            ));
+        }
+        maps.push(FurnaceMap {
+            form,
+            rows,
+            columns,
+            deviation,
+        });
+    }
+    Ok(maps)
+}

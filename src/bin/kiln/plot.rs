@@ -220,3 +220,101 @@ pub fn lookup_plot(report: &StudyReport) -> Result<(String, Vec<u8>), String> {
         None,
     )
 }
+
+/// The furnace deviation maps side by side, one per form: roughness up, the E table's mu
+/// coordinate across, colour by signed deviation on a log scale (blue: energy still lost, red:
+/// energy added; white below 1e-7), the worst point of each ringed.
+pub fn furnace_plot(
+    title: &str,
+    maps: &[kiln::verify::furnace::FurnaceMap],
+) -> Result<(String, Vec<u8>), String> {
+    register_font();
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
+        heat_maps(&root, title, maps).map_err(|e| e.to_string())?;
+    }
+    let mut pixels = vec![255u8; (SIZE.0 * SIZE.1 * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut pixels, SIZE).into_drawing_area();
+        heat_maps(&root, title, maps).map_err(|e| e.to_string())?;
+    }
+    let mut png_bytes = Vec::new();
+    {
+        let mut encoder = png::Encoder::new(&mut png_bytes, SIZE.0, SIZE.1);
+        encoder.set_color(png::ColorType::Rgb);
+        encoder.set_depth(png::BitDepth::Eight);
+        let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
+        writer
+            .write_image_data(&pixels)
+            .map_err(|e| e.to_string())?;
+    }
+    Ok((svg, png_bytes))
+}
+
+/// A diverging colour for a signed deviation: white at |d| <= 1e-7, full blue (negative) or red
+/// (positive) at |d| >= 1e-1, log-scaled between.
+fn deviation_colour(d: f64) -> RGBColor {
+    let level = ((d.abs().max(1e-7)).log10() + 7.0) / 6.0;
+    let s = level.clamp(0.0, 1.0);
+    let fade = |full: u8| (255.0 - (255.0 - f64::from(full)) * s).round() as u8;
+    if d < 0.0 {
+        RGBColor(fade(33), fade(102), fade(172))
+    } else {
+        RGBColor(fade(178), fade(24), fade(43))
+    }
+}
+
+fn heat_maps<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    title: &str,
+    maps: &[kiln::verify::furnace::FurnaceMap],
+) -> Result<(), Box<dyn std::error::Error>>
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE)?;
+    let root = root.titled(title, ("sans-serif", 22))?;
+    let panels = root.split_evenly((1, maps.len().max(1)));
+    for (panel, map) in panels.iter().zip(maps) {
+        let worst = map
+            .deviation
+            .iter()
+            .enumerate()
+            .flat_map(|(j, row)| row.iter().enumerate().map(move |(k, d)| (j, k, *d)))
+            .max_by(|a, b| a.2.abs().total_cmp(&b.2.abs()))
+            .unwrap_or((0, 0, 0.0));
+        let caption = format!("{}: max |deviation| {:.1e}", map.form.name(), worst.2.abs());
+        let mut chart = ChartBuilder::on(panel)
+            .caption(caption, ("sans-serif", 18))
+            .margin(12)
+            .x_label_area_size(40)
+            .y_label_area_size(50)
+            .build_cartesian_2d(0.0..1.0, 0.0..1.0)?;
+        chart
+            .configure_mesh()
+            .disable_mesh()
+            .x_desc("t, the mu axis' coordinate (0 = grazing)")
+            .y_desc("roughness r")
+            .draw()?;
+        let (rows, columns) = (map.rows.max(2), map.columns.max(2));
+        let (dy, dx) = (1.0 / (rows - 1) as f64, 1.0 / (columns - 1) as f64);
+        chart.draw_series(map.deviation.iter().enumerate().flat_map(|(j, row)| {
+            row.iter().enumerate().map(move |(k, &d)| {
+                let (x, y) = (k as f64 * dx, j as f64 * dy);
+                Rectangle::new(
+                    [(x - dx / 2.0, y - dy / 2.0), (x + dx / 2.0, y + dy / 2.0)],
+                    deviation_colour(d).filled(),
+                )
+            })
+        }))?;
+        let (j, k, _) = worst;
+        chart.draw_series(std::iter::once(Circle::new(
+            (k as f64 * dx, j as f64 * dy),
+            8,
+            BLACK.stroke_width(2),
+        )))?;
+    }
+    root.present()?;
+    Ok(())
+}

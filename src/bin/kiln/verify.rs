@@ -44,6 +44,10 @@ pub struct VerifyArgs {
     /// With --furnace: the compensation forms to check, comma-separated [default: both].
     #[arg(long, value_enum, value_delimiter = ',', requires = "furnace")]
     form: Option<Vec<kiln::verify::furnace::Form>>,
+    /// With --furnace: also draw the deviation of each form over (mu, r) as heat maps, the worst
+    /// point ringed, into this .svg or .png file.
+    #[arg(long, requires = "furnace")]
+    plot: Option<PathBuf>,
     /// The E_avg table for --furnace (default: beside FILE).
     #[arg(long, requires = "furnace")]
     average: Option<PathBuf>,
@@ -335,20 +339,63 @@ fn run_furnace(args: &VerifyArgs, table: &Table) -> kiln::Result<bool> {
         .form
         .clone()
         .unwrap_or_else(|| vec![Form::KullaConty, Form::Turquin]);
-    let kulla_conty = match forms.contains(&Form::KullaConty) {
+    let plot_kind = match &args.plot {
+        Some(path) => match path.extension().and_then(|e| e.to_str()) {
+            Some("svg") => Some(true),
+            Some("png") => Some(false),
+            _ => {
+                return Err(kiln::Error::InvalidInput(format!(
+                    "--plot {}: give a .svg or .png file",
+                    path.display()
+                )));
+            }
+        },
+        None => None,
+    };
+    let normalisation = match forms.contains(&Form::KullaConty) {
         true => {
             let average_path = match &args.average {
                 Some(path) => path.clone(),
                 None => sibling_normalisation(&args.file, table)?,
             };
             let average = args.load(&average_path)?;
-            Some((
-                average_path,
-                furnace(table, &average, args.density as usize)?,
-            ))
+            Some((average_path, average))
         }
         false => None,
     };
+    let kulla_conty = match &normalisation {
+        Some((path, average)) => Some((
+            path.clone(),
+            furnace(table, average, args.density as usize)?,
+        )),
+        None => None,
+    };
+    if let (Some(path), Some(svg)) = (&args.plot, plot_kind) {
+        let maps = kiln::verify::furnace::furnace_maps(
+            table,
+            normalisation.as_ref().map(|(_, t)| t),
+            &forms,
+            64,
+            64,
+        )?;
+        let title = format!(
+            "{}: white furnace deviation (blue: energy lost, red: added; white below 1e-7, full \
+             colour from 1e-1)",
+            table.spec.id()
+        );
+        let (text, png) =
+            crate::plot::furnace_plot(&title, &maps).map_err(|message| kiln::Error::Format {
+                path: path.clone(),
+                message,
+            })?;
+        let bytes = if svg { text.into_bytes() } else { png };
+        let dir = path.parent().filter(|p| !p.as_os_str().is_empty());
+        let name = path
+            .file_name()
+            .and_then(|n| n.to_str())
+            .unwrap_or("furnace.png");
+        kiln::format::write_files(dir.unwrap_or(Path::new(".")), &[(name.to_string(), bytes)])?;
+    }
     let turquin_report = match forms.contains(&Form::Turquin) {
         true => {
             let settings = AuditSettings {
