@@ -511,3 +511,51 @@ fn furnace_plot_draws_each_form() {
     assert!(String::from_utf8_lossy(&output.stderr).contains(".svg or .png"));
     assert!(!bad.exists());
 }
+
+/// The furnace of glass: Turquin's `1 / E` form on an `E_dielectric` table, its worst point
+/// with its IOR; at least the audit's absolute lookup error (E <= 1 in the energy convention).
+/// The Kulla-Conty lobe of glass is refused with a reason.
+#[test]
+fn glass_furnace_checks_turquins_form() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().to_str().unwrap();
+    let baked = kiln(&[
+        "bake",
+        "--quantity",
+        "e-dielectric",
+        "--size",
+        "4",
+        "--ior-size",
+        "3",
+        "--max-error",
+        "1e-4",
+        "--format",
+        "json",
+        "-q",
+        "--out",
+        out,
+    ]);
+    assert!(
+        baked.status.success(),
+        "{}",
+        String::from_utf8_lossy(&baked.stderr)
+    );
+    let table = dir.path().join("ggx-height-correlated-E_dielectric.json");
+    let table = table.to_str().unwrap();
+    let (status, report) = verify(&["--furnace", table, "--density", "1"]);
+    assert_eq!(status, Some(0), "{report}");
+    let forms = report["forms"].as_array().unwrap();
+    assert_eq!(forms.len(), 1);
+    assert_eq!(forms[0]["form"], "turquin");
+    let eta = number(&forms[0], "worst_eta");
+    assert!((1.0..=3.0).contains(&eta), "{report}");
+    let turquin = number(&forms[0], "max_deviation");
+    let (_, audit) = verify(&[table, "--density", "1"]);
+    assert!(
+        turquin >= number(&audit, "lookup_max_error"),
+        "{report} {audit}"
+    );
+    let output = kiln(&["verify", "--furnace", table, "--form", "kulla-conty"]);
+    assert_eq!(output.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&output.stderr).contains("glass"));
+}

@@ -287,6 +287,9 @@ pub struct FormReport {
     pub max_deviation: f64,
     pub worst_mu: f64,
     pub worst_roughness: f64,
+    /// The relative index there, for a glass table.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub worst_eta: Option<f64>,
     /// Where the worst deviation is: the compensated albedo's excess over 1 (negative: energy
     /// still lost).
     pub deviation: f64,
@@ -301,6 +304,7 @@ impl FormReport {
             max_deviation: report.max_deviation,
             worst_mu: report.worst.worst_mu,
             worst_roughness: report.worst.roughness,
+            worst_eta: None,
             deviation: report.worst.deviation,
         }
     }
@@ -309,7 +313,8 @@ impl FormReport {
 /// The furnace test of Turquin's compensation with an E table's lookup: single scattering
 /// scaled by `1 / E_lookup(mu_o)` returns `E_true(mu_o) / E_lookup(mu_o)` of the incident
 /// energy (`F = 1`), so the deviation is `E_true / E_lookup - 1`, the relative error of the
-/// lookup. Checked at the points of `kiln verify`'s lookup audit ([`super::lookup_coordinates`]:
+/// lookup. For glass (`E_dielectric`, from either side: the energy albedo `R + T`, the sample
+/// weight Cycles divides by) the same at every IOR of the ladder, on the axis and between. Checked at the points of `kiln verify`'s lookup audit ([`super::lookup_coordinates`]:
 /// a ladder of `1 / density` texel over both axes, ends included, and grazing probes down to
 /// `mu = 0` on every roughness rung) against the reference quadrature; in parallel,
 /// deterministic. `progress` is called once per point.
@@ -322,39 +327,46 @@ pub fn turquin(
     progress: &(dyn Fn() + Sync),
 ) -> Result<FormReport> {
     use rayon::prelude::*;
-    if e.spec.quantity != Quantity::E {
+    if !matches!(
+        e.spec.quantity,
+        Quantity::E | Quantity::EDielectric | Quantity::EDielectricInside
+    ) {
         return Err(Error::InvalidInput(format!(
-            "Turquin's compensation divides by E: the furnace test needs an E table (got {})",
+            "Turquin's compensation divides by E: the furnace test needs an E or E_dielectric \
+             table (got {})",
             e.spec.quantity.symbol()
         )));
     }
     let convention = e.spec.roughness_convention();
     let reference = crate::integrate::reference::ReferenceSettings::default();
-    let deviations: Vec<(f64, f64, f64)> = super::lookup_coordinates(&e.spec, settings)
-        .into_par_iter()
-        .map(|at| {
-            let roughness = convention.from_alpha(at.alpha);
-            let mu = at.mu.unwrap_or(1.0);
-            let truth = super::reference_value(&e.spec, at.alpha, at.mu, None, &reference).value;
-            let lookup = e.lookup(mu, roughness);
-            progress();
-            let deviation = if lookup > 0.0 {
-                truth / lookup - 1.0
-            } else {
-                0.0
-            };
-            (mu, roughness, deviation)
-        })
-        .collect();
-    let (worst_mu, worst_roughness, deviation) = deviations
+    let deviations: Vec<(f64, f64, Option<f64>, f64)> =
+        super::lookup_coordinates(&e.spec, settings)
+            .into_par_iter()
+            .map(|at| {
+                let roughness = convention.from_alpha(at.alpha);
+                let mu = at.mu.unwrap_or(1.0);
+                let truth =
+                    super::reference_value(&e.spec, at.alpha, at.mu, at.eta, &reference).value;
+                let lookup = e.lookup_eta(mu, roughness, at.eta.unwrap_or(1.0));
+                progress();
+                let deviation = if lookup > 0.0 {
+                    truth / lookup - 1.0
+                } else {
+                    0.0
+                };
+                (mu, roughness, at.eta, deviation)
+            })
+            .collect();
+    let (worst_mu, worst_roughness, worst_eta, deviation) = deviations
         .into_iter()
-        .max_by(|a, b| a.2.abs().total_cmp(&b.2.abs()))
-        .unwrap_or((0.0, 0.0, 0.0));
+        .max_by(|a, b| a.3.abs().total_cmp(&b.3.abs()))
+        .unwrap_or((0.0, 0.0, None, 0.0));
     Ok(FormReport {
         form: Form::Turquin,
         max_deviation: deviation.abs(),
         worst_mu,
         worst_roughness,
+        worst_eta,
         deviation,
     })
 }

@@ -335,10 +335,14 @@ fn sibling_normalisation(path: &Path, table: &Table) -> kiln::Result<PathBuf> {
 
 fn run_furnace(args: &VerifyArgs, table: &Table) -> kiln::Result<bool> {
     use kiln::verify::furnace::{Form, FormReport, turquin};
-    let forms = args
-        .form
-        .clone()
-        .unwrap_or_else(|| vec![Form::KullaConty, Form::Turquin]);
+    let glass = table.spec.quantity != Quantity::E;
+    let forms = args.form.clone().unwrap_or_else(|| {
+        if glass {
+            vec![Form::Turquin]
+        } else {
+            vec![Form::KullaConty, Form::Turquin]
+        }
+    });
     let plot_kind = match &args.plot {
         Some(path) => match path.extension().and_then(|e| e.to_str()) {
             Some("svg") => Some(true),
@@ -446,12 +450,15 @@ fn run_furnace(args: &VerifyArgs, table: &Table) -> kiln::Result<bool> {
     if let Some(t) = turquin_report {
         println!(
             "{}: white furnace test of Turquin's 1 / E scaling: max |E_true / E_lookup - 1| = \
-             {:.2e} at mu = {:.3e}, {} = {:.4} (the lookup audit's points against the reference)",
+             {:.2e} at mu = {:.3e}, {} = {:.4}{} (the lookup audit's points against the reference)",
             args.file.display(),
             t.max_deviation,
             t.worst_mu,
             table.spec.roughness_convention().name(),
-            t.worst_roughness
+            t.worst_roughness,
+            t.worst_eta
+                .map(|eta| format!(", eta = {eta:.4}"))
+                .unwrap_or_default()
         );
     }
     print_verdict(args.max_error, passed, "max deviation", max_deviation);
@@ -558,7 +565,23 @@ pub fn run(args: VerifyArgs) -> kiln::Result<bool> {
         return Ok(passed);
     }
     let table = args.load(&args.file)?;
-    if args.furnace && table.spec.quantity != Quantity::E {
+    let glass = matches!(
+        table.spec.quantity,
+        Quantity::EDielectric | Quantity::EDielectricInside
+    );
+    if args.furnace && glass {
+        if args
+            .form
+            .as_deref()
+            .is_some_and(|f| f.contains(&kiln::verify::furnace::Form::KullaConty))
+        {
+            return Err(kiln::Error::InvalidInput(format!(
+                "{} is a glass table: kiln checks Turquin's 1 / E compensation of it (--form \
+                 turquin); the Kulla-Conty lobe of glass is not in this version",
+                args.file.display()
+            )));
+        }
+    } else if args.furnace && table.spec.quantity != Quantity::E {
         return Err(kiln::Error::InvalidInput(format!(
             "--furnace tests an E table with its normalisation: {} holds {}; give the E file \
              (NAME-E.EXT), whose f_ms_norm or E_avg is found beside it or given with --average",
