@@ -52,6 +52,12 @@ pub fn encode(v: f64) -> (f16, Outcome) {
     (h, outcome)
 }
 
+/// The value a reader of the f16 file gets back for `v` ([`encode`], widened).
+#[must_use]
+pub fn stored(v: f64) -> f64 {
+    f64::from(encode(v).0.to_f32())
+}
+
 /// How many values of a channel [`encode`] clamped or stored as subnormals.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Counts {
@@ -105,8 +111,8 @@ mod tests {
         // 11 significant bits errs by at most 2^-11 relative throughout f16's normal range.
         let mut v = 1e-4;
         while v < 1.0 {
-            let stored = f64::from(encode(v).0.to_f32());
-            assert!(((stored - v) / v).abs() <= 2f64.powi(-11), "{v}");
+            let back = stored(v);
+            assert!(((back - v) / v).abs() <= 2f64.powi(-11), "{v}");
             v *= 1.013;
         }
     }

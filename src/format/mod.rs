@@ -206,10 +206,13 @@ pub fn as_stored(tables: &[Table], precision: Precision) -> Vec<Table> {
             let e = tables.iter().find(|t| Some(&t.spec) == source);
             match (precision, table.spec.quantity, e) {
                 (Precision::F16, crate::table::Quantity::FMsNorm, Some(e)) => {
-                    let round = |v: &f64| f64::from(f16::encode(*v).0.to_f32());
                     let stored = Table {
-                        value: e.value.iter().map(round).collect(),
-                        one_minus_value: e.one_minus_value.iter().map(round).collect(),
+                        value: e.value.iter().map(|&v| f16::stored(v)).collect(),
+                        one_minus_value: e
+                            .one_minus_value
+                            .iter()
+                            .map(|&v| f16::stored(v))
+                            .collect(),
                         ..e.clone()
                     };
                     crate::table::normalisation::derive(&stored, table.command.clone())

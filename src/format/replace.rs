@@ -65,11 +65,8 @@ fn own_spec(path: &Path, format: Format) -> Option<TableSpec> {
         #[cfg(feature = "containers")]
         Format::Ktx2 => {
             let text = super::ktx2::decode(&bytes).ok()?.metadata?;
-            let value: serde_json::Value = serde_json::from_str(&text).ok()?;
-            let first = value.get("tables")?.as_array()?.first()?.clone();
-            serde_json::from_value::<Metadata>(first)
-                .ok()
-                .map(|metadata| metadata.spec)
+            let tables = super::texture::texture_metadata(&text).ok()?;
+            tables.into_iter().next().map(|metadata| metadata.spec)
         }
         Format::H | Format::Rs => {
             let text = std::str::from_utf8(&bytes).ok()?;

@@ -109,6 +109,17 @@ fn metadata_json(tables: &[&Table]) -> String {
     object.to_string()
 }
 
+/// The tables' metadata of a texture's `kiln` JSON (as [`metadata_json`] writes it).
+pub fn texture_metadata(text: &str) -> std::result::Result<Vec<super::metadata::Metadata>, String> {
+    #[derive(serde::Deserialize)]
+    struct TextureMetadata {
+        tables: Vec<super::metadata::Metadata>,
+    }
+    serde_json::from_str::<TextureMetadata>(text)
+        .map(|t| t.tables)
+        .map_err(|e| format!("bad kiln metadata: {e}"))
+}
+
 /// A float texture read back from a GPU container ([`super::ktx2::decode`],
 /// [`super::dds::decode`]): its extent, its channels de-interleaved, and kiln's metadata JSON
 /// when the container carries it (KTX2 does, DDS cannot).

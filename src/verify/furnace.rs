@@ -70,6 +70,54 @@ pub struct FurnaceReport {
     pub worst: FurnaceRow,
 }
 
+/// At `roughness` (in `e`'s convention): `1 - Ē` of `e`'s lookup, the lobe's `1 - E_avg` as a
+/// renderer looks it up in `normalisation` (`f_ms_norm` or `E_avg`), and their ratio, which
+/// scales the lobe's albedo `(1 - E(mu_o)) * ratio`. Where `1 - E_avg` is 0 (a mirror) `f_ms` is
+/// taken as 0 (`kulla_conty::multiple_scattering`), so the ratio is 0.
+fn lobe_ratio(e: &Table, normalisation: &Table, roughness: f64) -> (f64, f64, f64) {
+    let (of_e, _) = one_minus_lookup_average(e, roughness);
+    let alpha = e.spec.roughness_convention().to_alpha(roughness);
+    let at = normalisation.spec.roughness_convention().from_alpha(alpha);
+    let one_minus_e_avg = match normalisation.spec.quantity {
+        Quantity::FMsNorm => normalisation_lookup(normalisation, at),
+        _ => normalisation.lookup_one_minus(1.0, at),
+    };
+    let ratio = if one_minus_e_avg >= f64::MIN_POSITIVE {
+        of_e / one_minus_e_avg
+    } else {
+        0.0
+    };
+    (of_e, one_minus_e_avg, ratio)
+}
+
+/// `E + albedo(f_ms) - 1 = (1 - E(mu_o)) (ratio - 1)`, 0 where nothing is lost.
+fn lobe_deviation(loss: f64, ratio: f64) -> f64 {
+    if loss == 0.0 {
+        0.0
+    } else {
+        loss * (ratio - 1.0)
+    }
+}
+
+/// Turquin's deviation `E_true / E_lookup - 1` at one point of an E or E_dielectric table
+/// (`eta` the relative index for glass).
+fn turquin_deviation(
+    e: &Table,
+    alpha: f64,
+    mu: f64,
+    eta: Option<f64>,
+    reference: &crate::integrate::reference::ReferenceSettings,
+) -> f64 {
+    let roughness = e.spec.roughness_convention().from_alpha(alpha);
+    let truth = super::reference_value(&e.spec, alpha, Some(mu), eta, reference).value;
+    let lookup = e.lookup_eta(mu, roughness, eta.unwrap_or(1.0));
+    if lookup > 0.0 {
+        truth / lookup - 1.0
+    } else {
+        0.0
+    }
+}
+
 /// The roughness ladder of the furnace test of an E table with `rows` rows: steps of
 /// `1 / (density (rows - 1))` (at least four per texel) over [0, 1], 400 more steps below 0.1,
 /// where the loss of a mirror-like surface hides in the grazing layer, and the midpoints
@@ -121,36 +169,20 @@ pub fn furnace(e: &Table, normalisation: &Table, density: usize) -> Result<Furna
         unreachable!("an E table has a mu axis")
     };
     let convention = e.spec.roughness_convention();
-    let norm_convention = normalisation.spec.roughness_convention();
     let mu_steps = density.max(4) * n_mu;
     let rows: Vec<FurnaceRow> = roughness_ladder(e.spec.roughness_axis().size(), density)
         .into_iter()
         .map(|roughness| {
             let alpha = convention.to_alpha(roughness);
             let loss = |mu: f64| e.lookup_one_minus(mu, roughness);
-            let (of_e, _) = one_minus_lookup_average(e, roughness);
-            let at = norm_convention.from_alpha(alpha);
-            let one_minus_e_avg = match quantity {
-                Quantity::FMsNorm => normalisation_lookup(normalisation, at),
-                _ => normalisation.lookup_one_minus(1.0, at),
-            };
-            // The lobe's albedo is (1 - E(mu_o)) * ratio; where 1 - E_avg = 0 (a mirror) f_ms is
-            // taken as 0 (`kulla_conty::multiple_scattering`), so the ratio is 0.
-            let ratio = if one_minus_e_avg >= f64::MIN_POSITIVE {
-                of_e / one_minus_e_avg
-            } else {
-                0.0
-            };
+            let (of_e, one_minus_e_avg, ratio) = lobe_ratio(e, normalisation, roughness);
             let mut mus: Vec<f64> = (0..=mu_steps)
                 .map(|k| mapping.mu(k as f64 / mu_steps as f64, alpha))
                 .collect();
             mus.extend(super::grazing_probes());
             let (worst_mu, deviation) = mus
                 .into_iter()
-                .map(|mu| {
-                    let l = loss(mu);
-                    (mu, if l == 0.0 { 0.0 } else { l * (ratio - 1.0) })
-                })
+                .map(|mu| (mu, lobe_deviation(loss(mu), ratio)))
                 .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
                 .expect("mu points");
             FurnaceRow {
@@ -343,18 +375,10 @@ pub fn turquin(
         super::lookup_coordinates(&e.spec, settings)
             .into_par_iter()
             .map(|at| {
-                let roughness = convention.from_alpha(at.alpha);
                 let mu = at.mu.unwrap_or(1.0);
-                let truth =
-                    super::reference_value(&e.spec, at.alpha, at.mu, at.eta, &reference).value;
-                let lookup = e.lookup_eta(mu, roughness, at.eta.unwrap_or(1.0));
+                let deviation = turquin_deviation(e, at.alpha, mu, at.eta, &reference);
                 progress();
-                let deviation = if lookup > 0.0 {
-                    truth / lookup - 1.0
-                } else {
-                    0.0
-                };
-                (mu, roughness, at.eta, deviation)
+                (mu, convention.from_alpha(at.alpha), at.eta, deviation)
             })
             .collect();
     let (worst_mu, worst_roughness, worst_eta, deviation) = deviations
@@ -400,6 +424,11 @@ pub fn furnace_maps(
     let Some(Axis::Mu { mapping, .. }) = e.spec.mu else {
         return Err(Error::InvalidInput("a furnace map needs an E table".into()));
     };
+    if forms.contains(&Form::KullaConty) && normalisation.is_none() {
+        return Err(Error::InvalidInput(
+            "the Kulla-Conty map needs the lobe's normalisation table".into(),
+        ));
+    }
     let convention = e.spec.roughness_convention();
     let coordinate = |n: usize, i: usize| i as f64 / (n.max(2) - 1) as f64;
     let reference = crate::integrate::reference::ReferenceSettings::default();
@@ -411,19 +440,7 @@ pub fn furnace_maps(
                 let roughness = coordinate(rows, j);
                 let alpha = convention.to_alpha(roughness);
                 let ratio = match (form, normalisation) {
-                    (Form::KullaConty, Some(norm)) => {
-                        let (of_e, _) = one_minus_lookup_average(e, roughness);
-                        let at = norm.spec.roughness_convention().from_alpha(alpha);
-                        let n = match norm.spec.quantity {
-                            Quantity::FMsNorm => normalisation_lookup(norm, at),
-                            _ => norm.lookup_one_minus(1.0, at),
-                        };
-                        if n >= f64::MIN_POSITIVE {
-                            of_e / n
-                        } else {
-                            0.0
-                        }
-                    }
+                    (Form::KullaConty, Some(norm)) => lobe_ratio(e, norm, roughness).2,
                     _ => 1.0,
                 };
                 (0..columns)
@@ -431,39 +448,14 @@ pub fn furnace_maps(
                         let mu = mapping.mu(coordinate(columns, k), alpha);
                         match form {
                             Form::KullaConty => {
-                                let loss = e.lookup_one_minus(mu, roughness);
-                                if loss == 0.0 {
-                                    0.0
-                                } else {
-                                    loss * (ratio - 1.0)
-                                }
+                                lobe_deviation(e.lookup_one_minus(mu, roughness), ratio)
                             }
-                            Form::Turquin => {
-                                let truth = super::reference_value(
-                                    &e.spec,
-                                    alpha,
-                                    Some(mu),
-                                    None,
-                                    &reference,
-                                )
-                                .value;
-                                let lookup = e.lookup(mu, roughness);
-                                if lookup > 0.0 {
-                                    truth / lookup - 1.0
-                                } else {
-                                    0.0
-                                }
-                            }
+                            Form::Turquin => turquin_deviation(e, alpha, mu, None, &reference),
                         }
                     })
                     .collect()
             })
             .collect();
-        if form == Form::KullaConty && normalisation.is_none() {
-            return Err(Error::InvalidInput(
-                "the Kulla-Conty map needs the lobe's normalisation table".into(),
-            ));
-        }
         maps.push(FurnaceMap {
             form,
             rows,

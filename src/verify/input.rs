@@ -217,20 +217,15 @@ pub fn read_kiln(path: &Path) -> Result<Option<Table>> {
         }
         _ if bytes.starts_with(binary::MAGIC) => {
             let contents = binary::decode(&bytes).map_err(|e| invalid(path, e))?;
-            let sidecar_path = path.with_extension("json");
-            let missing = || {
+            let metadata = sidecar_beside(path)?.ok_or_else(|| {
                 invalid(
                     path,
                     format!(
                         "a kiln binary holds no model; its sidecar {} is missing or unreadable",
-                        sidecar_path.display()
+                        path.with_extension("json").display()
                     ),
                 )
-            };
-            let sidecar_bytes = std::fs::read(&sidecar_path).map_err(|_| missing())?;
-            let metadata = parse_sidecar(&sidecar_path, &sidecar_bytes)?
-                .ok_or_else(missing)?
-                .metadata;
+            })?;
             if contents.shape != metadata.spec.shape() {
                 return Err(invalid(path, "shape differs from its sidecar's"));
             }
@@ -285,21 +280,16 @@ fn read_kiln_texture(
         let metadata = match (&texture.metadata, container) {
             (Some(text), _) => {
                 // A texture's metadata lists its tables; kiln's own texture holds one.
-                let value: serde_json::Value = serde_json::from_str(text)
-                    .map_err(|e| invalid(path, format!("bad kiln metadata: {e}")))?;
-                let tables = value.get("tables").and_then(|t| t.as_array());
-                match tables.map(Vec::as_slice) {
-                    Some([one]) => serde_json::from_value::<Metadata>(one.clone())
-                        .map_err(|e| invalid(path, format!("bad kiln metadata: {e}")))?,
-                    Some(_) => {
-                        return Err(invalid(
-                            path,
-                            "a texture of several tables (an engine layout): read it with \
-                             --preset NAME",
-                        ));
-                    }
-                    None => return Err(invalid(path, "kiln metadata without its tables")),
+                let mut tables =
+                    crate::format::texture::texture_metadata(text).map_err(|e| invalid(path, e))?;
+                if tables.len() != 1 {
+                    return Err(invalid(
+                        path,
+                        "a texture of several tables (an engine layout): read it with \
+                         --preset NAME",
+                    ));
                 }
+                tables.remove(0)
             }
             (None, Container::Ktx2) => return Ok(None),
             (None, Container::Dds) => match sidecar_beside(path)? {

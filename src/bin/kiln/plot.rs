@@ -122,6 +122,19 @@ fn chart<DB: DrawingBackend>(
     Ok(())
 }
 
+/// RGB pixels of `SIZE` as PNG bytes.
+fn png_of(pixels: &[u8]) -> Result<Vec<u8>, String> {
+    let mut png_bytes = Vec::new();
+    {
+        let mut encoder = png::Encoder::new(&mut png_bytes, SIZE.0, SIZE.1);
+        encoder.set_color(png::ColorType::Rgb);
+        encoder.set_depth(png::BitDepth::Eight);
+        let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
+        writer.write_image_data(pixels).map_err(|e| e.to_string())?;
+    }
+    Ok(png_bytes)
+}
+
 /// Renders a chart as SVG text and as PNG bytes.
 fn render(
     title: &str,
@@ -141,17 +154,7 @@ fn render(
         let root = BitMapBackend::with_buffer(&mut pixels, SIZE).into_drawing_area();
         chart(&root, title, x_label, y_label, series, highlight).map_err(|e| e.to_string())?;
     }
-    let mut png_bytes = Vec::new();
-    {
-        let mut encoder = png::Encoder::new(&mut png_bytes, SIZE.0, SIZE.1);
-        encoder.set_color(png::ColorType::Rgb);
-        encoder.set_depth(png::BitDepth::Eight);
-        let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
-        writer
-            .write_image_data(&pixels)
-            .map_err(|e| e.to_string())?;
-    }
-    Ok((svg, png_bytes))
+    Ok((svg, png_of(&pixels)?))
 }
 
 /// Error against time, one line per method, the Pareto front dashed.
@@ -239,17 +242,7 @@ pub fn furnace_plot(
         let root = BitMapBackend::with_buffer(&mut pixels, SIZE).into_drawing_area();
         heat_maps(&root, title, maps).map_err(|e| e.to_string())?;
     }
-    let mut png_bytes = Vec::new();
-    {
-        let mut encoder = png::Encoder::new(&mut png_bytes, SIZE.0, SIZE.1);
-        encoder.set_color(png::ColorType::Rgb);
-        encoder.set_depth(png::BitDepth::Eight);
-        let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
-        writer
-            .write_image_data(&pixels)
-            .map_err(|e| e.to_string())?;
-    }
-    Ok((svg, png_bytes))
+    Ok((svg, png_of(&pixels)?))
 }
 
 /// A diverging colour for a signed deviation: white at |d| <= 1e-7, full blue (negative) or red

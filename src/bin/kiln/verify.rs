@@ -335,7 +335,30 @@ fn sibling_normalisation(path: &Path, table: &Table) -> kiln::Result<PathBuf> {
 
 fn run_furnace(args: &VerifyArgs, table: &Table) -> kiln::Result<bool> {
     use kiln::verify::furnace::{Form, FormReport, turquin};
-    let glass = table.spec.quantity != Quantity::E;
+    let glass = matches!(
+        table.spec.quantity,
+        Quantity::EDielectric | Quantity::EDielectricInside
+    );
+    if !glass && table.spec.quantity != Quantity::E {
+        return Err(kiln::Error::InvalidInput(format!(
+            "--furnace tests an E table with its normalisation: {} holds {}; give the E file \
+             (NAME-E.EXT), whose f_ms_norm or E_avg is found beside it or given with --average",
+            args.file.display(),
+            table.spec.quantity.symbol()
+        )));
+    }
+    if glass
+        && args
+            .form
+            .as_deref()
+            .is_some_and(|f| f.contains(&Form::KullaConty))
+    {
+        return Err(kiln::Error::InvalidInput(format!(
+            "{} is a glass table: kiln checks Turquin's 1 / E compensation of it (--form \
+             turquin); the Kulla-Conty lobe of glass is not in this version",
+            args.file.display()
+        )));
+    }
     let forms = args.form.clone().unwrap_or_else(|| {
         if glass {
             vec![Form::Turquin]
@@ -565,30 +588,6 @@ pub fn run(args: VerifyArgs) -> kiln::Result<bool> {
         return Ok(passed);
     }
     let table = args.load(&args.file)?;
-    let glass = matches!(
-        table.spec.quantity,
-        Quantity::EDielectric | Quantity::EDielectricInside
-    );
-    if args.furnace && glass {
-        if args
-            .form
-            .as_deref()
-            .is_some_and(|f| f.contains(&kiln::verify::furnace::Form::KullaConty))
-        {
-            return Err(kiln::Error::InvalidInput(format!(
-                "{} is a glass table: kiln checks Turquin's 1 / E compensation of it (--form \
-                 turquin); the Kulla-Conty lobe of glass is not in this version",
-                args.file.display()
-            )));
-        }
-    } else if args.furnace && table.spec.quantity != Quantity::E {
-        return Err(kiln::Error::InvalidInput(format!(
-            "--furnace tests an E table with its normalisation: {} holds {}; give the E file \
-             (NAME-E.EXT), whose f_ms_norm or E_avg is found beside it or given with --average",
-            args.file.display(),
-            table.spec.quantity.symbol()
-        )));
-    }
     if args.furnace {
         return run_furnace(&args, &table);
     }
