@@ -49,7 +49,7 @@ use crate::error::{Error, Result};
 use crate::format::{Precision, ktx2, texture::Texture};
 use crate::model::{Masking, Ndf, RoughnessConvention};
 use crate::table::axis::{Grid, MuMapping};
-use crate::table::{Quantity, Table};
+use crate::table::{Quantity, Table, TableSpec};
 use std::fmt::Write as _;
 
 /// An engine layout.
@@ -149,15 +149,90 @@ impl Preset {
                 .map_err(Error::InvalidInput)?;
             files.push(("GGX_E_avg.exr".to_string(), average));
         }
+        if let Some((name, bytes)) = self.normalisation_file(tables)? {
+            files.push((name.to_string(), bytes));
+        }
         Ok((files, extra))
+    }
+
+    /// The number of entries of the preset's `f_ms_norm` table (0 for a preset without one).
+    #[must_use]
+    pub fn normalisation_size(self) -> usize {
+        self.options()
+            .resolved()
+            .specs()
+            .iter()
+            .find(|s| s.quantity == Quantity::FMsNorm)
+            .map_or(0, TableSpec::len)
+    }
+
+    /// The file of the lookup-consistent Kulla-Conty normalisation (`f_ms_norm`,
+    /// [`crate::table::normalisation`]) of a preset whose engine normalises by `E_avg`, beside
+    /// the engine's own files (which stay exactly as the engine ships them): derived from the E
+    /// table as the engine file stores it (Enterprise PBR's half floats: `1 - E` from the f16
+    /// `E`, as its shader computes it), so that it is the average of the lookup the engine
+    /// makes. `None` for the other presets, or when `tables` has no `f_ms_norm`.
+    fn normalisation_file(self, tables: &[Table]) -> Result<Option<(&'static str, Vec<u8>)>> {
+        let Some(norm) = tables.iter().find(|t| t.spec.quantity == Quantity::FMsNorm) else {
+            return Ok(None);
+        };
+        let e = tables
+            .iter()
+            .find(|t| t.spec.quantity == Quantity::E)
+            .ok_or_else(|| Error::InvalidInput("f_ms_norm needs the E table".into()))?;
+        // The E table as the engine file stores it, and 1 - E as the engine computes it.
+        let as_stored = |round: fn(f64) -> f64| -> Table {
+            let value: Vec<f64> = e.value.iter().map(|&v| round(v)).collect();
+            let stored = Table {
+                one_minus_value: value.iter().map(|v| 1.0 - v).collect(),
+                value,
+                ..e.clone()
+            };
+            crate::table::normalisation::derive(&stored, norm.command.clone())
+        };
+        match self {
+            Preset::Cycles => {
+                let norm = as_stored(|v| f64::from(v as f32));
+                let rows = norm.value.len();
+                let mut out = format!(
+                    "/* kiln {}: the lookup-consistent normalisation of the Kulla-Conty lobe for \
+                     Cycles' table_ggx_E (shader.tables).\n * table_ggx_f_ms_norm[i] = 1 - \
+                     Ebar(r) at r = i / {}, Ebar the cosine-weighted average of table_ggx_E's \
+                     bilinear lookup (as\n * lookup_table_read_2D reads it), linear between \
+                     entries; f_ms = (1 - E(mu_o)) (1 - E(mu_i)) / (pi (1 - Ebar(r))).\n * \
+                     Regenerate: {}\n */\n",
+                    crate::format::metadata::KILN_VERSION,
+                    rows - 1,
+                    norm.command
+                );
+                crate::format::c_header::float_array(&mut out, "table_ggx_f_ms_norm", &norm.value);
+                Ok(Some((CYCLES_NORMALISATION_FILE, out.into_bytes())))
+            }
+            Preset::EnterprisePbr => {
+                // Values from 1e-7 to 1: stored in f32, as f16 would lose the small ones.
+                let norm = as_stored(crate::format::f16::stored);
+                let bytes = crate::format::exr::encode_value_as(&norm, "Y", Precision::F32)
+                    .map_err(Error::InvalidInput)?;
+                Ok(Some((ENTERPRISE_NORMALISATION_FILE, bytes)))
+            }
+            _ => Ok(None),
+        }
     }
 
     /// The bake that gives the preset's tables (to the default max error).
     #[must_use]
     pub fn options(self) -> BakeOptions {
         let (size, grid, quantities) = match self {
-            Preset::Cycles => (32, Grid::Nodes, vec![Quantity::E, Quantity::EAvg]),
-            Preset::EnterprisePbr => (32, Grid::Centers, vec![Quantity::E, Quantity::EAvg]),
+            Preset::Cycles => (
+                32,
+                Grid::Nodes,
+                vec![Quantity::E, Quantity::EAvg, Quantity::FMsNorm],
+            ),
+            Preset::EnterprisePbr => (
+                32,
+                Grid::Centers,
+                vec![Quantity::E, Quantity::EAvg, Quantity::FMsNorm],
+            ),
             Preset::Bevy => (64, Grid::Centers, vec![Quantity::EScale, Quantity::EBias]),
             Preset::Three => (16, Grid::Centers, vec![Quantity::EScale, Quantity::EBias]),
             Preset::Filament | Preset::Godot => {
@@ -437,16 +512,29 @@ impl Preset {
                     .iter()
                     .find(|(name, _)| name == "Y")
                     .ok_or_else(|| bad("no channel Y".into()))?;
+                let norm = self.normalisation_size();
                 match (image.width, image.height) {
                     (w, h) if (w, h) == (n, n) => Ok(vec![(Quantity::E, kiln_order(values))]),
                     (w, 1) if w == n => Ok(vec![(Quantity::EAvg, values.clone())]),
+                    (w, 1) if w == norm => Ok(vec![(Quantity::FMsNorm, values.clone())]),
                     (w, h) => Err(bad(format!(
-                        "{w} x {h} (expected GGX_E.exr, {n} x {n}, or GGX_E_avg.exr, {n} x 1)"
+                        "{w} x {h} (expected GGX_E.exr, {n} x {n}, GGX_E_avg.exr, {n} x 1, or \
+                         {ENTERPRISE_NORMALISATION_FILE}, {norm} x 1)"
                     ))),
                 }
             }
             Preset::Cycles => {
                 let text = String::from_utf8_lossy(bytes);
+                if let Some(norm) = c_array(&text, "table_ggx_f_ms_norm") {
+                    let size = self.normalisation_size();
+                    if norm.len() != size {
+                        return Err(bad(format!(
+                            "table_ggx_f_ms_norm has {} values (expected {size})",
+                            norm.len()
+                        )));
+                    }
+                    return Ok((vec![(Quantity::FMsNorm, norm)], None));
+                }
                 let e =
                     c_array(&text, "table_ggx_E").ok_or_else(|| bad("no table_ggx_E".into()))?;
                 let avg = c_array(&text, "table_ggx_Eavg")
@@ -706,6 +794,12 @@ impl Preset {
             .collect())
     }
 }
+
+/// The file of `f_ms_norm` beside Cycles' `shader.tables`.
+pub const CYCLES_NORMALISATION_FILE: &str = "ggx_f_ms_norm.tables";
+
+/// The file of `f_ms_norm` beside Enterprise PBR's `GGX_E.exr` and `GGX_E_avg.exr`.
+pub const ENTERPRISE_NORMALISATION_FILE: &str = "GGX_f_ms_norm.exr";
 
 /// Files a preset writes: `(name, bytes)`.
 pub type Files = Vec<(String, Vec<u8>)>;

@@ -189,7 +189,7 @@ fn enterprise_pbr_layout_is_half_exr_channel_y_with_cos_across() {
     let (e, avg) = (&tables[0], &tables[1]);
     let files = Preset::EnterprisePbr.files(&tables).unwrap();
     let names: Vec<&str> = files.iter().map(|(n, _)| n.as_str()).collect();
-    assert_eq!(names, ["GGX_E.exr", "GGX_E_avg.exr"]);
+    assert_eq!(names, ["GGX_E.exr", "GGX_E_avg.exr", "GGX_f_ms_norm.exr"]);
     // Read through the exr crate (kiln's thin reader of any EXR): one half-float channel Y.
     for ((_, bytes), table) in files.iter().zip([e, avg]) {
         let decoded = kiln::format::exr::decode(bytes).unwrap();
@@ -431,4 +431,101 @@ fn unreal_layout_is_e_and_e_fc_in_red_and_green_with_roughness_rows() {
         back[1].value,
         bias.value.iter().map(|&v| f16_of(v)).collect::<Vec<_>>()
     );
+}
+
+/// `1 - Ē` at row `j` of an engine's E table (`rows[j]`, `n` values over `mu` in kiln's order)
+/// in closed form: the engine's lookup is linear in `mu` between its columns at `mu_k` (nodes
+/// `k / (n - 1)`, or centres `(k + 0.5) / n` held constant to the edges), so `2 ∫ (1 - E) mu
+/// dmu` is a sum of exact integrals of `mu (a + b mu)`. Independent of kiln's lookup and of its
+/// adaptive quadrature.
+fn one_minus_average_closed_form(row: &[f64], centres: bool) -> f64 {
+    let n = row.len();
+    let mu_k = |k: usize| {
+        if centres {
+            (k as f64 + 0.5) / n as f64
+        } else {
+            k as f64 / (n - 1) as f64
+        }
+    };
+    // Breakpoints with the lookup's value there (constant ends for centres).
+    let mut points: Vec<(f64, f64)> = (0..n).map(|k| (mu_k(k), 1.0 - row[k])).collect();
+    if centres {
+        points.insert(0, (0.0, 1.0 - row[0]));
+        points.push((1.0, 1.0 - row[n - 1]));
+    }
+    points
+        .windows(2)
+        .map(|w| {
+            let ((x0, y0), (x1, y1)) = (w[0], w[1]);
+            let b = (y1 - y0) / (x1 - x0);
+            let a = y0 - b * x0;
+            // 2 ∫ mu (a + b mu) dmu = a mu^2 + 2 b mu^3 / 3.
+            let f = |x: f64| a * x * x + 2.0 * b * x * x * x / 3.0;
+            f(x1) - f(x0)
+        })
+        .sum()
+}
+
+/// Cycles and Enterprise PBR normalise by `E_avg`: kiln writes beside their files the
+/// lookup-consistent normalisation of the table the engine file holds (f32 for Cycles, the
+/// half floats of Enterprise PBR), `1 - Ē` itself on a 16x finer roughness axis. At every row of
+/// the engine's E table it equals the closed-form average of that table's lookup (as read back
+/// from the engine file), and between rows the linear interpolation is exact.
+#[test]
+fn cycles_and_enterprise_pbr_get_the_normalisation_of_their_own_lookup() {
+    for (preset, file, centres) in [
+        (
+            Preset::Cycles,
+            kiln::preset::CYCLES_NORMALISATION_FILE,
+            false,
+        ),
+        (
+            Preset::EnterprisePbr,
+            kiln::preset::ENTERPRISE_NORMALISATION_FILE,
+            true,
+        ),
+    ] {
+        let tables = bake_to(preset, 1e-6);
+        let files = preset.files(&tables).unwrap();
+        let read = |name: &str| {
+            let bytes = &files.iter().find(|(n, _)| n == name).unwrap().1;
+            preset.read_tables(bytes, name).unwrap()
+        };
+        let e = read(preset.file_name()).remove(0);
+        let norm = read(file).remove(0);
+        assert_eq!(norm.spec.quantity, kiln::Quantity::FMsNorm);
+        let n = 32;
+        let entries = norm.value.len();
+        for j in 0..n {
+            let row = &e.value[j * n..(j + 1) * n];
+            let truth = one_minus_average_closed_form(row, centres);
+            // Row j sits at node 16 j (nodes) or 16 j + 8 (centres) of the normalisation axis.
+            let at = 16 * j + if centres { 8 } else { 0 };
+            let stored = norm.value[at];
+            assert!(
+                (stored - truth).abs() <= 1e-6 * truth + 1e-12,
+                "{}: row {j}: stored {stored:e}, closed form {truth:e}",
+                preset.name()
+            );
+            // Halfway between two rows the lookup average is the mean of theirs.
+            if j + 1 < n {
+                let next =
+                    one_minus_average_closed_form(&e.value[(j + 1) * n..(j + 2) * n], centres);
+                let r = (at as f64 + 8.0) / (entries - 1) as f64;
+                let looked_up = kiln::table::normalisation::normalisation_lookup(&norm, r);
+                let mid = 0.5 * (truth + next);
+                assert!(
+                    (looked_up - mid).abs() <= 1e-6 * mid + 1e-12,
+                    "{}: r {r}: lookup {looked_up:e}, closed form {mid:e}",
+                    preset.name()
+                );
+            }
+        }
+        // Below Enterprise PBR's first row centre the clamped lookup is constant.
+        if centres {
+            let first = one_minus_average_closed_form(&e.value[..n], true);
+            let looked_up = kiln::table::normalisation::normalisation_lookup(&norm, 0.004);
+            assert!((looked_up - first).abs() <= 1e-6 * first + 1e-12);
+        }
+    }
 }

@@ -166,7 +166,7 @@ fn write_lookup(out: &mut String, table: &Table, prefix: &str, ty: &str) {
             let _ = writeln!(out, "    let p = {t_r};");
             let _ = writeln!(out, "    let i = (p as usize).min({});", n_r - 2);
             let _ = writeln!(out, "    let f = p - i as f32;");
-            if spec.quantity == crate::table::Quantity::FMsNorm {
+            if crate::table::normalisation::stores_per_roughness(spec) {
                 // (1 - Ē) / r is stored: give back 1 - Ē (crate::table::normalisation).
                 let _ = writeln!(
                     out,

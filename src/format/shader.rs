@@ -394,10 +394,10 @@ fn write_array_lookup(
     );
 }
 
-/// What the interpolated value of a 1-D table is multiplied by: the roughness coordinate for
-/// `f_ms_norm`, which stores `(1 - Ē) / r` ([`crate::table::normalisation`]), nothing otherwise.
+/// What the interpolated value of a 1-D table is multiplied by: the roughness coordinate for an
+/// `f_ms_norm` that stores `(1 - Ē) / r` ([`crate::table::normalisation`]), nothing otherwise.
 fn array_scale(table: &Table) -> &'static str {
-    if table.spec.quantity == crate::table::Quantity::FMsNorm {
+    if crate::table::normalisation::stores_per_roughness(&table.spec) {
         "clamp(t, 0.0, 1.0) * "
     } else {
         ""

@@ -61,11 +61,12 @@ pub enum Quantity {
     #[serde(rename = "E_F")]
     #[cfg_attr(feature = "cli", value(name = "e-f"))]
     EF,
-    /// The lookup-consistent normalisation of the Kulla-Conty lobe, `(1 - Ē(r)) / r`: `Ē` is
-    /// the cosine-weighted average of the E table's own bilinear lookup at roughness `r`, so
-    /// that `f_ms = (1 - E(mu_o)) (1 - E(mu_i)) / (pi (1 - Ē))` gives back exactly what that
-    /// lookup loses. Divided by `r` (its leading power), it interpolates linearly down to 0;
-    /// the lookup multiplies by `r` again. A 1-D table over a fine roughness axis, derived
+    /// The lookup-consistent normalisation of the Kulla-Conty lobe, `1 - Ē(r)`: `Ē` is the
+    /// cosine-weighted average of the E table's own bilinear lookup at roughness `r`, so that
+    /// `f_ms = (1 - E(mu_o)) (1 - E(mu_i)) / (pi (1 - Ē))` gives back exactly what that lookup
+    /// loses. For an E table on the adaptive `mu` axis stored divided by `r` (its leading
+    /// power), so that it interpolates linearly down to 0, and the lookup multiplies by `r`
+    /// again ([`normalisation`]). A 1-D table over a fine roughness axis, derived
     /// from the E table of the same bake (needs e).
     #[serde(rename = "f_ms_norm")]
     #[cfg_attr(feature = "cli", value(name = "f-ms-norm"))]
@@ -162,10 +163,11 @@ impl Quantity {
                  one_minus_E_F is 1 - E_F"
             }
             Quantity::FMsNorm => {
-                "lookup-consistent Kulla-Conty normalisation (1 - Ebar(r)) / r, Ebar(r) = 2 * \
-                 integral of E_lookup(mu, r) mu dmu the average of the E table's own bilinear \
-                 lookup (the table in lookup_of); multiply the lookup by r (the roughness \
-                 coordinate) to get 1 - Ebar, the denominator of f_ms = (1 - E(mu_o)) \
+                "lookup-consistent Kulla-Conty normalisation, Ebar(r) = 2 * integral of \
+                 E_lookup(mu, r) mu dmu the average of the E table's own bilinear lookup (the \
+                 table in lookup_of), stored as (1 - Ebar(r)) / r when that E table has an \
+                 adaptive mu axis on nodes (multiply the lookup by r, the roughness coordinate) \
+                 and as 1 - Ebar(r) otherwise; 1 - Ebar is the denominator of f_ms = (1 - E(mu_o)) \
                  (1 - E(mu_i)) / (pi (1 - Ebar)); not E_avg, which is the exact average; \
                  one_minus_f_ms_norm is 1 - the value"
             }

@@ -10,16 +10,27 @@
 //! normalisation that closes the furnace for the lookup the renderer really uses is
 //! `1 - Ē(r) = 2 ∫ (1 - E_lookup(mu, r)) mu dmu`.
 //!
-//! Its table: `g(x) = (1 - Ē(x)) / x` over the E table's roughness coordinate `x` (`r` or
-//! `alpha`), on nodes that subdivide every cell of the E table's roughness axis
+//! Its table: over the E table's roughness coordinate `x` (`r` or `alpha`), on nodes that subdivide every cell of the E table's roughness axis
 //! [`SUBDIVISIONS`] times (497 entries for a 32-row table; so the kinks of the bilinear lookup, at the E table's rows, fall on
-//! nodes and the linear interpolation between them is smooth). Why divided by `x`: between the
-//! E table's first two rows the lookup blends row 1 in with weight proportional to `x`, so
-//! `1 - Ē` starts linearly in `x` (3.4e-5 x for the default GGX table) and then grows like
-//! `alpha`; divided by `x` it is close to linear over the first cell, where `1 - Ē` itself
-//! varies over orders of magnitude. `g(0)` is the limit, the slope of `1 - Ē` at 0; the product
-//! `x g(x)` is 0 at `x = 0` (a mirror loses nothing). The lookup is
-//! [`normalisation_lookup`]: `x` times the linear interpolation of `g`.
+//! nodes and the linear interpolation between them is smooth), one of two forms
+//! ([`divides_by_roughness`]):
+//!
+//! - `g(x) = (1 - Ē(x)) / x` for an E table on the adaptive `mu` axis with its rows on nodes
+//!   (kiln's default). There the lookup's columns move with `alpha`, and between the first two
+//!   rows `1 - Ē` starts linearly in `x` (3.4e-5 x for the default GGX table) and then grows
+//!   like `alpha`; divided by `x` it is close to linear over the first cell, where `1 - Ē`
+//!   itself varies over orders of magnitude. `g(0)` is the limit, the slope of `1 - Ē` at 0;
+//!   the product `x g(x)` is 0 at `x = 0` (a mirror loses nothing).
+//! - `g(x) = 1 - Ē(x)` for every other E table (linear or square-root `mu` axis, or rows on
+//!   texel centres, as the engines' tables are). Its columns do not move with roughness, so the
+//!   bilinear lookup is linear in `x` between rows and so is its average: the linear
+//!   interpolation of `g` on nodes that include the rows is exact, where dividing by `x` would
+//!   bend it (a relative error of `h / (2 x_0)` next to a row `x_0` where `1 - Ē` starts from
+//!   0, 6 % for Enterprise PBR's half-float table), and below the first row centre, where the
+//!   clamped lookup is constant, `(1 - Ē) / x` would diverge.
+//!
+//! The lookup is [`normalisation_lookup`]: the linear interpolation of `g`, times `x` in the
+//! first form.
 
 use super::axis::{Axis, Grid};
 use super::{Quantity, Table, TableSpec};
@@ -58,6 +69,26 @@ pub fn one_minus_lookup_average(e: &Table, roughness: f64) -> (f64, f64) {
     (integral.value[0], integral.error)
 }
 
+/// Whether the normalisation table of the E table `e` stores `(1 - Ē) / x` (true: an adaptive
+/// `mu` axis with rows on nodes) or `1 - Ē` itself (see the module docs).
+#[must_use]
+pub fn divides_by_roughness(e: &TableSpec) -> bool {
+    matches!(
+        e.mu,
+        Some(Axis::Mu {
+            mapping: super::axis::MuMapping::Adaptive,
+            ..
+        })
+    ) && e.roughness_axis().grid() == Grid::Nodes
+}
+
+/// Whether the normalisation table `norm` stores `(1 - Ē) / x` ([`divides_by_roughness`] of
+/// the E table it was derived from).
+#[must_use]
+pub fn stores_per_roughness(norm: &TableSpec) -> bool {
+    norm.lookup_of.as_deref().is_some_and(divides_by_roughness)
+}
+
 /// The spec of the normalisation table of the E table `e`.
 #[must_use]
 pub fn spec_for(e: &TableSpec) -> TableSpec {
@@ -89,20 +120,24 @@ pub fn derive(e: &Table, command: String) -> Table {
     let spec = spec_for(&e.spec);
     let n = spec.len();
     let grid = Grid::Nodes;
+    let per_x = divides_by_roughness(&e.spec);
     let mut value = vec![0.0; n];
     let mut std_error = vec![0.0; n];
-    for i in 1..n {
+    for i in 0..n {
         let x = grid.coordinate(i, n);
-        let (loss, error) = one_minus_lookup_average(e, x);
-        value[i] = loss / x;
-        std_error[i] = error / x;
+        // In the first form g(0) is the limit of (1 - Ē(x)) / x, the slope of 1 - Ē at 0: taken
+        // at a point 1e-4 of the first cell in (where the next term of 1 - Ē, of order x^2, is
+        // 1e-4 times smaller).
+        let at = if per_x && i == 0 {
+            1e-4 * grid.coordinate(1, n)
+        } else {
+            x
+        };
+        let (loss, error) = one_minus_lookup_average(e, at);
+        let scale = if per_x { at } else { 1.0 };
+        value[i] = loss / scale;
+        std_error[i] = error / scale;
     }
-    // g(0) is the limit of (1 - Ē(x)) / x, the slope of 1 - Ē at 0: taken at a point 1e-4 of
-    // the first cell in (where the next term of 1 - Ē, of order x^2, is 1e-4 times smaller).
-    let x = 1e-4 * grid.coordinate(1, n);
-    let (loss, error) = one_minus_lookup_average(e, x);
-    value[0] = loss / x;
-    std_error[0] = error / x;
     Table {
         one_minus_value: value.iter().map(|v| 1.0 - v).collect(),
         value,
@@ -114,10 +149,16 @@ pub fn derive(e: &Table, command: String) -> Table {
     }
 }
 
-/// `1 - Ē` at `roughness` (in the table's convention) from a normalisation table: `roughness`
-/// times its linear interpolation. The denominator of `f_ms` is `pi` times this
+/// `1 - Ē` at `roughness` (in the table's convention) from a normalisation table: its linear
+/// interpolation, times `roughness` if it stores `(1 - Ē) / x` ([`stores_per_roughness`]). The
+/// denominator of `f_ms` is `pi` times this
 /// ([`crate::model::kulla_conty::normalisation`]).
 #[must_use]
 pub fn normalisation_lookup(norm: &Table, roughness: f64) -> f64 {
-    roughness.clamp(0.0, 1.0) * norm.lookup(0.0, roughness)
+    let g = norm.lookup(0.0, roughness);
+    if stores_per_roughness(&norm.spec) {
+        roughness.clamp(0.0, 1.0) * g
+    } else {
+        g
+    }
 }

@@ -580,7 +580,24 @@ pub fn run(args: VerifyArgs) -> kiln::Result<bool> {
             .map_err(in_file)?;
         let mut passed = true;
         for table in &tables {
-            passed &= audit_one(&args, table)?;
+            passed &= if table.spec.quantity == Quantity::FMsNorm {
+                let e_path = args.file.with_file_name(preset.file_name());
+                let e_bytes = std::fs::read(&e_path).map_err(|source| kiln::Error::Io {
+                    path: e_path.clone(),
+                    action: "read (the E table whose lookup this f_ms_norm averages)",
+                    source,
+                })?;
+                let e = preset
+                    .read_tables(&e_bytes, &e_path.display().to_string())?
+                    .into_iter()
+                    .find(|t| t.spec.quantity == Quantity::E)
+                    .ok_or_else(|| {
+                        kiln::Error::InvalidInput(format!("{}: no E table", e_path.display()))
+                    })?;
+                normalisation_audit(&args, table, &e, &e_path)?
+            } else {
+                audit_one(&args, table)?
+            };
         }
         if let Some(audit) = preset.audit_extra(&bytes).map_err(in_file)? {
             passed &= audit_extra(&args, &audit);
@@ -620,7 +637,18 @@ fn run_normalisation_audit(args: &VerifyArgs, table: &Table) -> kiln::Result<boo
         )));
     }
     let e = args.load(&e_path)?;
-    let report = kiln::verify::furnace::audit_normalisation(&e, table)?;
+    normalisation_audit(args, table, &e, &e_path)
+}
+
+/// Audits `table` (`f_ms_norm`) against the average of the lookup of `e` (read from
+/// `e_path`), prints the report, and returns whether it passed `--max-error`.
+fn normalisation_audit(
+    args: &VerifyArgs,
+    table: &Table,
+    e: &Table,
+    e_path: &std::path::Path,
+) -> kiln::Result<bool> {
+    let report = kiln::verify::furnace::audit_normalisation(e, table)?;
     let passed = args
         .max_error
         .is_none_or(|bound| report.lookup_max_relative_error <= bound);
