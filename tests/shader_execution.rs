@@ -1,14 +1,18 @@
-//! The generated HLSL is executed, not only parsed: compiled as C++ with a small prelude that
-//! gives HLSL's types and intrinsics their meaning (`float2`, `float3`, `min`, `max`, `clamp`,
-//! `pow`, `floor`) and `Texture2D::SampleLevel` a GPU's semantics (bilinear filtering between
-//! texel centres, clamp-to-edge), every literal in single precision
+//! The generated HLSL, GLSL and WGSL are executed, not only parsed: compiled as C++ with a
+//! small prelude that gives each language's types and intrinsics their meaning (`float2`/`vec2`,
+//! `min`, `max`, `clamp`, `pow`, `floor`, WGSL's `select`) and its texture sampling
+//! (`Texture2D::SampleLevel`, `textureLod`, `textureSampleLevel`) a GPU's semantics (bilinear
+//! filtering between texel centres, clamp-to-edge), every literal in single precision
 //! (`-fsingle-precision-constant`), so the arithmetic is f32 as on a GPU. Its lookups, the
 //! Kulla-Conty lobe, its colour term and Turquin's factor are compared with the library at
 //! thousands of points: a wrong `alpha = roughness`, a missing half-texel remap or a lobe that
-//! forgot to multiply by `r` fails here.
+//! forgot to multiply by `r` fails here, in each language.
 //!
-//! WGSL and GLSL are generated from the same description of each function
-//! (`src/format/shader.rs`) and validated by naga in `tests/shaders.rs`.
+//! HLSL is C++ as it stands. GLSL needs one rewrite, of its array constructor (`float[N](...)`
+//! to a brace list). WGSL is rewritten by [`wgsl_as_cpp`] token for token (`fn f(x: f32) -> T`
+//! to `T f(float x)`, `let`/`var` to `auto`, `vec2<f32>` to `vec2`, `array<f32, N>(...)` to a
+//! `std::array`); nothing in an expression changes. naga parses and validates the WGSL and GLSL
+//! in `tests/shaders.rs`.
 
 #![cfg(feature = "cli")]
 
@@ -25,41 +29,42 @@ use std::process::Command;
 mod command;
 use command::kiln;
 
-/// HLSL's vocabulary in C++, with GPU texture sampling.
+/// The vocabulary the three languages share, in C++, with GPU texture sampling.
 const PRELUDE: &str = r"
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <vector>
 using std::floor;
 using std::pow;
 using std::sqrt;
-struct float2 {
+struct V2 {
     float x, y;
-    float2(float x, float y) : x(x), y(y) {}
+    V2(float x, float y) : x(x), y(y) {}
 };
-struct float3 {
+struct V3 {
     float x, y, z;
-    float3(float x, float y, float z) : x(x), y(y), z(z) {}
+    V3(float x, float y, float z) : x(x), y(y), z(z) {}
 };
-inline float3 operator+(float3 a, float3 b) { return float3(a.x + b.x, a.y + b.y, a.z + b.z); }
-inline float3 operator-(float3 a, float3 b) { return float3(a.x - b.x, a.y - b.y, a.z - b.z); }
-inline float3 operator*(float3 a, float3 b) { return float3(a.x * b.x, a.y * b.y, a.z * b.z); }
-inline float3 operator/(float3 a, float3 b) { return float3(a.x / b.x, a.y / b.y, a.z / b.z); }
-inline float3 operator*(float3 a, float s) { return float3(a.x * s, a.y * s, a.z * s); }
-inline float3 operator*(float s, float3 a) { return a * s; }
+inline V3 operator+(V3 a, V3 b) { return V3(a.x + b.x, a.y + b.y, a.z + b.z); }
+inline V3 operator-(V3 a, V3 b) { return V3(a.x - b.x, a.y - b.y, a.z - b.z); }
+inline V3 operator*(V3 a, V3 b) { return V3(a.x * b.x, a.y * b.y, a.z * b.z); }
+inline V3 operator/(V3 a, V3 b) { return V3(a.x / b.x, a.y / b.y, a.z / b.z); }
+inline V3 operator*(V3 a, float s) { return V3(a.x * s, a.y * s, a.z * s); }
+inline V3 operator*(float s, V3 a) { return a * s; }
 inline float min(float a, float b) { return a < b ? a : b; }
 inline int min(int a, int b) { return a < b ? a : b; }
 inline float max(float a, float b) { return a > b ? a : b; }
-inline float3 max(float3 a, float3 b) { return float3(max(a.x, b.x), max(a.y, b.y), max(a.z, b.z)); }
+inline V3 max(V3 a, V3 b) { return V3(max(a.x, b.x), max(a.y, b.y), max(a.z, b.z)); }
 inline float clamp(float x, float a, float b) { return min(max(x, a), b); }
-struct SamplerState {};
-struct Sample2 { float2 rg; };
+struct Sample2 { V2 rg; };
+struct Sampler {};
 // A 2-D texture of (R, G) texels, row 0 at v = 0: bilinear between texel centres
 // ((i + 0.5) / W), clamp to edge, as a GPU's linear filter samples level 0.
-template <typename T> struct Texture2D {
+struct Tex {
     int width, height;
     std::vector<float> texels; // R, G interleaved, row-major
-    Sample2 SampleLevel(SamplerState, float2 uv, int) const {
+    Sample2 SampleLevel(Sampler, V2 uv, int) const {
         float x = uv.x * width - 0.5f, y = uv.y * height - 0.5f;
         float fx0 = floor(x), fy0 = floor(y);
         float fx = x - fx0, fy = y - fy0;
@@ -75,10 +80,150 @@ template <typename T> struct Texture2D {
             float bottom = at(i0, j0 + 1, k) * (1 - fx) + at(i0 + 1, j0 + 1, k) * fx;
             c[k] = top * (1 - fy) + bottom * fy;
         }
-        return Sample2{float2(c[0], c[1])};
+        return Sample2{V2(c[0], c[1])};
     }
 };
 ";
+
+/// A shading language's names for the prelude's types and texture sampling.
+#[derive(Clone, Copy, Debug)]
+enum Language {
+    Hlsl,
+    Glsl,
+    Wgsl,
+}
+
+impl Language {
+    fn extension(self) -> &'static str {
+        match self {
+            Language::Hlsl => "hlsl",
+            Language::Glsl => "glsl",
+            Language::Wgsl => "wgsl",
+        }
+    }
+
+    fn prelude(self) -> &'static str {
+        match self {
+            Language::Hlsl => {
+                r"
+using float2 = V2;
+using float3 = V3;
+using SamplerState = Sampler;
+template <typename T> using Texture2D = Tex;
+"
+            }
+            Language::Glsl => {
+                r"
+using vec2 = V2;
+using vec3 = V3;
+using sampler2D = Tex;
+inline Sample2 textureLod(const Tex& t, V2 uv, float lod) { return t.SampleLevel(Sampler{}, uv, (int)lod); }
+"
+            }
+            Language::Wgsl => {
+                r"
+using vec2 = V2;
+using vec3 = V3;
+using texture_2d = Tex;
+using sampler = Sampler;
+inline Sample2 textureSampleLevel(const Tex& t, Sampler s, V2 uv, float lod) { return t.SampleLevel(s, uv, (int)lod); }
+template <typename T> T select(T f, T t, bool c) { return c ? t : f; }
+"
+            }
+        }
+    }
+
+    /// The generated source as C++.
+    fn as_cpp(self, source: &str) -> String {
+        match self {
+            Language::Hlsl => source.to_string(),
+            Language::Glsl => glsl_as_cpp(source),
+            Language::Wgsl => wgsl_as_cpp(source),
+        }
+    }
+
+    /// The arguments of a 2-D lookup before `mu, roughness`: the texture (and sampler).
+    fn texture_arguments(self, texture: &str) -> String {
+        match self {
+            Language::Glsl => texture.to_string(),
+            Language::Hlsl | Language::Wgsl => format!("{texture}, Sampler{{}}"),
+        }
+    }
+}
+
+/// GLSL's array constructors `= float[N](a, b);` as brace lists.
+fn glsl_as_cpp(source: &str) -> String {
+    source
+        .lines()
+        .map(|line| match line.find("= float[") {
+            Some(at) if line.trim_end().ends_with(");") => {
+                let open = at + line[at..].find('(').unwrap();
+                let body = &line[open + 1..line.trim_end().len() - 2];
+                format!("{}= {{{body}}};", &line[..at])
+            }
+            _ => line.to_string(),
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+/// WGSL's declarations as C++: `fn f(x: f32, t: T) -> R {` as `R f(float x, T t) {`, `let` and
+/// `var` as `auto`, `const NAME = array<f32, N>(...);` as a `std::array`, and the type names
+/// (`f32`, `i32`, `vec2<f32>`, `vec3<f32>`, `texture_2d<f32>`) as the prelude's.
+fn wgsl_as_cpp(source: &str) -> String {
+    let types = |text: &str| {
+        text.replace("vec2<f32>", "vec2")
+            .replace("vec3<f32>", "vec3")
+            .replace("texture_2d<f32>", "texture_2d")
+            .replace("f32", "float")
+            .replace("i32", "int")
+    };
+    source
+        .lines()
+        .map(|line| {
+            let trimmed = line.trim_start();
+            let indent = &line[..line.len() - trimmed.len()];
+            if let Some(rest) = trimmed.strip_prefix("fn ") {
+                let open = rest.find('(').unwrap();
+                let close = rest.rfind(')').unwrap();
+                let name = &rest[..open];
+                let params: Vec<String> = rest[open + 1..close]
+                    .split(',')
+                    .filter(|p| !p.trim().is_empty())
+                    .map(|p| {
+                        let (n, t) = p.split_once(':').unwrap();
+                        format!("{} {}", types(t.trim()), n.trim())
+                    })
+                    .collect();
+                let ret = rest[close + 1..]
+                    .trim()
+                    .trim_start_matches("->")
+                    .trim_end_matches('{')
+                    .trim();
+                format!("{indent}{} {name}({}) {{", types(ret), params.join(", "))
+            } else if let Some(rest) = trimmed.strip_prefix("const ") {
+                if let Some(at) = rest.find("= array<f32, ") {
+                    let name = rest[..at].trim();
+                    let n_end = at + rest[at..].find('>').unwrap();
+                    let n = &rest[at + "= array<f32, ".len()..n_end];
+                    let body = &rest[n_end + 2..rest.trim_end().len() - 2];
+                    format!("{indent}const std::array<float, {n}> {name} = {{{body}}};")
+                } else {
+                    line.to_string()
+                }
+            } else if let Some(rest) = trimmed.strip_prefix("let ") {
+                format!("{indent}const auto {}", types(rest))
+            } else if let Some(rest) = trimmed.strip_prefix("var ") {
+                format!("{indent}auto {}", types(rest))
+            } else if trimmed.starts_with("//") {
+                line.to_string()
+            } else {
+                types(line)
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+}
 
 fn read(dir: &Path, name: &str) -> Table {
     read_kiln(&dir.join(format!("{name}.json")))
@@ -92,17 +237,19 @@ fn floats(values: impl Iterator<Item = f64>) -> String {
     format!("{{{}}}", items.join(", "))
 }
 
-/// Compiles `main` (with the prelude and the given HLSL files) and runs it: the numbers it
-/// prints, one per line.
-fn run(dir: &Path, hlsl: &[&str], main: &str) -> Vec<f64> {
-    let mut source = PRELUDE.to_string();
-    for name in hlsl {
-        source += &std::fs::read_to_string(dir.join(format!("{name}.hlsl"))).unwrap();
+/// Compiles `main` (with the prelude and the given generated files of `language`) and runs
+/// it: the numbers it prints, one per line.
+fn run(dir: &Path, language: Language, files: &[&str], main: &str) -> Vec<f64> {
+    let mut source = PRELUDE.to_string() + language.prelude();
+    for name in files {
+        let path = dir.join(format!("{name}.{}", language.extension()));
+        source += &language.as_cpp(&std::fs::read_to_string(path).unwrap());
+        source += "\n";
     }
     source += main;
-    let cpp = dir.join("program.cpp");
+    let cpp = dir.join(format!("program-{}.cpp", language.extension()));
     std::fs::write(&cpp, source).unwrap();
-    let program = dir.join("program");
+    let program = dir.join(format!("program-{}", language.extension()));
     let compiler = std::env::var("CXX").unwrap_or_else(|_| "c++".into());
     let compiled = Command::new(compiler)
         .args(["-std=c++17", "-O0", "-fsingle-precision-constant", "-o"])
@@ -112,7 +259,8 @@ fn run(dir: &Path, hlsl: &[&str], main: &str) -> Vec<f64> {
         .expect("a C++ compiler (c++) runs");
     assert!(
         compiled.status.success(),
-        "{}",
+        "{language:?} as C++ ({}): {}",
+        cpp.display(),
         String::from_utf8_lossy(&compiled.stderr)
     );
     let output = Command::new(&program).output().unwrap();
@@ -124,19 +272,34 @@ fn run(dir: &Path, hlsl: &[&str], main: &str) -> Vec<f64> {
         .collect()
 }
 
-fn assert_close(got: f64, want: f64, tolerance: f64, what: &str) {
+fn assert_close(language: Language, got: f64, want: f64, tolerance: f64, what: &str) {
     assert!(
         (got - want).abs() <= tolerance,
-        "{what}: HLSL {got:e}, library {want:e}"
+        "{what}: {language:?} {got:e}, library {want:e}"
     );
 }
 
+/// A C++ array of the points' coordinates, flattened.
+fn point_array(name: &str, points: &[f64]) -> String {
+    format!(
+        "const std::vector<float> {name} = {};\n",
+        floats(points.iter().copied())
+    )
+}
+
 #[test]
-fn generated_hlsl_runs_and_agrees_with_the_library() {
+fn generated_shaders_run_and_agree_with_the_library() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let out = d.to_str().unwrap();
-    let baked = kiln(&["bake", "--format", "hlsl,json", "-q", "--out", out]);
+    let baked = kiln(&[
+        "bake",
+        "--format",
+        "hlsl,glsl,wgsl,json",
+        "-q",
+        "--out",
+        out,
+    ]);
     assert!(
         baked.status.success(),
         "{}",
@@ -147,7 +310,7 @@ fn generated_hlsl_runs_and_agrees_with_the_library() {
     let baked = kiln(&[
         "bake",
         "--format",
-        "hlsl,json",
+        "hlsl,glsl,wgsl,json",
         "--mu-axis",
         "sqrt",
         "--grid",
@@ -165,6 +328,19 @@ fn generated_hlsl_runs_and_agrees_with_the_library() {
         "{}",
         String::from_utf8_lossy(&baked.stderr)
     );
+    for language in [Language::Hlsl, Language::Glsl, Language::Wgsl] {
+        std::fs::copy(
+            other.join(format!(
+                "ggx-height-correlated-E-mu-sqrt-centers.{}",
+                language.extension()
+            )),
+            d.join(format!(
+                "ggx-height-correlated-E-mu-sqrt-centers.{}",
+                language.extension()
+            )),
+        )
+        .unwrap();
+    }
 
     let e = read(d, "ggx-height-correlated-E");
     let avg = read(d, "ggx-height-correlated-E_avg");
@@ -172,137 +348,146 @@ fn generated_hlsl_runs_and_agrees_with_the_library() {
     let centres = read(&other, "ggx-height-correlated-E-mu-sqrt-centers");
     assert_eq!(centres.spec.quantity, Quantity::E);
 
+    // The 2-D lookups at every point `verify` audits, on both layouts.
+    let points = |t: &Table| -> Vec<f64> {
+        lookup_coordinates(&t.spec, &AuditSettings::default())
+            .into_iter()
+            .flat_map(|c| [c.mu.unwrap(), c.alpha.sqrt()])
+            .collect()
+    };
+    let (e_points, c_points) = (points(&e), points(&centres));
+    assert!(e_points.len() > 2000 && c_points.len() > 200);
+    // The 1-D lookups, the lobe, its colour and Turquin's factor on dense ladders.
+    let ladder: Vec<f64> = (0..=1500)
+        .map(|k| (f64::from(k) / 1500.0).powi(2))
+        .collect();
+    let lobes: Vec<f64> = (0..1200)
+        .flat_map(|k| {
+            let k = f64::from(k);
+            let r = ((k * 0.618_034) % 1.0).powi(2);
+            [(k * 0.754_877) % 1.0 * 0.6, (k * 0.569_840) % 1.0 * 0.6, r]
+        })
+        .collect();
+    let fresnels: Vec<f64> = (0..1200)
+        .flat_map(|k| {
+            let k = f64::from(k);
+            [(k * 0.618_034) % 1.0, 0.05 + 0.95 * ((k * 0.754_877) % 1.0)]
+        })
+        .collect();
+
     let texture = |name: &str, t: &Table| {
         let [rows, columns] = t.spec.shape()[..] else {
             unreachable!()
         };
         let texels = floats((0..t.spec.len()).flat_map(|k| [t.value[k], t.one_minus_value[k]]));
-        format!("const Texture2D<float2> {name} = {{{columns}, {rows}, {texels}}};\n")
+        format!("const Tex {name} = {{{columns}, {rows}, {texels}}};\n")
     };
-    let mut main = texture("E", &e) + &texture("C", &centres);
-    main += "int main() {\n    SamplerState s;\n";
+    let data = texture("E", &e)
+        + &texture("C", &centres)
+        + &point_array("E_POINTS", &e_points)
+        + &point_array("C_POINTS", &c_points)
+        + &point_array("LADDER", &ladder)
+        + &point_array("LOBES", &lobes)
+        + &point_array("FRESNELS", &fresnels);
 
-    // The 2-D lookups at every point `verify` audits, on both layouts.
-    let points = |t: &Table| -> Vec<(f64, f64)> {
-        lookup_coordinates(&t.spec, &AuditSettings::default())
-            .into_iter()
-            .map(|c| (c.mu.unwrap(), c.alpha.sqrt()))
-            .collect()
-    };
-    let (e_points, c_points) = (points(&e), points(&centres));
-    assert!(e_points.len() > 1000 && c_points.len() > 100);
-    for (texture, stem, points) in [
-        ("E", "ggx_height_correlated_e", &e_points),
-        ("C", "ggx_height_correlated_e_mu_sqrt_centers", &c_points),
-    ] {
-        for &(mu, r) in points.iter() {
+    for language in [Language::Hlsl, Language::Glsl, Language::Wgsl] {
+        let mut main = data.clone();
+        main += "int main() {\n";
+        for (texture, stem, array) in [
+            ("E", "ggx_height_correlated_e", "E_POINTS"),
+            ("C", "ggx_height_correlated_e_mu_sqrt_centers", "C_POINTS"),
+        ] {
             let _ = writeln!(
                 main,
-                "    {{ float2 v = {stem}_lookup({texture}, s, {mu:?}f, {r:?}f); \
-                 printf(\"%.9g\\n%.9g\\n\", v.x, v.y); }}"
+                "    for (size_t k = 0; k < {array}.size(); k += 2) {{ auto v = \
+                 {stem}_lookup({}, {array}[k], {array}[k + 1]); \
+                 printf(\"%.9g\\n%.9g\\n\", v.x, v.y); }}",
+                language.texture_arguments(texture)
             );
         }
-    }
-    // The 1-D lookups, the lobe, its colour and Turquin's factor on dense ladders.
-    let ladder: Vec<f64> = (0..=1500)
-        .map(|k| (f64::from(k) / 1500.0).powi(2))
-        .collect();
-    for &r in &ladder {
-        let _ = writeln!(
-            main,
-            "    printf(\"%.9g\\n%.9g\\n\", ggx_height_correlated_e_avg_lookup({r:?}f), \
-             ggx_height_correlated_f_ms_norm_lookup({r:?}f));"
-        );
-    }
-    let lobes: Vec<(f64, f64, f64)> = (0..1200)
-        .map(|k| {
-            let k = f64::from(k);
-            let r = ((k * 0.618_034) % 1.0).powi(2);
-            ((k * 0.754_877) % 1.0 * 0.6, (k * 0.569_840) % 1.0 * 0.6, r)
-        })
-        .collect();
-    for &(o, i, r) in &lobes {
-        let _ = writeln!(
-            main,
-            "    printf(\"%.9g\\n\", ggx_height_correlated_f_ms_norm_f_ms({o:?}f, {i:?}f, {r:?}f));"
-        );
-    }
-    let fresnels: Vec<(f64, f64)> = (0..1200)
-        .map(|k| {
-            let k = f64::from(k);
-            ((k * 0.618_034) % 1.0, 0.05 + 0.95 * ((k * 0.754_877) % 1.0))
-        })
-        .collect();
-    for &(f, x) in &fresnels {
-        let _ = writeln!(
-            main,
-            "    {{ float3 c = ggx_height_correlated_f_ms_norm_fresnel_colour(float3({f:?}f, \
-             {f:?}f, {f:?}f), {x:?}f); float3 t = ggx_height_correlated_e_turquin({x:?}f, \
-             float3({f:?}f, {f:?}f, {f:?}f)); printf(\"%.9g\\n%.9g\\n\", c.y, t.z); }}"
-        );
-    }
-    main += "    return 0;\n}\n";
+        main += "    for (float r : LADDER) printf(\"%.9g\\n%.9g\\n\", \
+                 ggx_height_correlated_e_avg_lookup(r), \
+                 ggx_height_correlated_f_ms_norm_lookup(r));\n";
+        main += "    for (size_t k = 0; k < LOBES.size(); k += 3) printf(\"%.9g\\n\", \
+                 ggx_height_correlated_f_ms_norm_f_ms(LOBES[k], LOBES[k + 1], LOBES[k + 2]));\n";
+        main += "    for (size_t k = 0; k < FRESNELS.size(); k += 2) { float f = FRESNELS[k], \
+                 x = FRESNELS[k + 1]; auto c = \
+                 ggx_height_correlated_f_ms_norm_fresnel_colour(V3(f, f, f), x); auto t = \
+                 ggx_height_correlated_e_turquin(x, V3(f, f, f)); printf(\"%.9g\\n%.9g\\n\", \
+                 c.y, t.z); }\n";
+        main += "    return 0;\n}\n";
 
-    let centres_dir = other.clone();
-    std::fs::copy(
-        centres_dir.join("ggx-height-correlated-E-mu-sqrt-centers.hlsl"),
-        d.join("ggx-height-correlated-E-mu-sqrt-centers.hlsl"),
-    )
-    .unwrap();
-    let printed = run(
-        d,
-        &[
-            "ggx-height-correlated-E",
-            "ggx-height-correlated-E-mu-sqrt-centers",
-            "ggx-height-correlated-E_avg",
-            "ggx-height-correlated-f_ms_norm",
-        ],
-        &main,
-    );
-    let mut values = printed.into_iter();
-    let mut next = || values.next().expect("as many numbers as asked for");
+        let printed = run(
+            d,
+            language,
+            &[
+                "ggx-height-correlated-E",
+                "ggx-height-correlated-E-mu-sqrt-centers",
+                "ggx-height-correlated-E_avg",
+                "ggx-height-correlated-f_ms_norm",
+            ],
+            &main,
+        );
+        let mut values = printed.into_iter();
+        let mut next = || values.next().expect("as many numbers as asked for");
+        let f32_of = |v: f64| f64::from(v as f32);
 
-    // f32 positions err by ~31 * 6e-8 of a texel (texel steps below 0.1): 2e-6 at most.
-    for (table, points) in [(&e, &e_points), (&centres, &c_points)] {
-        for &(mu, r) in points.iter() {
-            let what = format!("{} at mu {mu}, r {r}", table.spec.id());
-            assert_close(next(), table.lookup(mu, r), 2e-6, &what);
-            assert_close(next(), table.lookup_one_minus(mu, r), 2e-6, &what);
+        // f32 positions err by ~31 * 6e-8 of a texel (texel steps below 0.1): 2e-6 at most.
+        for (table, points) in [(&e, &e_points), (&centres, &c_points)] {
+            for p in points.chunks(2) {
+                let (mu, r) = (f32_of(p[0]), f32_of(p[1]));
+                let what = format!("{} at mu {mu}, r {r}", table.spec.id());
+                assert_close(language, next(), table.lookup(mu, r), 2e-6, &what);
+                assert_close(language, next(), table.lookup_one_minus(mu, r), 2e-6, &what);
+            }
         }
+        for &r in &ladder {
+            let r = f32_of(r);
+            assert_close(
+                language,
+                next(),
+                avg.lookup(1.0, r),
+                1e-6,
+                &format!("E_avg at r {r}"),
+            );
+            let want = normalisation_lookup(&norm, r);
+            assert_close(
+                language,
+                next(),
+                want,
+                1e-6 * want.max(1e-3),
+                &format!("f_ms_norm at r {r}"),
+            );
+        }
+        for p in lobes.chunks(3) {
+            let (o, i, r) = (f32_of(p[0]), f32_of(p[1]), f32_of(p[2]));
+            let want = multiple_scattering(o, i, normalisation_lookup(&norm, r));
+            assert_close(
+                language,
+                next(),
+                want,
+                1e-5 * want.max(1.0),
+                &format!("f_ms({o}, {i}, {r})"),
+            );
+        }
+        for p in fresnels.chunks(2) {
+            let (f, x) = (f32_of(p[0]), f32_of(p[1]));
+            assert_close(
+                language,
+                next(),
+                fresnel_colour(f, x),
+                1e-6,
+                &format!("colour({f}, {x})"),
+            );
+            let turquin = 1.0 + f * (1.0 / x - 1.0);
+            assert_close(
+                language,
+                next(),
+                turquin,
+                1e-6 * turquin,
+                &format!("turquin({x}, {f})"),
+            );
+        }
+        assert!(values.next().is_none());
     }
-    for &r in &ladder {
-        assert_close(next(), avg.lookup(1.0, r), 1e-6, &format!("E_avg at r {r}"));
-        let want = normalisation_lookup(&norm, r);
-        assert_close(
-            next(),
-            want,
-            1e-6 * want.max(1e-3),
-            &format!("f_ms_norm at r {r}"),
-        );
-    }
-    for &(o, i, r) in &lobes {
-        let want = multiple_scattering(o, i, normalisation_lookup(&norm, r));
-        assert_close(
-            next(),
-            want,
-            1e-5 * want.max(1.0),
-            &format!("f_ms({o}, {i}, {r})"),
-        );
-    }
-    for &(f, x) in &fresnels {
-        assert_close(
-            next(),
-            fresnel_colour(f, x),
-            1e-6,
-            &format!("colour({f}, {x})"),
-        );
-        let turquin = 1.0 + f * (1.0 / x - 1.0);
-        assert_close(
-            next(),
-            turquin,
-            1e-6 * turquin,
-            &format!("turquin({x}, {f})"),
-        );
-    }
-    assert!(values.next().is_none());
 }
