@@ -442,10 +442,16 @@ impl BakeOptions {
         for spec in options.specs() {
             let command = self.command_for(spec.model);
             let key = CacheKey::new(&spec, self.max_error, &command);
-            if let Some(table) = cache.and_then(|c| c.load(&key)) {
-                report.reused.push(table.spec.id());
-                report.tables.push(table);
-                continue;
+            match cache.map(|c| c.lookup(&key)) {
+                Some(crate::cache::Lookup::Hit(table)) => {
+                    report.reused.push(table.spec.id());
+                    report.tables.push(*table);
+                    continue;
+                }
+                Some(crate::cache::Lookup::Damaged(reason)) => {
+                    report.repaired.push((spec.id(), reason));
+                }
+                Some(crate::cache::Lookup::Miss) | None => {}
             }
             if spec.quantity == Quantity::FMsNorm {
                 // Derived from the lookup of the E table baked (or reused) just before it.
@@ -456,6 +462,7 @@ impl BakeOptions {
                     .find(|t| Some(&t.spec) == source)
                     .expect("validate() requires E, and quantities() orders it first");
                 let table = crate::table::normalisation::derive(e, command);
+                check_computed(&table)?;
                 if let Some(cache) = cache {
                     cache.store(&key, &table)?;
                 }
@@ -464,6 +471,7 @@ impl BakeOptions {
                 continue;
             }
             let mut table = bake_table(spec, command, progress);
+            check_computed(&table)?;
             table.requested_max_error = self.max_error;
             if let Some(bound) = self.max_error {
                 table.node_errors = Some(node_errors_at(
@@ -473,6 +481,16 @@ impl BakeOptions {
                 ));
             } else if options.check_against_reference && options.method == Method::Qmc {
                 table.node_errors = Some(node_errors(&table, &ReferenceSettings::default()));
+            }
+            if let Some(measured) = table.node_errors
+                && measured.max.is_nan()
+            {
+                return Err(Error::InvalidInput(format!(
+                    "{}: the check against the reference gave no number (NaN) at one of its {} \
+                     texels; nothing was written: please report it",
+                    table.spec.id(),
+                    measured.texels
+                )));
             }
             if let (Some(bound), Some(measured)) = (self.max_error, table.node_errors)
                 && measured.max > bound
@@ -524,6 +542,8 @@ pub struct BakeReport {
     pub tables: Vec<Table>,
     pub baked: Vec<String>,
     pub reused: Vec<String>,
+    /// Tables whose cache entry was damaged (and why): baked again, and the entry replaced.
+    pub repaired: Vec<(String, String)>,
 }
 
 /// The texels a bake at a requested max error checks against the reference: for `E`, the first
@@ -628,11 +648,76 @@ pub fn estimate_texel(spec: &TableSpec, index: usize) -> Estimate {
             Estimate {
                 value: r.value,
                 one_minus_value: r.one_minus_value,
-                std_error: r.error,
+                // A quadrature that ran out of budget has no error bound: its texel says so
+                // (infinite), and the bake refuses it (`check_computed`).
+                std_error: if r.converged { r.error } else { f64::INFINITY },
                 samples: r.evaluations,
             }
         }
     }
+}
+
+/// Checks a computed table before anything is written or claimed about it: every value and
+/// one-minus value finite, every error estimate finite and not negative (an infinite one marks
+/// a quadrature that did not converge, [`estimate_texel`]). The error names the first texel
+/// that fails, where it is and what to do.
+///
+/// # Errors
+/// As above.
+pub fn check_computed(table: &Table) -> Result<()> {
+    let spec = &table.spec;
+    let place = |k: usize| {
+        let (alpha, mu) = spec.texel_coordinates(k);
+        let mut at = format!("texel {k} (alpha {alpha:e}");
+        if let Some(mu) = mu {
+            at += &format!(", mu {mu:e}");
+        }
+        if let Some(eta) = spec.texel_eta(k) {
+            at += &format!(", eta {eta:e}");
+        }
+        at + ")"
+    };
+    let lengths = [
+        table.value.len(),
+        table.one_minus_value.len(),
+        table.std_error.len(),
+    ];
+    if lengths.iter().any(|&n| n != spec.len()) {
+        return Err(Error::InvalidInput(format!(
+            "{}: {lengths:?} values, one-minus values and errors for {} texels",
+            spec.id(),
+            spec.len()
+        )));
+    }
+    for k in 0..spec.len() {
+        let (v, w, e) = (table.value[k], table.one_minus_value[k], table.std_error[k]);
+        if !v.is_finite() || !w.is_finite() {
+            return Err(Error::InvalidInput(format!(
+                "{}: the computed value at {} is {v} (1 - value {w}): the model gives no finite \
+                 number there; nothing was written. Check the inputs (IOR, eta, k) for values \
+                 outside what the physics allows",
+                spec.id(),
+                place(k)
+            )));
+        }
+        if e == f64::INFINITY {
+            return Err(Error::InvalidInput(format!(
+                "{}: the quadrature did not converge at {} within its evaluation budget, so \
+                 the value {v} has no error bound; nothing was written. Ask for fewer digits \
+                 (a larger --max-error) or use --method qmc",
+                spec.id(),
+                place(k)
+            )));
+        }
+        if !(e >= 0.0 && e.is_finite()) {
+            return Err(Error::InvalidInput(format!(
+                "{}: the error estimate at {} is {e}; nothing was written",
+                spec.id(),
+                place(k)
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// The estimated cost of baking `spec`, in seconds of one core (divide by the threads): for

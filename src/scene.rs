@@ -499,6 +499,7 @@ impl Scene {
             report.tables.extend(part.tables);
             report.baked.extend(part.baked);
             report.reused.extend(part.reused);
+            report.repaired.extend(part.repaired);
         }
         let mut files = crate::format::encode_all(&report.tables, &formats, precision)?;
         if !self.materials.is_empty() {

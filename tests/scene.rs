@@ -109,3 +109,73 @@ fn a_damaged_cache_entry_is_rebaked() {
         .unwrap();
     assert_eq!(again.report.baked.len(), 3);
 }
+
+/// A cache entry whose numbers were changed (one digit of one value) or whose key was edited
+/// (a GGX table relabelled Beckmann) fails its digest: it is rebaked, replaced and reported,
+/// and the tables written are those of a clean bake. Before the digest, the changed digit was
+/// written out as is.
+#[test]
+fn an_edited_cache_entry_fails_its_digest_and_is_repaired() {
+    let clean = tempfile::tempdir().unwrap();
+    let reference = scene(STEEL)
+        .bake(clean.path(), &|_| {}, Replace::Refuse)
+        .unwrap();
+    for edit in ["digit", "key"] {
+        let dir = tempfile::tempdir().unwrap();
+        scene(STEEL)
+            .bake(dir.path(), &|_| {}, Replace::Refuse)
+            .unwrap();
+        let mut edited = 0;
+        for entry in std::fs::read_dir(dir.path().join(".kiln-cache")).unwrap() {
+            let path = entry.unwrap().path();
+            let text = std::fs::read_to_string(&path).unwrap();
+            let changed = match edit {
+                "digit" => {
+                    // The fifth character of the first value of six or more: a digit of
+                    // its mantissa.
+                    let start = text.find("\"value\":[").unwrap() + 9;
+                    let mut at = start;
+                    for token in text[start..].split(',') {
+                        if token.len() >= 6 {
+                            at += 4;
+                            break;
+                        }
+                        at += token.len() + 1;
+                    }
+                    let digit = text.as_bytes()[at];
+                    assert!(digit.is_ascii_digit(), "{}", &text[at - 4..at + 5]);
+                    let new = if digit == b'5' { '6' } else { '5' };
+                    format!("{}{new}{}", &text[..at], &text[at + 1..])
+                }
+                _ => text.replacen("\"ndf\":\"ggx\"", "\"ndf\":\"beckmann\"", 1),
+            };
+            if changed != text {
+                edited += 1;
+                std::fs::write(&path, changed).unwrap();
+            }
+        }
+        assert!(edited > 0);
+        let again = scene(STEEL)
+            .bake(dir.path(), &|_| {}, Replace::Force)
+            .unwrap();
+        assert_eq!(
+            again.report.repaired.len(),
+            edited,
+            "{edit}: {:?}",
+            again.report
+        );
+        assert!(
+            again
+                .report
+                .repaired
+                .iter()
+                .all(|(_, why)| why.contains("digest") || why.contains("key"))
+        );
+        assert_eq!(again.report.tables, reference.report.tables, "{edit}");
+        // Replaced: the third bake reuses everything.
+        let third = scene(STEEL)
+            .bake(dir.path(), &|_| {}, Replace::Refuse)
+            .unwrap();
+        assert!(third.report.baked.is_empty() && third.report.repaired.is_empty());
+    }
+}

@@ -89,7 +89,7 @@ pub fn sheen_plane(n: usize, tolerance: f64) -> SheenPlane {
         })
         .collect();
     SheenPlane {
-        max_error: texels.iter().map(|q| q.error).fold(0.0, f64::max),
+        max_error: crate::stats::max_or_nan(texels.iter().map(|q| q.error)),
         converged: texels.iter().all(|q| q.converged),
         value: texels.into_iter().map(|q| q.value[0]).collect(),
     }

@@ -262,7 +262,7 @@ pub fn errors(values: &[f64], truth: &[f64]) -> (f64, f64) {
         .zip(truth)
         .map(|(v, t)| (v - t).abs())
         .collect();
-    let max = diffs.iter().copied().fold(0.0, f64::max);
+    let max = crate::stats::max_or_nan(diffs.iter().copied());
     let rms = (diffs.iter().map(|d| d * d).sum::<f64>() / diffs.len() as f64).sqrt();
     (max, rms)
 }

@@ -66,7 +66,7 @@ pub enum Quantity {
     /// `f_ms = (1 - E(mu_o)) (1 - E(mu_i)) / (pi (1 - Ē))` gives back exactly what that lookup
     /// loses. For an E table on the adaptive `mu` axis stored divided by `r` (its leading
     /// power), so that it interpolates linearly down to 0, and the lookup multiplies by `r`
-    /// again ([`normalisation`]). A 1-D table over a fine roughness axis, derived
+    /// again (see `table::normalisation`). A 1-D table over a fine roughness axis, derived
     /// from the E table of the same bake (needs e).
     #[serde(rename = "f_ms_norm")]
     #[cfg_attr(feature = "cli", value(name = "f-ms-norm"))]
@@ -561,10 +561,11 @@ pub struct Table {
 }
 
 impl Table {
-    /// The largest per-texel standard error.
+    /// The largest per-texel standard error (NaN if any is NaN; infinite where a quadrature
+    /// did not converge, [`crate::bake::estimate_texel`]).
     #[must_use]
     pub fn max_std_error(&self) -> f64 {
-        self.std_error.iter().copied().fold(0.0, f64::max)
+        crate::stats::max_or_nan(self.std_error.iter().copied())
     }
 
     /// The root-mean-square per-texel standard error.

@@ -271,7 +271,7 @@ pub fn audit_normalisation(e: &Table, norm: &Table) -> Result<NormalisationAudit
     let between: Vec<f64> = (0..n - 1)
         .map(|i| (grid.coordinate(i, n) + grid.coordinate(i + 1, n)) / 2.0)
         .collect();
-    let node_max_relative_error = nodes.iter().map(|&x| relative(x)).fold(0.0, f64::max);
+    let node_max_relative_error = crate::stats::max_or_nan(nodes.iter().map(|&x| relative(x)));
     let (worst_roughness, lookup_max_relative_error) = between
         .iter()
         .map(|&x| (x, relative(x)))

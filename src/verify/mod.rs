@@ -285,7 +285,7 @@ pub fn audit(
     let p99 = lookup_errors
         [((0.99 * lookup_errors.len() as f64).ceil() as usize).clamp(1, lookup_errors.len()) - 1];
     let all = nodes.iter().chain(&lookups);
-    let reference_error_estimate = all.clone().map(|p| p.1).fold(0.0, f64::max);
+    let reference_error_estimate = crate::stats::max_or_nan(all.clone().map(|p| p.1));
     let reference_converged = all.clone().all(|p| p.2);
     let (worst_node, worst_lookup) = (worst(&nodes), worst(&lookups));
     Report {
@@ -420,31 +420,44 @@ pub fn node_errors_at(
     settings: &ReferenceSettings,
 ) -> NodeErrors {
     let spec = &table.spec;
-    let errors: Vec<f64> = indices
+    let measured: Vec<(f64, bool)> = indices
         .par_iter()
         .map(|&k| {
             let (alpha, mu) = spec.texel_coordinates(k);
             let reference = reference_value(spec, alpha, mu, spec.texel_eta(k), settings);
             // `1 - E` where both carry it directly; the split-sum channels and `E_F` by value.
-            if spec.quantity.varies_on_a_mirror() {
+            let difference = if spec.quantity.varies_on_a_mirror() {
                 (table.value[k] - reference.value).abs()
             } else {
                 (table.one_minus_value[k] - reference.one_minus_value).abs()
+            };
+            // A reference that ran out of budget is only known to within its own error
+            // estimate: the error stated is the difference plus that, never less.
+            if reference.converged {
+                (difference, true)
+            } else {
+                (difference + reference.error, false)
             }
         })
         .collect();
     NodeErrors {
-        max: errors.iter().copied().fold(0.0, f64::max),
-        rms: (errors.iter().map(|e| e * e).sum::<f64>() / errors.len() as f64).sqrt(),
-        texels: errors.len(),
+        max: crate::stats::max_or_nan(measured.iter().map(|m| m.0)),
+        rms: (measured.iter().map(|m| m.0 * m.0).sum::<f64>() / measured.len() as f64).sqrt(),
+        texels: measured.len(),
+        unconverged: measured.iter().filter(|m| !m.1).count(),
     }
 }
 
 /// The node errors `kiln bake` measures and records.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, serde::Deserialize)]
 pub struct NodeErrors {
+    /// The largest error (NaN if any texel is NaN).
     pub max: f64,
     pub rms: f64,
     /// How many texels were checked.
     pub texels: usize,
+    /// How many of them had a reference that did not converge within its evaluation budget
+    /// (their error is the difference plus the reference's own error estimate).
+    #[serde(default)]
+    pub unconverged: usize,
 }

@@ -410,6 +410,13 @@ fn bake_scene(
     let start = Instant::now();
     let result = scene.bake(&dir, &|samples| bar.inc(samples), replace)?;
     bar.finish_and_clear();
+    // A warning, quiet or not.
+    for (id, reason) in &result.report.repaired {
+        eprintln!(
+            "kiln: warning: the cache entry of {id} was damaged ({reason}): baked it again and \
+             replaced the entry"
+        );
+    }
     if !quiet {
         let list = |ids: &[String]| {
             if ids.is_empty() {

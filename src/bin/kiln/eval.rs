@@ -342,7 +342,7 @@ fn fresnel_weighted(
     }
     let seconds = start.elapsed().as_secs_f64();
     let values: [f64; 3] = std::array::from_fn(|j| channels[j.min(channels.len() - 1)].0);
-    let error = channels.iter().map(|c| c.1).fold(0.0, f64::max);
+    let error = kiln::stats::max_or_nan(channels.iter().map(|c| c.1));
     let samples: u64 = channels.iter().map(|c| c.2).sum();
     let converged = channels.iter().all(|c| c.3);
     let uniform = values[0] == values[1] && values[1] == values[2];

@@ -1,0 +1,135 @@
+//! The cache key carries `kiln::cache::NUMERICS_VERSION`, the version of kiln's numbers, so that
+//! no scene cache or build script reuses a table the current code would not make. This test
+//! holds digests of small tables of every kind for that version: when a change alters any
+//! stored number, it fails until the version is bumped and the digests are renewed.
+//!
+//! Values are digested at 9 significant digits, so that a machine whose last bits differ (FMA,
+//! SIMD width) does not fail, while any change of substance does.
+
+use kiln::cache::{NUMERICS_VERSION, fnv1a};
+use kiln::{BakeOptions, Method, Ndf, Quantity, Table};
+
+/// The digests of [`NUMERICS_VERSION`]: (version, table, FNV-1a of its values at 9 digits).
+const GOLDEN: &[(u32, &str, &str)] = &[
+    (2, "ggx-height-correlated-E Reference", "9eebdec17c5588db"),
+    (
+        2,
+        "ggx-height-correlated-E_avg Reference",
+        "b8a04f0ac415d77b",
+    ),
+    (
+        2,
+        "ggx-height-correlated-f_ms_norm Reference",
+        "9d6262dbc0598008",
+    ),
+    (
+        2,
+        "beckmann-height-correlated-E Reference",
+        "b294a94af93f4738",
+    ),
+    (
+        2,
+        "beckmann-height-correlated-E_avg Reference",
+        "d09c580c449cb7ed",
+    ),
+    (
+        2,
+        "ggx-height-correlated-E_scale-mu-linear Reference",
+        "304eb1a2937ed309",
+    ),
+    (
+        2,
+        "ggx-height-correlated-E_bias-mu-linear Reference",
+        "72fc9daaf4043745",
+    ),
+    (
+        2,
+        "ggx-height-correlated-E_dielectric Reference",
+        "b44374a15aab8a0e",
+    ),
+    (
+        2,
+        "ggx-height-correlated-E_dielectric_inside Reference",
+        "9628faa47a1a8215",
+    ),
+    (2, "dielectric-F_avg Reference", "6721c906b37a9454"),
+    (2, "ggx-height-correlated-E Qmc", "e60e9f97dcff4b2a"),
+    (2, "ggx-height-correlated-E_avg Qmc", "653fca88dccaae34"),
+];
+
+fn digest(table: &Table) -> String {
+    let text: String = table
+        .value
+        .iter()
+        .chain(&table.one_minus_value)
+        .map(|v| format!("{v:.8e};"))
+        .collect();
+    format!("{:016x}", fnv1a(text.as_bytes()))
+}
+
+fn tables() -> Vec<Table> {
+    let base = BakeOptions {
+        size: 5,
+        ior_size: 3,
+        max_error: Some(1e-6),
+        ..BakeOptions::default()
+    };
+    let bake = |options: BakeOptions| options.bake(&|_| {}).unwrap();
+    let mut all = bake(base.clone());
+    all.extend(bake(BakeOptions {
+        ndfs: vec![Ndf::Beckmann],
+        quantities: vec![Quantity::E, Quantity::EAvg],
+        ..base.clone()
+    }));
+    all.extend(bake(BakeOptions {
+        quantities: vec![Quantity::EScale, Quantity::EBias],
+        mu_mapping: kiln::MuMapping::Linear,
+        ..base.clone()
+    }));
+    all.extend(bake(BakeOptions {
+        quantities: vec![
+            Quantity::EDielectric,
+            Quantity::EDielectricInside,
+            Quantity::FAvg,
+        ],
+        ..base.clone()
+    }));
+    all.extend(bake(BakeOptions {
+        quantities: vec![Quantity::E, Quantity::EAvg],
+        method: Method::Qmc,
+        max_error: None,
+        samples: 1 << 10,
+        average_samples: 1 << 10,
+        check_against_reference: false,
+        ..base
+    }));
+    all
+}
+
+#[test]
+fn the_numbers_are_those_of_the_numerics_version() {
+    let found: Vec<(String, String)> = tables()
+        .iter()
+        .map(|t| (format!("{} {:?}", t.spec.id(), t.spec.method), digest(t)))
+        .collect();
+    let listing: String = found
+        .iter()
+        .map(|(id, d)| format!("    ({NUMERICS_VERSION}, \"{id}\", \"{d}\"),\n"))
+        .collect();
+    let renew = format!(
+        "if the change of numbers is intended, bump NUMERICS_VERSION in src/cache.rs (so that \
+         caches rebake) and set GOLDEN in tests/numerics_version.rs to:\n{listing}"
+    );
+    assert!(
+        GOLDEN.iter().all(|g| g.0 == NUMERICS_VERSION),
+        "NUMERICS_VERSION is {NUMERICS_VERSION} but the digests are of another version; {renew}"
+    );
+    assert_eq!(GOLDEN.len(), found.len(), "{renew}");
+    for ((_, id, want), (found_id, got)) in GOLDEN.iter().zip(&found) {
+        assert_eq!(id, found_id, "{renew}");
+        assert_eq!(
+            want, got,
+            "the numbers of {id} changed under NUMERICS_VERSION {NUMERICS_VERSION}; {renew}"
+        );
+    }
+}
