@@ -123,11 +123,11 @@ impl BakeOptions {
                 self.ior_size
             )));
         }
-        if !(self.ior_max > 1.0 && self.ior_max <= 100.0) {
+        if !(self.ior_max > 1.0 && self.ior_max <= MAX_IOR) {
             return Err(Error::InvalidInput(format!(
                 "ior-max must be above 1 and at most 100 (got {}): the IOR axis runs over \
                  [1, ior-max], and inside tables use 1 / eta",
-                self.ior_max
+                crate::error::shown(self.ior_max)
             )));
         }
         if let Some(x) = self.max_error
@@ -656,6 +656,9 @@ pub fn estimate_texel(spec: &TableSpec, index: usize) -> Estimate {
         }
     }
 }
+
+/// The top of an IOR axis kiln accepts ([`crate::model::fresnel::MAX_INDEX`]).
+pub const MAX_IOR: f64 = crate::model::fresnel::MAX_INDEX;
 
 /// Checks a computed table before anything is written or claimed about it: every value and
 /// one-minus value finite, every error estimate finite and not negative (an infinite one marks

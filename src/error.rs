@@ -52,3 +52,40 @@ impl std::error::Error for Error {
 
 /// kiln's result type.
 pub type Result<T> = std::result::Result<T, Error>;
+
+/// A number as a message shows it: plainly between 1e-4 and 1e6, in scientific notation beyond
+/// (`1e155`, not 156 digits).
+#[must_use]
+pub fn shown(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() || (1e-4..1e6).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
+/// Text from a file as a message quotes it: control characters (newlines, NUL, escape) and the
+/// bidirectional overrides that reorder a terminal line shown escaped, at most 60 characters.
+#[must_use]
+pub fn quoted(text: &str) -> String {
+    let mut out = String::new();
+    for (n, c) in text.chars().enumerate() {
+        if n == 60 {
+            out.push('…');
+            break;
+        }
+        if c.is_control() || is_bidi_control(c) {
+            out.extend(c.escape_default());
+        } else {
+            out.push(c);
+        }
+    }
+    format!("'{out}'")
+}
+
+/// The Unicode bidirectional formatting characters (embeddings, overrides, isolates, marks),
+/// which change how the text around them is displayed.
+#[must_use]
+pub fn is_bidi_control(c: char) -> bool {
+    matches!(c, '\u{200e}' | '\u{200f}' | '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}')
+}

@@ -590,7 +590,8 @@ impl Preset {
                     .filter(|s| !s.is_empty())
                     .map(|s| {
                         let s = s.trim_start_matches("0x").trim_start_matches("0X");
-                        u16::from_str_radix(s, 16).map_err(|e| bad(format!("'{s}': {e}")))
+                        u16::from_str_radix(s, 16)
+                            .map_err(|e| bad(format!("{}: {e}", crate::error::quoted(s))))
                     })
                     .collect::<Result<_>>()?;
                 if bits.len() != 2 * n * n {
@@ -712,6 +713,20 @@ impl Preset {
         let reference = self
             .extra_channel()
             .expect("a preset that decodes an extra channel computes it");
+        if stored.len() != reference.value.len() {
+            return Err(Error::InvalidInput(format!(
+                "the {} channel has {} values (expected {})",
+                reference.name,
+                stored.len(),
+                reference.value.len()
+            )));
+        }
+        if let Some(k) = stored.iter().position(|v| !v.is_finite()) {
+            return Err(Error::InvalidInput(format!(
+                "the {} channel at texel {k} is {}, not a finite number",
+                reference.name, stored[k]
+            )));
+        }
         let (mut max_error, mut sum2, mut worst) = (0.0f64, 0.0, 0);
         for (k, (s, r)) in stored.iter().zip(&reference.value).enumerate() {
             let error = (s - r).abs();
@@ -775,7 +790,7 @@ impl Preset {
     /// value` by subtraction; no standard errors), for auditing.
     pub fn read_tables(self, bytes: &[u8], origin: &str) -> Result<Vec<Table>> {
         let specs = self.options().resolved().specs();
-        Ok(self
+        let tables: Vec<Table> = self
             .decode(bytes)?
             .into_iter()
             .filter_map(|(quantity, value)| {
@@ -791,7 +806,17 @@ impl Preset {
                 node_errors: None,
                 requested_max_error: None,
             })
-            .collect())
+            .collect();
+        for table in &tables {
+            table.check().map_err(|m| {
+                Error::InvalidInput(format!(
+                    "{origin}: {} in the {} layout: {m}",
+                    table.spec.quantity.symbol(),
+                    self.name()
+                ))
+            })?;
+        }
+        Ok(tables)
     }
 }
 

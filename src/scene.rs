@@ -207,17 +207,18 @@ fn toml_message(error: &toml::de::Error, text: &str, origin: &str) -> String {
     let mut message = error.message().trim().to_string();
     if source_line.starts_with("fresnel") {
         message = format!(
-            "'{source_line}': a Fresnel model is \"none\", {{ schlick = {{ f0 = 0.04 }} }} (f0 \
+            "{}: a Fresnel model is \"none\", {{ schlick = {{ f0 = 0.04 }} }} (f0 \
              and an optional f90, one value or [r, g, b]), {{ dielectric = {{ ior = 1.5 }} }} or \
-             {{ conductor = {{ eta = [r, g, b], k = [r, g, b] }} }}"
+             {{ conductor = {{ eta = [r, g, b], k = [r, g, b] }} }}",
+            crate::error::quoted(source_line)
         );
     } else if message.contains("untagged enum Roughness") {
         message = format!(
-            "'{source_line}': roughness is one perceptual roughness in [0, 1] or a [min, max] \
-             range"
+            "{}: roughness is one perceptual roughness in [0, 1] or a [min, max] range",
+            crate::error::quoted(source_line)
         );
     } else if !source_line.is_empty() {
-        message = format!("'{source_line}': {message}");
+        message = format!("{}: {message}", crate::error::quoted(source_line));
     }
     match line {
         Some(line) => format!("{origin}, line {line}: {message}"),
@@ -237,10 +238,13 @@ impl Scene {
 
     /// Reads and parses a scene file.
     pub fn read(path: &Path) -> Result<Scene> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::Io {
-            path: path.to_path_buf(),
-            action: "read the scene file",
-            source: e,
+        let bytes = crate::format::read_file(path)?;
+        let text = String::from_utf8(bytes).map_err(|e| {
+            Error::InvalidInput(format!(
+                "{}: not a text file (invalid UTF-8 at byte {}); a scene is TOML",
+                path.display(),
+                e.utf8_error().valid_up_to()
+            ))
         })?;
         let mut scene = Scene::parse(&text, &path.display().to_string())?;
         scene.base_dir = Some(
@@ -256,6 +260,16 @@ impl Scene {
         for m in &self.materials {
             if m.name.trim().is_empty() {
                 return Err(bad("a material has an empty name".into()));
+            }
+            if m.name
+                .chars()
+                .any(|c| c.is_control() || crate::error::is_bidi_control(c))
+            {
+                return Err(bad(format!(
+                    "material {}: a name may not hold control characters (NUL, newlines, \
+                     escapes) or bidirectional overrides, which would hide what it says",
+                    crate::error::quoted(&m.name)
+                )));
             }
             if names.contains(&m.name.as_str()) {
                 return Err(bad(format!(

@@ -57,6 +57,16 @@ fn align16(n: usize) -> usize {
     n.div_ceil(16) * 16
 }
 
+/// The axis descriptors the header of `spec`'s binary holds, in its order (what
+/// [`BinaryContents::axes`] reads back).
+#[must_use]
+pub fn descriptors(spec: &crate::table::TableSpec) -> Vec<[u32; 4]> {
+    spec.axes()
+        .iter()
+        .map(|a| axis_descriptor(Some(a)))
+        .collect()
+}
+
 fn axis_descriptor(axis: Option<&Axis>) -> [u32; 4] {
     let grid = |g: Grid| match g {
         Grid::Centers => 0,
@@ -216,7 +226,16 @@ pub fn decode(bytes: &[u8]) -> std::result::Result<BinaryContents, String> {
     let shape: Vec<usize> = (0..rank)
         .map(|k| word(dim_offset(k)).map(|v| v as usize))
         .collect::<std::result::Result<_, _>>()?;
-    let count: usize = shape.iter().product();
+    let count = shape
+        .iter()
+        .try_fold(1_usize, |n, &s| n.checked_mul(s))
+        .filter(|&n| n > 0 && n <= super::MAX_TEXELS)
+        .ok_or_else(|| {
+            format!(
+                "bad header: shape {shape:?} (1 to {} texels)",
+                super::MAX_TEXELS
+            )
+        })?;
     let mut axes = Vec::with_capacity(rank);
     for k in 0..rank {
         let base = descriptor_offset(k);
@@ -241,8 +260,9 @@ pub fn decode(bytes: &[u8]) -> std::result::Result<BinaryContents, String> {
         let dtype = Precision::from_code(word(entry + name_bytes)?)
             .ok_or_else(|| format!("channel {name}: unknown dtype"))?;
         let plane = word(entry + name_bytes + 4)? as usize;
-        let data = bytes
-            .get(plane..plane + count * dtype.bytes())
+        let data = plane
+            .checked_add(count * dtype.bytes())
+            .and_then(|end| bytes.get(plane..end))
             .ok_or_else(|| format!("channel {name}: file too short for {count} values"))?;
         let values = match dtype {
             Precision::F32 => data

@@ -148,6 +148,23 @@ pub struct ExrContents {
 
 /// Reads the first layer of an EXR file from memory.
 pub fn decode(bytes: &[u8]) -> std::result::Result<ExrContents, String> {
+    // The header first: a data window beyond what a table can be is refused before the image
+    // is allocated (a 405-byte file can claim 2^40 pixels).
+    let meta = ::exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false)
+        .map_err(|e| e.to_string())?;
+    for header in &meta.headers {
+        let (w, h) = (header.layer_size.0, header.layer_size.1);
+        let samples = w
+            .saturating_mul(h)
+            .saturating_mul(header.channels.list.len().max(1));
+        if w.saturating_mul(h) > super::MAX_TEXELS || samples > 4 * super::MAX_TEXELS {
+            return Err(format!(
+                "a {w} x {h} image with {} channels, more than the {} texels kiln reads",
+                header.channels.list.len(),
+                super::MAX_TEXELS
+            ));
+        }
+    }
     let image = read()
         .no_deep_data()
         .largest_resolution_level()

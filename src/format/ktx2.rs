@@ -185,6 +185,16 @@ pub fn decode(bytes: &[u8]) -> std::result::Result<super::texture::DecodedTextur
         header.pixel_height.max(1) as usize,
         header.pixel_depth.max(1) as usize,
     );
+    let texels = extent.0.saturating_mul(extent.1).saturating_mul(extent.2);
+    if texels > super::MAX_TEXELS {
+        return Err(format!(
+            "{} x {} x {} texels, more than the {} kiln reads",
+            extent.0,
+            extent.1,
+            extent.2,
+            super::MAX_TEXELS
+        ));
+    }
     // What the texels must take: decompression stops there, whatever the file claims.
     let expected = extent
         .0

@@ -223,6 +223,62 @@ pub fn as_stored(tables: &[Table], precision: Precision) -> Vec<Table> {
         .collect()
 }
 
+/// The most texels kiln reads from any file or accepts in any metadata: 2^26, a 4096 x 4096
+/// table (the largest 2-D table kiln bakes, [`crate::BakeOptions::MAX_SIZE`]). A header that
+/// claims more is refused before anything is allocated or decompressed.
+pub const MAX_TEXELS: usize = 1 << 26;
+
+/// The largest file kiln reads: 2 GiB (a 4096 x 4096 table with its three channels in JSON is
+/// about 1 GiB). Larger files, and anything that is not a regular file (`/dev/zero`, a pipe,
+/// a directory), are refused before reading.
+pub const MAX_FILE_BYTES: u64 = 2 << 30;
+
+/// Reads a file kiln was given, within [`MAX_FILE_BYTES`]: a regular file only, refused at once
+/// otherwise, and read through a limit so that a file growing meanwhile cannot exceed it.
+///
+/// # Errors
+/// When the file cannot be read, is not a regular file or is too large.
+pub fn read_file(path: &Path) -> Result<Vec<u8>> {
+    let io = |action: &'static str| {
+        move |source| Error::Io {
+            path: path.to_path_buf(),
+            action,
+            source,
+        }
+    };
+    let metadata = std::fs::metadata(path).map_err(io("read"))?;
+    if !metadata.is_file() {
+        return Err(Error::InvalidInput(format!(
+            "{}: not a regular file (kiln reads tables and scenes from files, not devices, \
+             pipes or directories)",
+            path.display()
+        )));
+    }
+    if metadata.len() > MAX_FILE_BYTES {
+        return Err(Error::InvalidInput(format!(
+            "{}: {} bytes, more than the {} bytes of any table kiln reads",
+            path.display(),
+            metadata.len(),
+            MAX_FILE_BYTES
+        )));
+    }
+    let file = std::fs::File::open(path).map_err(io("open"))?;
+    let mut bytes = Vec::with_capacity(usize::try_from(metadata.len()).unwrap_or(0));
+    std::io::Read::read_to_end(
+        &mut std::io::Read::take(file, MAX_FILE_BYTES + 1),
+        &mut bytes,
+    )
+    .map_err(io("read"))?;
+    if bytes.len() as u64 > MAX_FILE_BYTES {
+        return Err(Error::InvalidInput(format!(
+            "{}: grew beyond {} bytes while being read",
+            path.display(),
+            MAX_FILE_BYTES
+        )));
+    }
+    Ok(bytes)
+}
+
 /// Checks that `dir` exists or can be created, and that kiln can create files in it: called
 /// before long work so that a bad `--out` fails at once, not after the bake.
 pub fn check_output_dir(dir: &Path) -> Result<()> {
@@ -246,6 +302,7 @@ pub fn check_output_dir(dir: &Path) -> Result<()> {
 /// each goes to a temporary file first; only when all were written are they renamed into place.
 pub fn write_files(dir: &Path, files: &[(String, Vec<u8>)]) -> Result<Vec<PathBuf>> {
     check_output_dir(dir)?;
+    remove_stale_temporaries(dir);
     let mut staged = Vec::with_capacity(files.len());
     for (name, bytes) in files {
         let path = dir.join(name);
@@ -277,6 +334,43 @@ pub fn write_files(dir: &Path, files: &[(String, Vec<u8>)]) -> Result<Vec<PathBu
         paths.push(path);
     }
     Ok(paths)
+}
+
+/// How old a temporary file of kiln's must be to count as left behind by an interrupted run:
+/// a bake holds its temporaries for the moments between writing and renaming its files.
+const STALE_AFTER: std::time::Duration = std::time::Duration::from_secs(60);
+
+/// Removes the temporary files an interrupted kiln left in `dir` (`.NAME.EXT.XXXXXX.tmp` of the
+/// files kiln writes, and `.kiln-probe-*`), if older than [`STALE_AFTER`], so that a
+/// concurrent bake's own are left alone. Returns how many were removed; failures to remove are
+/// ignored (the next run tries again).
+pub fn remove_stale_temporaries(dir: &Path) -> usize {
+    const EXTENSIONS: [&str; 14] = [
+        ".json.", ".exr.", ".bin.", ".rs.", ".png.", ".ktx2.", ".dds.", ".h.", ".wgsl.", ".glsl.",
+        ".hlsl.", ".tables.", ".js.", ".inc.",
+    ];
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return 0;
+    };
+    let mut removed = 0;
+    for entry in entries.flatten() {
+        let name = entry.file_name().to_string_lossy().into_owned();
+        let ours = name.starts_with(".kiln-probe-")
+            || (name.starts_with('.')
+                && name.ends_with(".tmp")
+                && EXTENSIONS.iter().any(|e| name.contains(e)));
+        let old = entry
+            .metadata()
+            .ok()
+            .filter(std::fs::Metadata::is_file)
+            .and_then(|m| m.modified().ok())
+            .and_then(|t| t.elapsed().ok())
+            .is_some_and(|age| age > STALE_AFTER);
+        if ours && old && std::fs::remove_file(entry.path()).is_ok() {
+            removed += 1;
+        }
+    }
+    removed
 }
 
 /// Encodes and writes tables: [`encode_all`], the replacement rule ([`replace::check`]), then

@@ -51,7 +51,7 @@ const EXTENSIONS: [Format; 11] = [
 /// The spec an existing kiln file was made to, from its own metadata; `None` for formats that
 /// carry none (binary, PNG, DDS, shaders) and for files kiln cannot read as its own.
 fn own_spec(path: &Path, format: Format) -> Option<TableSpec> {
-    let bytes = std::fs::read(path).ok()?;
+    let bytes = super::read_file(path).ok()?;
     match format {
         Format::Json => serde_json::from_slice::<Sidecar>(&bytes)
             .ok()

@@ -37,6 +37,12 @@ pub enum Fresnel {
     Conductor { eta: Rgb, k: Rgb },
 }
 
+/// The largest index of refraction (dielectric `ior`, conductor `eta` and `k`) kiln accepts,
+/// and `1 / MAX_INDEX` the smallest `ior` and `eta`: far beyond any material (diamond 2.42,
+/// germanium 4; metals' `eta` 0.03 to 5, `k` below 12), well within f64 (an `ior` of 1e155
+/// overflows `ior^2` and gave NaN tables).
+pub const MAX_INDEX: f64 = 100.0;
+
 /// Models compare equal only with identical parameters (no NaN passes [`Fresnel::validate`]), so
 /// a model can be part of a table's identity ([`crate::TableSpec`]).
 impl Eq for Fresnel {}
@@ -121,10 +127,12 @@ impl Fresnel {
             }
             Fresnel::Dielectric { eta } => {
                 finite("ior", &[eta])?;
-                if eta <= 0.0 {
+                if !(1.0 / MAX_INDEX..=MAX_INDEX).contains(&eta) {
                     return Err(format!(
-                        "ior must be > 0 (got {eta}); it is n_inside / n_outside, e.g. 1.5 for \
-                         glass in air, 1/1.5 for light leaving glass"
+                        "ior must be between 0.01 and 100 (got {}); it is n_inside / \
+                         n_outside, e.g. 1.5 for glass in air, 1/1.5 for light leaving glass \
+                         (real materials lie between 1/4 and 4)",
+                        crate::error::shown(eta)
                     ));
                 }
                 Ok(())
@@ -132,11 +140,21 @@ impl Fresnel {
             Fresnel::Conductor { eta, k } => {
                 finite("eta", &eta)?;
                 finite("k", &k)?;
-                if let Some(x) = eta.iter().find(|x| **x <= 0.0) {
-                    return Err(format!("eta must be > 0 (got {x})"));
+                if let Some(x) = eta
+                    .iter()
+                    .find(|x| !(1.0 / MAX_INDEX..=MAX_INDEX).contains(*x))
+                {
+                    return Err(format!(
+                        "eta must be between 0.01 and 100 (got {}); metals lie between 0.03 \
+                         and 5",
+                        crate::error::shown(*x)
+                    ));
                 }
-                if let Some(x) = k.iter().find(|x| **x < 0.0) {
-                    return Err(format!("k must be >= 0 (got {x})"));
+                if let Some(x) = k.iter().find(|x| !(0.0..=MAX_INDEX).contains(*x)) {
+                    return Err(format!(
+                        "k must be between 0 and 100 (got {}); metals lie below 12",
+                        crate::error::shown(*x)
+                    ));
                 }
                 Ok(())
             }

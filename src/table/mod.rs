@@ -1,6 +1,7 @@
 //! Tables: what was computed (the spec), the values with their errors, and how to look them up.
 
 pub mod axis;
+pub mod check;
 pub mod normalisation;
 
 use crate::integrate::QmcSettings;
@@ -364,7 +365,7 @@ impl TableSpec {
     /// The number of texels.
     #[must_use]
     pub fn len(&self) -> usize {
-        self.shape().iter().product()
+        self.shape().iter().fold(1, |n, &s| n.saturating_mul(s))
     }
 
     /// Whether the table has no texels (never, for a validated spec).

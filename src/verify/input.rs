@@ -54,11 +54,7 @@ fn invalid(path: &Path, message: impl std::fmt::Display) -> Error {
 }
 
 fn read(path: &Path) -> Result<Vec<u8>> {
-    std::fs::read(path).map_err(|source| Error::Io {
-        path: path.to_path_buf(),
-        action: "read",
-        source,
-    })
+    crate::format::read_file(path)
 }
 
 /// Checks that no value is NaN or infinite, naming the first one that is.
@@ -149,6 +145,20 @@ pub fn read_kiln(path: &Path) -> Result<Option<Table>> {
         .unwrap_or("")
         .to_ascii_lowercase();
     let from_metadata = |metadata: Metadata, channels: &[(String, Vec<f64>)]| -> Result<Table> {
+        metadata
+            .spec
+            .check()
+            .map_err(|m| invalid(path, format!("its metadata: {m}")))?;
+        if metadata.quantity != metadata.spec.quantity.symbol() {
+            return Err(invalid(
+                path,
+                format!(
+                    "its metadata names quantity {} but its spec {}",
+                    metadata.quantity,
+                    metadata.spec.quantity.symbol()
+                ),
+            ));
+        }
         let values = channel(path, channels, &metadata.quantity)?;
         check_finite(path, &values)?;
         if values.len() != metadata.spec.len() {
@@ -169,6 +179,7 @@ pub fn read_kiln(path: &Path) -> Result<Option<Table>> {
         if let Ok(std_error) = channel(path, channels, "std_error") {
             table.std_error = std_error;
         }
+        table.check().map_err(|m| invalid(path, m))?;
         Ok(table)
     };
     match extension.as_str() {
@@ -189,7 +200,13 @@ pub fn read_kiln(path: &Path) -> Result<Option<Table>> {
             from_metadata(metadata, &image.channels).map(Some)
         }
         "ktx2" => read_kiln_texture(path, &bytes, Container::Ktx2, &from_metadata),
-        "dds" => read_kiln_texture(path, &bytes, Container::Dds, &from_metadata),
+        "dds" => {
+            let table = read_kiln_texture(path, &bytes, Container::Dds, &from_metadata)?;
+            if let Some(table) = &table {
+                agrees_with_sidecar(path, table)?;
+            }
+            Ok(table)
+        }
         "h" | "rs" => {
             let Ok(text) = std::str::from_utf8(&bytes) else {
                 return Ok(None);
@@ -226,10 +243,23 @@ pub fn read_kiln(path: &Path) -> Result<Option<Table>> {
                     ),
                 )
             })?;
+            metadata
+                .spec
+                .check()
+                .map_err(|m| invalid(path, format!("its sidecar's spec: {m}")))?;
             if contents.shape != metadata.spec.shape() {
                 return Err(invalid(path, "shape differs from its sidecar's"));
             }
-            from_metadata(metadata, &contents.channels).map(Some)
+            if contents.axes != binary::descriptors(&metadata.spec) {
+                return Err(invalid(
+                    path,
+                    "its axis descriptors differ from its sidecar's axes (a file of another \
+                     bake, or damaged)",
+                ));
+            }
+            let table = from_metadata(metadata, &contents.channels)?;
+            agrees_with_sidecar(path, &table)?;
+            Ok(Some(table))
         }
         _ => Ok(None),
     }
@@ -248,10 +278,46 @@ enum Container {
 /// The metadata in the kiln sidecar beside `path` (`NAME.json`), if there is one.
 fn sidecar_beside(path: &Path) -> Result<Option<Metadata>> {
     let sidecar_path = path.with_extension("json");
-    let Ok(bytes) = std::fs::read(&sidecar_path) else {
+    if !sidecar_path.is_file() {
         return Ok(None);
-    };
+    }
+    let bytes = read(&sidecar_path)?;
     Ok(parse_sidecar(&sidecar_path, &bytes)?.map(|sidecar| sidecar.metadata))
+}
+
+/// Checks that a file read through the sidecar beside it (binary, DDS) holds the values that
+/// sidecar holds, as its precision stores them (relative 1e-3, the f16 rounding with room): a
+/// kill between the renames of a bake with `--force` can leave a new file beside an old
+/// sidecar of another table, which would otherwise be read under the wrong description.
+fn agrees_with_sidecar(path: &Path, table: &Table) -> Result<()> {
+    let sidecar_path = path.with_extension("json");
+    if !sidecar_path.is_file() {
+        return Ok(());
+    }
+    let bytes = read(&sidecar_path)?;
+    let Some(sidecar) = parse_sidecar(&sidecar_path, &bytes)? else {
+        return Ok(());
+    };
+    let Some(values) = sidecar.data.get(&sidecar.metadata.quantity) else {
+        return Ok(());
+    };
+    let differs = values.len() != table.value.len()
+        || values
+            .iter()
+            .zip(&table.value)
+            .any(|(s, v)| (s - v).abs() > 1e-3 * s.abs() + 1e-7);
+    if differs {
+        return Err(invalid(
+            path,
+            format!(
+                "it does not hold the values of its sidecar {}: the two are of different \
+                 bakes (a bake interrupted while renaming its files?); bake the table again \
+                 (with --force if its spec changed)",
+                sidecar_path.display()
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// A kiln KTX2 (metadata inside) or DDS (metadata in the sidecar beside it): R = the value, G =
@@ -345,10 +411,12 @@ fn source_array(text: &str, name: &str, c: bool) -> Option<std::result::Result<V
             };
             // The generators print the shortest literal that round-trips to the f32 they
             // store: parse it as that f32.
-            digits
-                .parse::<f32>()
-                .map(f64::from)
-                .map_err(|_| format!("the array {name} holds '{token}', not a number"))
+            digits.parse::<f32>().map(f64::from).map_err(|_| {
+                format!(
+                    "the array {name} holds {}, not a number",
+                    crate::error::quoted(token)
+                )
+            })
         })
         .collect();
     Some(numbers)
@@ -371,7 +439,11 @@ pub fn read_external(path: &Path, encoding: &Encoding, layout: &Layout) -> Resul
                     let value: f64 = token.parse().map_err(|_| {
                         invalid(
                             path,
-                            format!("line {}: '{token}' is not a number", line_number + 1),
+                            format!(
+                                "line {}: {} is not a number",
+                                line_number + 1,
+                                crate::error::quoted(token)
+                            ),
                         )
                     })?;
                     values.push(value);
@@ -417,11 +489,9 @@ pub fn read_external(path: &Path, encoding: &Encoding, layout: &Layout) -> Resul
     }
     check_finite(path, &values)?;
     let (spec, values) = spec_and_values(layout, values).map_err(|m| invalid(path, m))?;
-    Ok(table_from_channel(
-        spec,
-        values,
-        format!("external table {}", path.display()),
-    ))
+    let table = table_from_channel(spec, values, format!("external table {}", path.display()));
+    table.check().map_err(|m| invalid(path, m))?;
+    Ok(table)
 }
 
 /// Builds kiln's spec for a layout and reorders the values into kiln's order (roughness slowest).

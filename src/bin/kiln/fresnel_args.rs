@@ -31,13 +31,13 @@ pub struct FresnelArgs {
     /// Schlick's reflectance at grazing incidence, in [0, 1] [default: 1].
     #[arg(long, value_parser = parse_rgb, allow_negative_numbers = true)]
     pub f90: Option<[f64; 3]>,
-    /// Dielectric relative index of refraction, > 0 (1.5: glass seen from air).
+    /// Dielectric relative index of refraction, in [0.01, 100] (1.5: glass seen from air).
     #[arg(long, value_parser = crate::args::parse_number, allow_negative_numbers = true)]
     pub ior: Option<f64>,
-    /// Conductor: real part of the complex index, > 0, per channel.
+    /// Conductor: real part of the complex index, in [0.01, 100], per channel.
     #[arg(long, value_parser = parse_rgb, allow_negative_numbers = true)]
     pub eta: Option<[f64; 3]>,
-    /// Conductor: imaginary part (extinction), >= 0, per channel.
+    /// Conductor: imaginary part (extinction), in [0, 100], per channel.
     #[arg(long, value_parser = parse_rgb, allow_negative_numbers = true)]
     pub k: Option<[f64; 3]>,
 }

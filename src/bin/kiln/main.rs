@@ -101,6 +101,15 @@ pub fn announce_cost(core_seconds: f64, quiet: bool) {
 }
 
 fn main() -> ExitCode {
+    // A reader that stops reading (`kiln verify ... | head`) ends kiln quietly, as it ends any
+    // Unix tool: the default SIGPIPE action, which Rust's runtime replaces with "ignore" (and
+    // println! would then panic on the broken pipe).
+    #[cfg(unix)]
+    // SAFETY: setting a signal's disposition to SIG_DFL at start-up, before any thread exists,
+    // installs no handler and touches no memory.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => {

@@ -563,11 +563,7 @@ fn json_report(
 /// Returns whether the table passed `--max-error` (always true without it).
 pub fn run(args: VerifyArgs) -> kiln::Result<bool> {
     if let Some(preset) = args.preset {
-        let bytes = std::fs::read(&args.file).map_err(|source| kiln::Error::Io {
-            path: args.file.clone(),
-            action: "read",
-            source,
-        })?;
+        let bytes = kiln::format::read_file(&args.file)?;
         // Name the file in what the layout's reader says.
         let in_file = |e: kiln::Error| match e {
             kiln::Error::InvalidInput(m) if !m.contains(&args.file.display().to_string()) => {
@@ -582,11 +578,7 @@ pub fn run(args: VerifyArgs) -> kiln::Result<bool> {
         for table in &tables {
             passed &= if table.spec.quantity == Quantity::FMsNorm {
                 let e_path = args.file.with_file_name(preset.file_name());
-                let e_bytes = std::fs::read(&e_path).map_err(|source| kiln::Error::Io {
-                    path: e_path.clone(),
-                    action: "read (the E table whose lookup this f_ms_norm averages)",
-                    source,
-                })?;
+                let e_bytes = kiln::format::read_file(&e_path)?;
                 let e = preset
                     .read_tables(&e_bytes, &e_path.display().to_string())?
                     .into_iter()
