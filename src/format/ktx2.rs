@@ -160,30 +160,47 @@ pub fn encode_with(
     Ok(out)
 }
 
-/// Reads a KTX2 file of one to four 16- or 32-bit float channels, one level, uncompressed or
-/// Zstandard-supercompressed, with kiln's metadata if it has a `kiln` key.
+/// Reads a KTX2 file of float texels (R, RG or RGBA, 16- or 32-bit; uncompressed or
+/// Zstandard-supercompressed): its first level and kiln's metadata (the `kiln` key), if any.
+/// kiln's own parser of the KTX 2.0 layout (header, level index, key/value data): every offset
+/// and length is checked against the file before use, the extent against
+/// [`super::MAX_TEXELS`] before anything is decompressed, and decompression stops at the
+/// bytes the extent needs, so that no file can make it panic or allocate beyond that.
+///
+/// # Errors
+/// A message naming what is wrong with the file.
 #[cfg(feature = "containers")]
 pub fn decode(bytes: &[u8]) -> std::result::Result<super::texture::DecodedTexture, String> {
-    use ::ktx2::Format as F;
-    let reader = ::ktx2::Reader::new(bytes).map_err(|e| format!("not a KTX2 file ({e:?})"))?;
-    let header = reader.header();
-    let (channels, precision) = match header.format {
-        Some(F::R16_SFLOAT) => (1, Precision::F16),
-        Some(F::R16G16_SFLOAT) => (2, Precision::F16),
-        Some(F::R16G16B16A16_SFLOAT) => (4, Precision::F16),
-        Some(F::R32_SFLOAT) => (1, Precision::F32),
-        Some(F::R32G32_SFLOAT) => (2, Precision::F32),
-        Some(F::R32G32B32A32_SFLOAT) => (4, Precision::F32),
+    let u32_at = |offset: usize| -> std::result::Result<u32, String> {
+        bytes
+            .get(offset..offset + 4)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .ok_or_else(|| format!("the file ends at byte {} inside its header", bytes.len()))
+    };
+    let u64_at = |offset: usize| -> std::result::Result<u64, String> {
+        Ok(u64::from(u32_at(offset)?) | u64::from(u32_at(offset + 4)?) << 32)
+    };
+    if bytes.len() < 80 || bytes[..12] != IDENTIFIER {
+        return Err("not a KTX2 file (no KTX 2.0 identifier)".into());
+    }
+    let format = u32_at(12)?;
+    let (channels, precision) = match format {
+        76 => (1, Precision::F16),
+        83 => (2, Precision::F16),
+        97 => (4, Precision::F16),
+        100 => (1, Precision::F32),
+        103 => (2, Precision::F32),
+        109 => (4, Precision::F32),
         other => {
             return Err(format!(
-                "format {other:?}: kiln reads R, RG and RGBA textures of 16- or 32-bit floats"
+                "VkFormat {other}: kiln reads R, RG and RGBA textures of 16- or 32-bit floats"
             ));
         }
     };
     let extent = (
-        header.pixel_width.max(1) as usize,
-        header.pixel_height.max(1) as usize,
-        header.pixel_depth.max(1) as usize,
+        u32_at(20)?.max(1) as usize,
+        u32_at(24)?.max(1) as usize,
+        u32_at(28)?.max(1) as usize,
     );
     let texels = extent.0.saturating_mul(extent.1).saturating_mul(extent.2);
     if texels > super::MAX_TEXELS {
@@ -195,19 +212,33 @@ pub fn decode(bytes: &[u8]) -> std::result::Result<super::texture::DecodedTextur
             super::MAX_TEXELS
         ));
     }
+    let level_count = u32_at(40)?.max(1) as usize;
+    let scheme = u32_at(44)?;
+    let (kvd_offset, kvd_length) = (u32_at(56)? as usize, u32_at(60)? as usize);
+    // The first level's index entry: byte offset, byte length, uncompressed length.
+    if level_count > 64 {
+        return Err(format!("{level_count} levels"));
+    }
+    let (offset, length) = (u64_at(80)?, u64_at(88)?);
+    let level = usize::try_from(offset)
+        .ok()
+        .zip(usize::try_from(length).ok())
+        .and_then(|(o, l)| bytes.get(o..o.checked_add(l)?))
+        .ok_or_else(|| {
+            format!(
+                "level 0 claims bytes {offset} to {} of a {}-byte file",
+                offset.saturating_add(length),
+                bytes.len()
+            )
+        })?;
     // What the texels must take: decompression stops there, whatever the file claims.
-    let expected = extent
-        .0
-        .saturating_mul(extent.1)
-        .saturating_mul(extent.2)
-        .saturating_mul(channels * precision.bytes());
-    let level = reader.levels().next().ok_or("the file has no level")?;
-    let data: Vec<u8> = match header.supercompression_scheme {
-        None => level.data.to_vec(),
-        Some(::ktx2::SupercompressionScheme::Zstandard) => {
+    let expected = texels * channels * precision.bytes();
+    let data: Vec<u8> = match scheme {
+        0 => level.to_vec(),
+        2 => {
             let mut out = Vec::new();
-            let decoder = ruzstd::decoding::StreamingDecoder::new(level.data)
-                .map_err(|e| format!("zstd: {e}"))?;
+            let decoder =
+                ruzstd::decoding::StreamingDecoder::new(level).map_err(|e| format!("zstd: {e}"))?;
             std::io::Read::read_to_end(
                 &mut std::io::Read::take(decoder, expected as u64 + 1),
                 &mut out,
@@ -215,17 +246,36 @@ pub fn decode(bytes: &[u8]) -> std::result::Result<super::texture::DecodedTextur
             .map_err(|e| format!("zstd: {e}"))?;
             out
         }
-        Some(other) => {
+        other => {
             return Err(format!(
-                "supercompression {other:?}: kiln reads none or Zstandard"
+                "supercompression scheme {other}: kiln reads none (0) or Zstandard (2)"
             ));
         }
     };
-    let metadata = reader
-        .key_value_data()
-        .find(|(key, _)| *key == "kiln")
-        .map(|(_, value)| {
-            String::from_utf8_lossy(value.strip_suffix(&[0]).unwrap_or(value)).into_owned()
-        });
+    // Key/value data: (u32 length, key NUL value, padding to 4) entries.
+    let mut metadata = None;
+    if kvd_length > 0 {
+        let kvd = kvd_offset
+            .checked_add(kvd_length)
+            .and_then(|end| bytes.get(kvd_offset..end))
+            .ok_or("the key/value data lies outside the file")?;
+        let mut at = 0;
+        while at + 4 <= kvd.len() {
+            let n = u32::from_le_bytes([kvd[at], kvd[at + 1], kvd[at + 2], kvd[at + 3]]) as usize;
+            let entry = at
+                .checked_add(4)
+                .zip((at + 4).checked_add(n))
+                .and_then(|(start, end)| kvd.get(start..end))
+                .ok_or("a key/value entry runs past the key/value data")?;
+            if let Some(split) = entry.iter().position(|&b| b == 0)
+                && &entry[..split] == b"kiln"
+            {
+                let value = &entry[split + 1..];
+                let value = value.strip_suffix(&[0]).unwrap_or(value);
+                metadata = Some(String::from_utf8_lossy(value).into_owned());
+            }
+            at = align(at + 4 + n, 4);
+        }
+    }
     super::texture::DecodedTexture::from_interleaved(extent, channels, precision, &data, metadata)
 }

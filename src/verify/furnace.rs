@@ -312,8 +312,24 @@ impl Form {
     }
 }
 
-/// The worst deviation of one compensation form.
+/// The edges of the IOR bands a glass table's furnace report gives, on the index as the axis
+/// lists it (`eta`, or `1 / eta` from inside): near 1 the grazing albedo changes fastest.
+pub const ETA_BAND_EDGES: [f64; 7] = [1.0, 1.01, 1.05, 1.2, 1.5, 2.0, f64::INFINITY];
+
+/// The worst deviation within one IOR band of a glass table.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct EtaBand {
+    /// The band's edges on `eta` (or `1 / eta`), lower included.
+    pub lower: f64,
+    pub upper: f64,
+    pub max_deviation: f64,
+    pub worst_mu: f64,
+    pub worst_roughness: f64,
+    pub worst_eta: f64,
+}
+
+/// The worst deviation of one compensation form.
+#[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct FormReport {
     pub form: Form,
     pub max_deviation: f64,
@@ -325,6 +341,9 @@ pub struct FormReport {
     /// Where the worst deviation is: the compensated albedo's excess over 1 (negative: energy
     /// still lost).
     pub deviation: f64,
+    /// For a glass table, the worst deviation per IOR band ([`ETA_BAND_EDGES`]).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub eta_bands: Vec<EtaBand>,
 }
 
 impl FormReport {
@@ -338,6 +357,7 @@ impl FormReport {
             worst_roughness: report.worst.roughness,
             worst_eta: None,
             deviation: report.worst.deviation,
+            eta_bands: Vec::new(),
         }
     }
 }
@@ -381,6 +401,25 @@ pub fn turquin(
                 (mu, convention.from_alpha(at.alpha), at.eta, deviation)
             })
             .collect();
+    let eta_bands = ETA_BAND_EDGES
+        .windows(2)
+        .filter_map(|edges| {
+            let index = |eta: f64| if eta < 1.0 { 1.0 / eta } else { eta };
+            deviations
+                .iter()
+                .filter_map(|d| d.2.map(|eta| (d, index(eta))))
+                .filter(|(_, x)| (edges[0]..edges[1]).contains(x))
+                .max_by(|a, b| a.0.3.abs().total_cmp(&b.0.3.abs()))
+                .map(|(d, _)| EtaBand {
+                    lower: edges[0],
+                    upper: edges[1],
+                    max_deviation: d.3.abs(),
+                    worst_mu: d.0,
+                    worst_roughness: d.1,
+                    worst_eta: d.2.unwrap_or(1.0),
+                })
+        })
+        .collect();
     let (worst_mu, worst_roughness, worst_eta, deviation) = deviations
         .into_iter()
         .max_by(|a, b| a.3.abs().total_cmp(&b.3.abs()))
@@ -392,6 +431,7 @@ pub fn turquin(
         worst_roughness,
         worst_eta,
         deviation,
+        eta_bands,
     })
 }
 

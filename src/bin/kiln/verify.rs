@@ -445,9 +445,7 @@ fn run_furnace(args: &VerifyArgs, table: &Table) -> kiln::Result<bool> {
         .map(|(_, report)| FormReport::of_kulla_conty(report))
         .chain(turquin_report)
         .collect();
-    let max_deviation = form_reports
-        .iter()
-        .fold(0.0, |max: f64, f| max.max(f.max_deviation));
+    let max_deviation = kiln::stats::max_or_nan(form_reports.iter().map(|f| f.max_deviation));
     let passed = args.max_error.is_none_or(|bound| max_deviation <= bound);
     if args.json {
         let mut object = match &kulla_conty {
@@ -470,7 +468,7 @@ fn run_furnace(args: &VerifyArgs, table: &Table) -> kiln::Result<bool> {
     if let Some((path, report)) = &kulla_conty {
         print_kulla_conty(args, table, path, report);
     }
-    if let Some(t) = turquin_report {
+    if let Some(t) = form_reports.iter().find(|f| f.form == Form::Turquin) {
         println!(
             "{}: white furnace test of Turquin's 1 / E scaling: max |E_true / E_lookup - 1| = \
              {:.2e} at mu = {:.3e}, {} = {:.4}{} (the lookup audit's points against the reference)",
@@ -483,6 +481,24 @@ fn run_furnace(args: &VerifyArgs, table: &Table) -> kiln::Result<bool> {
                 .map(|eta| format!(", eta = {eta:.4}"))
                 .unwrap_or_default()
         );
+        if !t.eta_bands.is_empty() {
+            println!("         eta (or 1 / eta)     max |dev|      at eta       at r      at mu");
+            for band in &t.eta_bands {
+                println!(
+                    "    {:>6.3} - {:<10}  {:>12.2e}  {:>10.5}  {:>9.4}  {:>9.3e}",
+                    band.lower,
+                    if band.upper.is_finite() {
+                        format!("{:.3}", band.upper)
+                    } else {
+                        "max".to_string()
+                    },
+                    band.max_deviation,
+                    band.worst_eta,
+                    band.worst_roughness,
+                    band.worst_mu
+                );
+            }
+        }
     }
     print_verdict(args.max_error, passed, "max deviation", max_deviation);
     Ok(passed)
