@@ -767,7 +767,7 @@ fresnel = { schlick = { f0 = 0.04 } }
             ),
             (
                 "[[material]]\nname = \"a\"\nndf = \"ggx\"\nroughness = 0.1\nfresnel = { dielectric = { ior = 0 } }\n",
-                "ior must be > 0",
+                "ior must be between 0.01 and 100 (got 0)",
             ),
             (
                 "[[material]]\nname = \"a\"\nndf = \"ggx\"\nroughness = [0.5, 0.2]\n",

@@ -24,7 +24,7 @@ fn f32_of(v: f64) -> f64 {
 }
 
 fn f16_of(v: f64) -> f64 {
-    f64::from(kiln::format::f16::encode(v).0.to_f32())
+    f64::from(half::f16::from_f64(v).to_f32())
 }
 
 /// The numbers between the braces after `name[`.

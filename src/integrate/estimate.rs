@@ -43,11 +43,14 @@ impl Estimate {
             .iter()
             .map(|&x| (x - mean) * (x - mean))
             .sum::<f64>();
+        // A mean outside [0, 1] (possible only for an estimator with negative or > 1 weights)
+        // is brought into the range, and the standard error widened by the distance: never a
+        // clamp that hides a bias.
         let one_minus_value = mean.clamp(0.0, 1.0);
         Self {
             value: 1.0 - one_minus_value,
             one_minus_value,
-            std_error: (var / (r * (r - 1.0))).sqrt(),
+            std_error: (var / (r * (r - 1.0))).sqrt() + (mean - one_minus_value).abs(),
             samples,
         }
     }
@@ -64,5 +67,12 @@ mod tests {
         assert!((e.value - 0.75).abs() < 1e-15);
         // Sample variance 1/60 * 5 ... : Σ (x - 0.25)^2 = 0.05, / (4 * 3) -> sqrt(0.05 / 12).
         assert!((e.std_error - (0.05f64 / 12.0).sqrt()).abs() < 1e-15);
+    }
+
+    #[test]
+    fn a_mean_outside_the_range_widens_the_error() {
+        let e = Estimate::from_replicates(&[-2e-6, -1e-6, -3e-6, -2e-6], 64);
+        assert_eq!(e.one_minus_value, 0.0);
+        assert!(e.std_error >= 2e-6, "{e:?}");
     }
 }
