@@ -23,7 +23,7 @@ use rayon::prelude::*;
 ///
 /// The default is GGX with height-correlated masking, to a max error of 1e-7 (the deterministic
 /// quadrature, checked against the reference on a sample of texels).
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct BakeOptions {
     pub ndfs: Vec<Ndf>,
     pub maskings: Vec<Masking>,
@@ -470,39 +470,8 @@ impl BakeOptions {
                 report.tables.push(table);
                 continue;
             }
-            let mut table = bake_table(spec, command, progress);
-            check_computed(&table)?;
-            table.requested_max_error = self.max_error;
-            if let Some(bound) = self.max_error {
-                table.node_errors = Some(node_errors_at(
-                    &table,
-                    &confirmation_sample(&table.spec),
-                    &confirmation_settings(bound, &table.spec),
-                ));
-            } else if options.check_against_reference && options.method == Method::Qmc {
-                table.node_errors = Some(node_errors(&table, &ReferenceSettings::default()));
-            }
-            if let Some(measured) = table.node_errors
-                && measured.max.is_nan()
-            {
-                return Err(Error::InvalidInput(format!(
-                    "{}: the check against the reference gave no number (NaN) at one of its {} \
-                     texels; nothing was written: please report it",
-                    table.spec.id(),
-                    measured.texels
-                )));
-            }
-            if let (Some(bound), Some(measured)) = (self.max_error, table.node_errors)
-                && measured.max > bound
-            {
-                return Err(Error::InvalidInput(format!(
-                    "{}: the measured node error {:.2e} exceeds --max-error {bound:e}; kiln's \
-                     choice ({}) fell short: please report it, and use --method reference",
-                    table.spec.id(),
-                    measured.max,
-                    table.spec.method.describe()
-                )));
-            }
+            let table = bake_table(spec, command, progress);
+            let table = self.confirm(&options, table)?;
             if let Some(cache) = cache {
                 cache.store(&key, &table)?;
             }
@@ -510,6 +479,50 @@ impl BakeOptions {
             report.tables.push(table);
         }
         Ok(report)
+    }
+
+    /// Finishes a table whose texels were all integrated (in one process, or merged from
+    /// shards, [`crate::shard`]): checks every value is finite, records the requested max
+    /// error, measures the node error against the reference as the options ask (`options` is
+    /// [`BakeOptions::resolved`]) and refuses a table that misses its bound. The same steps
+    /// whatever computed the texels, so a merged bake is byte-identical to an unsharded one.
+    ///
+    /// # Errors
+    /// A non-finite texel, a NaN check or a measured error beyond `--max-error`.
+    pub fn confirm(&self, options: &BakeOptions, mut table: Table) -> Result<Table> {
+        check_computed(&table)?;
+        table.requested_max_error = self.max_error;
+        if let Some(bound) = self.max_error {
+            table.node_errors = Some(node_errors_at(
+                &table,
+                &confirmation_sample(&table.spec),
+                &confirmation_settings(bound, &table.spec),
+            ));
+        } else if options.check_against_reference && options.method == Method::Qmc {
+            table.node_errors = Some(node_errors(&table, &ReferenceSettings::default()));
+        }
+        if let Some(measured) = table.node_errors
+            && measured.max.is_nan()
+        {
+            return Err(Error::InvalidInput(format!(
+                "{}: the check against the reference gave no number (NaN) at one of its {} \
+                 texels; nothing was written: please report it",
+                table.spec.id(),
+                measured.texels
+            )));
+        }
+        if let (Some(bound), Some(measured)) = (self.max_error, table.node_errors)
+            && measured.max > bound
+        {
+            return Err(Error::InvalidInput(format!(
+                "{}: the measured node error {:.2e} exceeds --max-error {bound:e}; kiln's \
+                 choice ({}) fell short: please report it, and use --method reference",
+                table.spec.id(),
+                measured.max,
+                table.spec.method.describe()
+            )));
+        }
+        Ok(table)
     }
 
     /// The estimated cost of the bake in seconds of one core ([`estimated_core_seconds`] of

@@ -47,6 +47,7 @@ pub mod integrate;
 pub mod model;
 pub mod preset;
 pub mod scene;
+pub mod shard;
 pub mod stats;
 pub mod study;
 pub mod table;

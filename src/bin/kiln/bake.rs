@@ -168,6 +168,16 @@ pub struct BakeArgs {
     /// `-centers`, `-alpha`; a preset's sidecars start with the preset's name.)
     #[arg(long)]
     force: bool,
+    /// Compute only shard I of N of this bake (I from 0 to N - 1): a share of every table's
+    /// texels, balanced by estimated cost, written to --out as kiln-shard-I-of-N.json; `kiln
+    /// merge` then writes the tables, byte for byte as the unsharded bake would. `auto` reads
+    /// the scheduler's environment: SLURM_ARRAY_TASK_ID with SLURM_ARRAY_TASK_COUNT (or _MIN and
+    /// _MAX), or Kubernetes' JOB_COMPLETION_INDEX with --shard-count or KILN_SHARD_COUNT.
+    #[arg(long, value_name = "I/N|auto", conflicts_with_all = ["scene", "preset"])]
+    shard: Option<String>,
+    /// The number of shards with --shard auto under Kubernetes (an indexed job's completions).
+    #[arg(long, value_name = "N", requires = "shard")]
+    shard_count: Option<usize>,
     /// No progress bar and no summary.
     #[arg(long, short)]
     quiet: bool,
@@ -247,6 +257,22 @@ pub fn run(args: BakeArgs) -> kiln::Result<()> {
     formats.dedup();
     // Fail on an unusable output directory now, not after minutes of integration.
     format::check_output_dir(&out)?;
+    if let Some(shard) = &args.shard {
+        let shard = match shard.as_str() {
+            "auto" => kiln::shard::ShardIndex::from_environment(
+                &|name| std::env::var(name).ok(),
+                args.shard_count,
+            ),
+            text => kiln::shard::ShardIndex::parse(text),
+        }
+        .map_err(kiln::Error::InvalidInput)?;
+        let bake = kiln::shard::ShardedBake {
+            options,
+            formats,
+            precision: args.precision,
+        };
+        return bake_shard(&bake, shard, &out, args.quiet);
+    }
     // A folder of tables this bake may not replace: refused now, not after the integration.
     format::replace::precheck(&out, &options.resolved().specs(), &formats, replace)?;
     crate::announce_cost(options.estimated_core_seconds(), args.quiet);
@@ -279,6 +305,41 @@ pub fn run(args: BakeArgs) -> kiln::Result<()> {
             tables.len(),
             written.len(),
             out.display()
+        );
+    }
+    Ok(())
+}
+
+/// `kiln bake ... --shard I/N`: integrates the shard and writes its file.
+fn bake_shard(
+    bake: &kiln::shard::ShardedBake,
+    shard: kiln::shard::ShardIndex,
+    out: &std::path::Path,
+    quiet: bool,
+) -> kiln::Result<()> {
+    crate::announce_cost(
+        bake.options.estimated_core_seconds() / shard.count as f64,
+        quiet,
+    );
+    let bar = crate::progress_bar(
+        quiet,
+        bake.options.total_samples() / shard.count as u64,
+        "integrating",
+    );
+    let start = Instant::now();
+    let file = kiln::shard::bake_shard(bake, shard, &|samples| bar.inc(samples))?;
+    bar.finish_and_clear();
+    let bytes = serde_json::to_vec(&file).map_err(|e| kiln::Error::InvalidInput(e.to_string()))?;
+    let written = format::write_files(out, &[(shard.file_name(), bytes)])?;
+    if !quiet {
+        let texels: usize = file.tables.iter().map(|t| t.range.1 - t.range.0).sum();
+        println!(
+            "shard {} of {}: {texels} texels of {} tables in {:.1} s; wrote {}",
+            shard.index,
+            shard.count,
+            file.tables.len(),
+            start.elapsed().as_secs_f64(),
+            written[0].display()
         );
     }
     Ok(())

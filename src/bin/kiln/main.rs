@@ -4,6 +4,7 @@ mod args;
 mod bake;
 mod eval;
 mod fresnel_args;
+mod merge;
 mod plan;
 mod plot;
 mod study;
@@ -41,6 +42,8 @@ enum Command {
     Verify(verify::VerifyArgs),
     /// Measure what accuracy costs: error against time per estimator, lookup error against size.
     Study(study::StudyArgs),
+    /// Merge the shard files of a sharded bake (`kiln bake --shard I/N`) into its tables.
+    Merge(merge::MergeArgs),
 }
 
 /// A progress bar on stderr, drawn only when stderr is a terminal; hidden with `quiet`.
@@ -149,6 +152,7 @@ fn main() -> ExitCode {
         Command::Plan(args) => plan::run(args).map(|()| true),
         Command::Verify(args) => verify::run(args),
         Command::Study(args) => study::run(args).map(|()| true),
+        Command::Merge(args) => merge::run(args).map(|()| true),
     };
     match result {
         Ok(true) => ExitCode::SUCCESS,

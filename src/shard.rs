@@ -1,0 +1,545 @@
+//! Sharded bakes: one bake split over N processes (Slurm array tasks, Kubernetes indexed-job
+//! pods, or plain processes), each integrating a share of every table's texels into a shard
+//! file, and a merge that checks the shards and finishes the tables exactly as the unsharded
+//! bake does ([`BakeOptions::confirm`], the derived `f_ms_norm`), so that the files it writes
+//! are byte-identical.
+//!
+//! The partition: every integrated table's texels (row-major, slowest axis first) are cut into
+//! N contiguous ranges of equal estimated cost ([`texel_cost`]); shard `i` takes range `i` of
+//! every table. A texel's value depends only on its coordinates and the spec, so where and in
+//! which order it is computed does not change a bit.
+//!
+//! A shard file (`kiln-shard-I-of-N.json`) holds: its kind and versions, the bake (the options,
+//! output formats and precision), a digest of the bake (so a merge can tell shards of different
+//! bakes apart), its index and count, and per table the spec, the texel range, the values,
+//! one-minus values and error estimates, and a digest of those numbers.
+
+use crate::bake::{BakeOptions, estimate_texel};
+use crate::cache::fnv1a;
+use crate::error::{Error, Result};
+use crate::format::{Format, Precision};
+use crate::table::{Quantity, Table, TableSpec};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// The `kind` of a shard file.
+pub const KIND: &str = "kiln-shard";
+
+/// Which share of the work a process does: shard `index` of `count` (0-based, as Kubernetes
+/// counts).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ShardIndex {
+    pub index: usize,
+    pub count: usize,
+}
+
+impl ShardIndex {
+    /// Parses `I/N`.
+    ///
+    /// # Errors
+    /// Anything but two integers with `0 <= I < N`, `N` from 1 to 100,000.
+    pub fn parse(text: &str) -> std::result::Result<Self, String> {
+        let (i, n) = text
+            .split_once('/')
+            .ok_or_else(|| format!("--shard takes I/N (e.g. 0/4) or auto, not '{text}'"))?;
+        let number = |s: &str, what: &str| {
+            s.trim()
+                .parse::<usize>()
+                .map_err(|_| format!("--shard {text}: {what} '{s}' is not a whole number"))
+        };
+        Self::new(number(i, "the index")?, number(n, "the count")?)
+    }
+
+    /// Shard `index` of `count`.
+    ///
+    /// # Errors
+    /// Unless `index < count <= 100_000`.
+    pub fn new(index: usize, count: usize) -> std::result::Result<Self, String> {
+        if count == 0 || count > 100_000 {
+            return Err(format!("the shard count must be 1 to 100000 (got {count})"));
+        }
+        if index >= count {
+            return Err(format!(
+                "shard index {index} is not below the count {count} (indices run from 0 to {})",
+                count - 1
+            ));
+        }
+        Ok(Self { index, count })
+    }
+
+    /// The shard a scheduler's task is, from its environment (`get` reads a variable): Slurm's
+    /// `SLURM_ARRAY_TASK_ID` with `SLURM_ARRAY_TASK_COUNT` (or `SLURM_ARRAY_TASK_MIN` and
+    /// `_MAX`), or Kubernetes' `JOB_COMPLETION_INDEX` with the count from `count` (the
+    /// `--shard-count` flag) or `KILN_SHARD_COUNT`.
+    ///
+    /// # Errors
+    /// Neither scheduler's variables, both, a missing count, or values that do not fit.
+    pub fn from_environment(
+        get: &dyn Fn(&str) -> Option<String>,
+        count: Option<usize>,
+    ) -> std::result::Result<Self, String> {
+        let number = |name: &str| -> std::result::Result<Option<usize>, String> {
+            get(name)
+                .map(|v| {
+                    v.trim()
+                        .parse::<usize>()
+                        .map_err(|_| format!("{name}={v} is not a whole number"))
+                })
+                .transpose()
+        };
+        let slurm = number("SLURM_ARRAY_TASK_ID")?;
+        let kubernetes = number("JOB_COMPLETION_INDEX")?;
+        match (slurm, kubernetes) {
+            (Some(_), Some(_)) => Err(
+                "--shard auto: both SLURM_ARRAY_TASK_ID and JOB_COMPLETION_INDEX are set; give \
+                 --shard I/N"
+                    .into(),
+            ),
+            (Some(id), None) => {
+                let (min, max) = (
+                    number("SLURM_ARRAY_TASK_MIN")?,
+                    number("SLURM_ARRAY_TASK_MAX")?,
+                );
+                let min = min.unwrap_or(0);
+                let total = match (number("SLURM_ARRAY_TASK_COUNT")?, max) {
+                    (Some(n), _) => n,
+                    (None, Some(max)) if max >= min => max - min + 1,
+                    _ => {
+                        return Err("--shard auto under Slurm needs SLURM_ARRAY_TASK_COUNT or \
+                                    SLURM_ARRAY_TASK_MIN and _MAX (submit with --array=0-N)"
+                            .into());
+                    }
+                };
+                if id < min {
+                    return Err(format!(
+                        "SLURM_ARRAY_TASK_ID={id} is below SLURM_ARRAY_TASK_MIN={min}"
+                    ));
+                }
+                Self::new(id - min, total).map_err(|e| format!("--shard auto (Slurm): {e}"))
+            }
+            (None, Some(index)) => {
+                let total = match count {
+                    Some(n) => n,
+                    None => number("KILN_SHARD_COUNT")?.ok_or(
+                        "--shard auto under Kubernetes needs the completion count: \
+                         --shard-count N or KILN_SHARD_COUNT (JOB_COMPLETION_INDEX alone does \
+                         not say it)",
+                    )?,
+                };
+                Self::new(index, total).map_err(|e| format!("--shard auto (Kubernetes): {e}"))
+            }
+            (None, None) => Err(
+                "--shard auto: neither SLURM_ARRAY_TASK_ID (a Slurm array task) nor \
+                 JOB_COMPLETION_INDEX (a Kubernetes indexed job) is set; give --shard I/N"
+                    .into(),
+            ),
+        }
+    }
+
+    /// The shard file's name: `kiln-shard-I-of-N.json`.
+    #[must_use]
+    pub fn file_name(self) -> String {
+        format!("kiln-shard-{}-of-{}.json", self.index, self.count)
+    }
+}
+
+/// The relative cost of integrating texel `k` of `spec`, for balancing shards: 1, and 3 for
+/// glass texels seen from inside within 0.1 of the critical angle `mu_c = sqrt(1 - eta^2)`
+/// (where the quadrature splits and refines). A heuristic: it changes the balance, never the
+/// values.
+#[must_use]
+pub fn texel_cost(spec: &TableSpec, k: usize) -> f64 {
+    if spec.quantity == Quantity::EDielectricInside
+        && let (Some(eta), (_, Some(mu))) = (spec.texel_eta(k), spec.texel_coordinates(k))
+    {
+        let inside = if eta > 1.0 { 1.0 / eta } else { eta };
+        let critical = (1.0 - inside * inside).max(0.0).sqrt();
+        if (mu - critical).abs() < 0.1 {
+            return 3.0;
+        }
+    }
+    1.0
+}
+
+/// The texel ranges of `count` shards of `spec`: contiguous, in order, covering every texel
+/// once, of equal estimated cost ([`texel_cost`]) as far as whole texels allow.
+#[must_use]
+pub fn partition(spec: &TableSpec, count: usize) -> Vec<(usize, usize)> {
+    let n = spec.len();
+    let costs: Vec<f64> = (0..n).map(|k| texel_cost(spec, k)).collect();
+    let total: f64 = costs.iter().sum();
+    let mut bounds = vec![0];
+    let mut running = 0.0;
+    let mut next = 1;
+    for (k, c) in costs.iter().enumerate() {
+        running += c;
+        while next < count && running >= total * next as f64 / count as f64 {
+            bounds.push(k + 1);
+            next += 1;
+        }
+    }
+    while bounds.len() < count {
+        bounds.push(n);
+    }
+    bounds.push(n);
+    bounds.windows(2).map(|w| (w[0], w[1])).collect()
+}
+
+/// One table's share in a shard file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ShardTable {
+    pub spec: TableSpec,
+    /// The texels `[start, end)` of the table (row-major, slowest axis first).
+    pub range: (usize, usize),
+    pub value: Vec<f64>,
+    pub one_minus_value: Vec<f64>,
+    pub std_error: Vec<f64>,
+    /// FNV-1a of the JSON of the spec, range and the three channels.
+    pub digest: String,
+}
+
+impl ShardTable {
+    fn compute_digest(&self) -> String {
+        let json = serde_json::to_vec(&(
+            &self.spec,
+            self.range,
+            &self.value,
+            &self.one_minus_value,
+            &self.std_error,
+        ))
+        .expect("a shard serialises");
+        format!("{:016x}", fnv1a(&json))
+    }
+}
+
+/// What is baked and written: the same for every shard of one bake.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ShardedBake {
+    pub options: BakeOptions,
+    pub formats: Vec<Format>,
+    pub precision: Precision,
+}
+
+impl ShardedBake {
+    /// FNV-1a of the bake's JSON and kiln's versions: shards of one bake share it.
+    #[must_use]
+    pub fn digest(&self) -> String {
+        let json = serde_json::to_vec(&(
+            self,
+            crate::format::metadata::KILN_VERSION,
+            crate::cache::NUMERICS_VERSION,
+        ))
+        .expect("a bake serialises");
+        format!("{:016x}", fnv1a(&json))
+    }
+}
+
+/// A shard file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ShardFile {
+    pub kind: String,
+    pub kiln_version: String,
+    pub numerics_version: u32,
+    pub bake: ShardedBake,
+    pub bake_digest: String,
+    pub index: usize,
+    pub count: usize,
+    pub tables: Vec<ShardTable>,
+}
+
+/// The tables of `options` that are integrated texel by texel (all but the derived
+/// `f_ms_norm`), in bake order.
+fn integrated_specs(options: &BakeOptions) -> Vec<TableSpec> {
+    options
+        .resolved()
+        .specs()
+        .into_iter()
+        .filter(|s| s.quantity != Quantity::FMsNorm)
+        .collect()
+}
+
+/// Integrates shard `shard` of `bake`: its range of every table's texels, in parallel
+/// (deterministic for any thread count). `progress` is called with the samples of each texel.
+///
+/// # Errors
+/// Invalid options, or a texel that is not finite.
+pub fn bake_shard(
+    bake: &ShardedBake,
+    shard: ShardIndex,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<ShardFile> {
+    bake.options.validate()?;
+    let mut tables = Vec::new();
+    for spec in integrated_specs(&bake.options) {
+        let range = partition(&spec, shard.count)[shard.index];
+        let estimates: Vec<_> = (range.0..range.1)
+            .into_par_iter()
+            .map(|k| {
+                let e = estimate_texel(&spec, k);
+                progress(spec.qmc.samples);
+                e
+            })
+            .collect();
+        let mut piece = ShardTable {
+            value: estimates.iter().map(|e| e.value).collect(),
+            one_minus_value: estimates.iter().map(|e| e.one_minus_value).collect(),
+            std_error: estimates.iter().map(|e| e.std_error).collect(),
+            spec,
+            range,
+            digest: String::new(),
+        };
+        if let Some(k) = (0..piece.value.len()).find(|&k| {
+            !(piece.value[k].is_finite()
+                && piece.one_minus_value[k].is_finite()
+                && piece.std_error[k].is_finite())
+        }) {
+            return Err(Error::InvalidInput(format!(
+                "{}: texel {} is not finite (value {}, error {}): nothing was written",
+                piece.spec.id(),
+                range.0 + k,
+                piece.value[k],
+                piece.std_error[k]
+            )));
+        }
+        piece.digest = piece.compute_digest();
+        tables.push(piece);
+    }
+    Ok(ShardFile {
+        kind: KIND.to_string(),
+        kiln_version: crate::format::metadata::KILN_VERSION.to_string(),
+        numerics_version: crate::cache::NUMERICS_VERSION,
+        bake_digest: bake.digest(),
+        bake: bake.clone(),
+        index: shard.index,
+        count: shard.count,
+        tables,
+    })
+}
+
+/// Reads the shard files among `paths` (files, or directories whose `kiln-shard-*.json` files
+/// are taken), each with the path it came from.
+///
+/// # Errors
+/// An unreadable or damaged file, or a path with no shard file.
+pub fn read_shards(paths: &[PathBuf]) -> Result<Vec<(PathBuf, ShardFile)>> {
+    let mut files = Vec::new();
+    for path in paths {
+        if path.is_dir() {
+            let mut found: Vec<PathBuf> = std::fs::read_dir(path)
+                .map_err(|source| Error::Io {
+                    path: path.clone(),
+                    action: "list",
+                    source,
+                })?
+                .flatten()
+                .map(|e| e.path())
+                .filter(|p| {
+                    p.file_name()
+                        .and_then(|n| n.to_str())
+                        .is_some_and(|n| n.starts_with("kiln-shard-") && n.ends_with(".json"))
+                })
+                .collect();
+            if found.is_empty() {
+                return Err(Error::InvalidInput(format!(
+                    "{}: no kiln-shard-*.json files in it",
+                    path.display()
+                )));
+            }
+            found.sort();
+            files.extend(found);
+        } else {
+            files.push(path.clone());
+        }
+    }
+    files
+        .into_iter()
+        .map(|path| {
+            let bytes = crate::format::read_file(&path)?;
+            let shard: ShardFile = serde_json::from_slice(&bytes).map_err(|e| {
+                Error::InvalidInput(format!(
+                    "{}: not a readable kiln shard file ({e}): damaged, or cut short",
+                    path.display()
+                ))
+            })?;
+            if shard.kind != KIND {
+                return Err(Error::InvalidInput(format!(
+                    "{}: not a kiln shard file (kind '{}')",
+                    path.display(),
+                    crate::error::quoted(&shard.kind)
+                )));
+            }
+            Ok((path, shard))
+        })
+        .collect()
+}
+
+/// Checks that `shards` are all the shards of one bake, each whole, and merges them into the
+/// bake's tables, finished exactly as the unsharded bake finishes them
+/// ([`BakeOptions::confirm`]; `f_ms_norm` derived from the merged `E`).
+///
+/// # Errors
+/// Shards of different bakes or kiln versions, a count that differs, a missing or duplicated
+/// index, a table range that is not the partition's, a digest that does not hold (each naming
+/// the shard file and the texel range), or the bake's own checks.
+pub fn merge(shards: &[(PathBuf, ShardFile)]) -> Result<(ShardedBake, Vec<Table>)> {
+    let name = |p: &Path| p.display().to_string();
+    let Some((first_path, first)) = shards.first() else {
+        return Err(Error::InvalidInput("no shard files to merge".into()));
+    };
+    let count = first.count;
+    for (path, shard) in shards {
+        if shard.bake_digest != first.bake_digest
+            || shard.bake != first.bake
+            || shard.bake.digest() != shard.bake_digest
+        {
+            return Err(Error::InvalidInput(format!(
+                "{} is a shard of another bake than {} (other options, formats or kiln version)",
+                name(path),
+                name(first_path)
+            )));
+        }
+        if shard.kiln_version != crate::format::metadata::KILN_VERSION
+            || shard.numerics_version != crate::cache::NUMERICS_VERSION
+        {
+            return Err(Error::InvalidInput(format!(
+                "{} was baked by kiln {} (numerics {}); this is kiln {} (numerics {}): bake the \
+                 shards again with this kiln",
+                name(path),
+                shard.kiln_version,
+                shard.numerics_version,
+                crate::format::metadata::KILN_VERSION,
+                crate::cache::NUMERICS_VERSION
+            )));
+        }
+        if shard.count != count {
+            return Err(Error::InvalidInput(format!(
+                "{} is shard {} of {}, but {} is of {count}",
+                name(path),
+                shard.index,
+                shard.count,
+                name(first_path)
+            )));
+        }
+    }
+    let specs = integrated_specs(&first.bake.options);
+    let mut by_index: Vec<Option<&(PathBuf, ShardFile)>> = vec![None; count];
+    for entry in shards {
+        let (path, shard) = entry;
+        if shard.index >= count {
+            return Err(Error::InvalidInput(format!(
+                "{}: shard index {} is not below its count {count}",
+                name(path),
+                shard.index
+            )));
+        }
+        if let Some((other, _)) = by_index[shard.index] {
+            return Err(Error::InvalidInput(format!(
+                "{} and {} are both shard {} of {count}: give each shard once",
+                name(other),
+                name(path),
+                shard.index
+            )));
+        }
+        by_index[shard.index] = Some(entry);
+    }
+    if let Some(missing) = by_index.iter().position(Option::is_none) {
+        let ranges: Vec<String> = specs
+            .iter()
+            .map(|s| {
+                let r = partition(s, count)[missing];
+                format!("{} texels {}..{}", s.id(), r.0, r.1)
+            })
+            .collect();
+        return Err(Error::InvalidInput(format!(
+            "shard {missing} of {count} is missing ({}): run it (kiln bake ... --shard \
+             {missing}/{count}) and merge again",
+            ranges.join(", ")
+        )));
+    }
+    let options = first.bake.options.resolved();
+    let mut tables: Vec<Table> = Vec::new();
+    for spec in first.bake.options.resolved().specs() {
+        let command = first.bake.options.command_for(spec.model);
+        if spec.quantity == Quantity::FMsNorm {
+            let source = spec.lookup_of.as_deref();
+            let e = tables
+                .iter()
+                .find(|t| Some(&t.spec) == source)
+                .expect("validate() requires E, and specs() orders it first");
+            let table = crate::table::normalisation::derive(e, command);
+            crate::bake::check_computed(&table)?;
+            tables.push(table);
+            continue;
+        }
+        let t = specs
+            .iter()
+            .position(|s| *s == spec)
+            .expect("an integrated spec");
+        let ranges = partition(&spec, count);
+        let (mut value, mut one_minus_value, mut std_error) = (
+            Vec::with_capacity(spec.len()),
+            Vec::with_capacity(spec.len()),
+            Vec::with_capacity(spec.len()),
+        );
+        for (index, entry) in by_index.iter().enumerate() {
+            let (path, shard) = entry.expect("checked above");
+            let range = ranges[index];
+            let piece = shard
+                .tables
+                .get(t)
+                .filter(|p| p.spec == spec)
+                .ok_or_else(|| {
+                    Error::InvalidInput(format!(
+                        "{}: has no share of {} (texels {}..{})",
+                        name(path),
+                        spec.id(),
+                        range.0,
+                        range.1
+                    ))
+                })?;
+            let n = range.1 - range.0;
+            if piece.range != range
+                || piece.value.len() != n
+                || piece.one_minus_value.len() != n
+                || piece.std_error.len() != n
+            {
+                return Err(Error::InvalidInput(format!(
+                    "{}: its share of {} is texels {}..{} with {} values, where shard {index} of \
+                     {count} takes texels {}..{}",
+                    name(path),
+                    spec.id(),
+                    piece.range.0,
+                    piece.range.1,
+                    piece.value.len(),
+                    range.0,
+                    range.1
+                )));
+            }
+            if piece.compute_digest() != piece.digest {
+                return Err(Error::InvalidInput(format!(
+                    "{}: the digest of {} texels {}..{} does not hold: the file was damaged or \
+                     edited; run shard {index} again",
+                    name(path),
+                    spec.id(),
+                    range.0,
+                    range.1
+                )));
+            }
+            value.extend(&piece.value);
+            one_minus_value.extend(&piece.one_minus_value);
+            std_error.extend(&piece.std_error);
+        }
+        let table = Table {
+            spec,
+            value,
+            one_minus_value,
+            std_error,
+            command,
+            node_errors: None,
+            requested_max_error: None,
+        };
+        tables.push(first.bake.options.confirm(&options, table)?);
+    }
+    Ok((first.bake.clone(), tables))
+}
