@@ -14,9 +14,7 @@ use crate::integrate::{Estimate, QmcSettings, albedo, average_albedo};
 use crate::model::{Masking, Model, Ndf, RoughnessConvention};
 use crate::table::axis::{Axis, Grid, IorBound, IorMapping, MuMapping};
 use crate::table::{Method, Quantity, Table, TableSpec};
-use crate::verify::{
-    MAX_AVERAGE_ENTRIES_CHECKED, node_errors, node_errors_at, reference_value, spread_indices,
-};
+use crate::verify::{MAX_AVERAGE_ENTRIES_CHECKED, reference_value, spread_indices};
 use rayon::prelude::*;
 
 /// What `kiln bake` bakes: for each model, an `E` table and an `E_avg` table.
@@ -489,18 +487,54 @@ impl BakeOptions {
     ///
     /// # Errors
     /// A non-finite texel, a NaN check or a measured error beyond `--max-error`.
-    pub fn confirm(&self, options: &BakeOptions, mut table: Table) -> Result<Table> {
+    pub fn confirm(&self, options: &BakeOptions, table: Table) -> Result<Table> {
+        check_computed(&table)?;
+        let terms = self
+            .check_plan(options, &table.spec)
+            .map(|(indices, settings)| {
+                crate::verify::node_error_terms(
+                    &table.spec,
+                    &indices,
+                    &|k| (table.value[k], table.one_minus_value[k]),
+                    &settings,
+                )
+            });
+        self.confirm_with(table, terms.as_deref())
+    }
+
+    /// The check against the reference a table gets ([`BakeOptions::confirm`]): the texels and
+    /// the reference settings, or `None` for none. `options` is [`BakeOptions::resolved`].
+    #[must_use]
+    pub fn check_plan(
+        &self,
+        options: &BakeOptions,
+        spec: &TableSpec,
+    ) -> Option<(Vec<usize>, ReferenceSettings)> {
+        if let Some(bound) = self.max_error {
+            Some((
+                confirmation_sample(spec),
+                confirmation_settings(bound, spec),
+            ))
+        } else if options.check_against_reference && options.method == Method::Qmc {
+            Some((
+                crate::verify::node_error_indices(spec),
+                ReferenceSettings::default(),
+            ))
+        } else {
+            None
+        }
+    }
+
+    /// [`BakeOptions::confirm`] with the check's terms already measured
+    /// ([`crate::verify::node_error_terms`] at [`BakeOptions::check_plan`]'s texels, in order):
+    /// a sharded bake measures them where the texels were computed.
+    ///
+    /// # Errors
+    /// As [`BakeOptions::confirm`].
+    pub fn confirm_with(&self, mut table: Table, terms: Option<&[(f64, bool)]>) -> Result<Table> {
         check_computed(&table)?;
         table.requested_max_error = self.max_error;
-        if let Some(bound) = self.max_error {
-            table.node_errors = Some(node_errors_at(
-                &table,
-                &confirmation_sample(&table.spec),
-                &confirmation_settings(bound, &table.spec),
-            ));
-        } else if options.check_against_reference && options.method == Method::Qmc {
-            table.node_errors = Some(node_errors(&table, &ReferenceSettings::default()));
-        }
+        table.node_errors = terms.map(crate::verify::summarise_node_errors);
         if let Some(measured) = table.node_errors
             && measured.max.is_nan()
         {

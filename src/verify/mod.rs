@@ -391,13 +391,7 @@ pub const MAX_AVERAGE_ENTRIES_CHECKED: usize = 5;
 /// `kiln bake` records.
 #[must_use]
 pub fn node_errors(table: &Table, settings: &ReferenceSettings) -> NodeErrors {
-    let spec = &table.spec;
-    let indices: Vec<usize> = if spec.quantity.has_mu() {
-        (0..spec.len()).collect()
-    } else {
-        spread_indices(spec.len(), MAX_AVERAGE_ENTRIES_CHECKED)
-    };
-    node_errors_at(table, &indices, settings)
+    node_errors_at(table, &node_error_indices(&table.spec), settings)
 }
 
 /// At most `count` indices of `0..n`, evenly spread with both ends (all of them if `n <= count`).
@@ -412,6 +406,16 @@ pub fn spread_indices(n: usize, count: usize) -> Vec<usize> {
         .collect()
 }
 
+/// The texels [`node_errors`] checks.
+#[must_use]
+pub fn node_error_indices(spec: &TableSpec) -> Vec<usize> {
+    if spec.quantity.has_mu() {
+        (0..spec.len()).collect()
+    } else {
+        spread_indices(spec.len(), MAX_AVERAGE_ENTRIES_CHECKED)
+    }
+}
+
 /// As [`node_errors`], at the given texel indices only.
 #[must_use]
 pub fn node_errors_at(
@@ -419,17 +423,37 @@ pub fn node_errors_at(
     indices: &[usize],
     settings: &ReferenceSettings,
 ) -> NodeErrors {
-    let spec = &table.spec;
-    let measured: Vec<(f64, bool)> = indices
+    summarise_node_errors(&node_error_terms(
+        &table.spec,
+        indices,
+        &|k| (table.value[k], table.one_minus_value[k]),
+        settings,
+    ))
+}
+
+/// One term per texel of `indices`: the error of the stored `(value, one_minus_value)` that
+/// `stored` gives against the reference, and whether the reference converged (if not, the
+/// error is the difference plus the reference's own estimate, so that it stays a bound). In
+/// parallel, in the order of `indices`. A sharded bake measures each shard's texels where they
+/// were computed and [`summarise_node_errors`] the concatenation, as the unsharded bake does.
+#[must_use]
+pub fn node_error_terms(
+    spec: &TableSpec,
+    indices: &[usize],
+    stored: &(dyn Fn(usize) -> (f64, f64) + Sync),
+    settings: &ReferenceSettings,
+) -> Vec<(f64, bool)> {
+    indices
         .par_iter()
         .map(|&k| {
             let (alpha, mu) = spec.texel_coordinates(k);
             let reference = reference_value(spec, alpha, mu, spec.texel_eta(k), settings);
+            let (value, one_minus_value) = stored(k);
             // `1 - E` where both carry it directly; the split-sum channels and `E_F` by value.
             let difference = if spec.quantity.varies_on_a_mirror() {
-                (table.value[k] - reference.value).abs()
+                (value - reference.value).abs()
             } else {
-                (table.one_minus_value[k] - reference.one_minus_value).abs()
+                (one_minus_value - reference.one_minus_value).abs()
             };
             // A reference that ran out of budget is only known to within its own error
             // estimate: the error stated is the difference plus that, never less.
@@ -439,7 +463,13 @@ pub fn node_errors_at(
                 (difference + reference.error, false)
             }
         })
-        .collect();
+        .collect()
+}
+
+/// The summary of [`node_error_terms`] (in their order, so that the sum is the same however
+/// they were computed).
+#[must_use]
+pub fn summarise_node_errors(measured: &[(f64, bool)]) -> NodeErrors {
     NodeErrors {
         max: crate::stats::max_or_nan(measured.iter().map(|m| m.0)),
         rms: (measured.iter().map(|m| m.0 * m.0).sum::<f64>() / measured.len() as f64).sqrt(),
