@@ -70,8 +70,8 @@ impl ShardIndex {
 
     /// The shard a scheduler's task is, from its environment (`get` reads a variable): Slurm's
     /// `SLURM_ARRAY_TASK_ID` with `SLURM_ARRAY_TASK_COUNT` (or `SLURM_ARRAY_TASK_MIN` and
-    /// `_MAX`), or Kubernetes' `JOB_COMPLETION_INDEX` with the count from `count` (the
-    /// `--shard-count` flag) or `KILN_SHARD_COUNT`.
+    /// `_MAX`), or Kubernetes' `JOB_COMPLETION_INDEX` with the count from `count` (a
+    /// caller's own setting) or `KILN_SHARD_COUNT`.
     ///
     /// # Errors
     /// Neither scheduler's variables, both, a missing count, or values that do not fit.
@@ -122,9 +122,8 @@ impl ShardIndex {
                 let total = match count {
                     Some(n) => n,
                     None => number("KILN_SHARD_COUNT")?.ok_or(
-                        "--shard auto under Kubernetes needs the completion count: \
-                         --shard-count N or KILN_SHARD_COUNT (JOB_COMPLETION_INDEX alone does \
-                         not say it)",
+                        "--shard auto under Kubernetes needs the completion count in \
+                         KILN_SHARD_COUNT (JOB_COMPLETION_INDEX alone does not say it)",
                     )?,
                 };
                 Self::new(index, total).map_err(|e| format!("--shard auto (Kubernetes): {e}"))

@@ -107,6 +107,7 @@ fn the_repository_root_holds_no_junk() {
         "benches",
         "docs",
         "examples",
+        "fuzz",
         "scripts",
         "src",
         "tables",

@@ -24,7 +24,14 @@ fn f32_of(v: f64) -> f64 {
 }
 
 fn f16_of(v: f64) -> f64 {
-    f64::from(half::f16::from_f64(v).to_f32())
+    // Rounded to nearest by the half crate, with kiln's documented rule that a non-zero value
+    // is never flushed to zero but kept as the smallest subnormal (docs/accuracy.md).
+    let h = half::f16::from_f64(v);
+    if h.to_f32() == 0.0 && v != 0.0 {
+        f64::from(half::f16::from_bits(1).to_f32()).copysign(v)
+    } else {
+        f64::from(h.to_f32())
+    }
 }
 
 /// The numbers between the braces after `name[`.

@@ -223,8 +223,7 @@ fn broken_sets_of_shards_are_refused_and_nothing_is_written() {
 }
 
 /// `--shard auto` as the schedulers set it: a Slurm array (`--array=0-2`, or `--array=5-7`
-/// with its MIN and MAX), a Kubernetes indexed job (JOB_COMPLETION_INDEX with --shard-count or
-/// KILN_SHARD_COUNT); missing or conflicting variables are errors.
+/// with its MIN and MAX), a Kubernetes indexed job (JOB_COMPLETION_INDEX with KILN_SHARD_COUNT); missing or conflicting variables are errors.
 #[test]
 fn shard_auto_reads_slurm_and_kubernetes_variables() {
     let dir = tempfile::tempdir().unwrap();
@@ -256,13 +255,6 @@ fn shard_auto_reads_slurm_and_kubernetes_variables() {
     );
     ok(&o);
     assert!(out.join("kiln-shard-1-of-3.json").is_file());
-    let (o, out) = run(
-        "k8s",
-        &[("JOB_COMPLETION_INDEX", "1")],
-        &["--shard-count", "2"],
-    );
-    ok(&o);
-    assert!(out.join("kiln-shard-1-of-2.json").is_file());
     let (o, out) = run(
         "k8s-env",
         &[("JOB_COMPLETION_INDEX", "3"), ("KILN_SHARD_COUNT", "4")],

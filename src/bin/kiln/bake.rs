@@ -168,16 +168,11 @@ pub struct BakeArgs {
     /// `-centers`, `-alpha`; a preset's sidecars start with the preset's name.)
     #[arg(long)]
     force: bool,
-    /// Compute only shard I of N of this bake (I from 0 to N - 1): a share of every table's
-    /// texels, balanced by estimated cost, written to --out as kiln-shard-I-of-N.json; `kiln
-    /// merge` then writes the tables, byte for byte as the unsharded bake would. `auto` reads
-    /// the scheduler's environment: SLURM_ARRAY_TASK_ID with SLURM_ARRAY_TASK_COUNT (or _MIN and
-    /// _MAX), or Kubernetes' JOB_COMPLETION_INDEX with --shard-count or KILN_SHARD_COUNT.
+    /// Compute only shard I of N (0 to N - 1) into --out/kiln-shard-I-of-N.json; `kiln merge`
+    /// writes the tables. auto: Slurm's SLURM_ARRAY_TASK_ID/_COUNT, or Kubernetes'
+    /// JOB_COMPLETION_INDEX with KILN_SHARD_COUNT.
     #[arg(long, value_name = "I/N|auto", conflicts_with_all = ["scene", "preset"])]
     shard: Option<String>,
-    /// The number of shards with --shard auto under Kubernetes (an indexed job's completions).
-    #[arg(long, value_name = "N", requires = "shard")]
-    shard_count: Option<usize>,
     /// No progress bar and no summary.
     #[arg(long, short)]
     quiet: bool,
@@ -259,10 +254,9 @@ pub fn run(args: BakeArgs) -> kiln::Result<()> {
     format::check_output_dir(&out)?;
     if let Some(shard) = &args.shard {
         let shard = match shard.as_str() {
-            "auto" => kiln::shard::ShardIndex::from_environment(
-                &|name| std::env::var(name).ok(),
-                args.shard_count,
-            ),
+            "auto" => {
+                kiln::shard::ShardIndex::from_environment(&|name| std::env::var(name).ok(), None)
+            }
             text => kiln::shard::ShardIndex::parse(text),
         }
         .map_err(kiln::Error::InvalidInput)?;
