@@ -583,7 +583,11 @@ impl Preset {
                     .ok_or_else(|| bad("no Uint16Array".into()))?;
                 let body = &text[start..];
                 let open = body.find('[').ok_or_else(|| bad("no [".into()))?;
-                let close = body.find(']').ok_or_else(|| bad("no ]".into()))?;
+                // The first ] after the [ (one before it is not this array's).
+                let close = body[open..]
+                    .find(']')
+                    .map(|c| open + c)
+                    .ok_or_else(|| bad("no ] after the [".into()))?;
                 let bits: Vec<u16> = body[open + 1..close]
                     .split(',')
                     .map(str::trim)

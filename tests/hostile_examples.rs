@@ -213,6 +213,18 @@ fn engine_files_with_nan_texels_are_refused() {
         &kiln(&["verify", "--preset", "three", file.to_str().unwrap()]),
         "is NaN",
     );
+    // A ] before the array's [ (found by cargo-fuzz: a string slice out of order panicked).
+    let at = text.find("Uint16Array").unwrap() + "Uint16Array".len();
+    std::fs::write(&file, format!("{}]{}", &text[..at], &text[at..])).unwrap();
+    let o = kiln(&[
+        "verify",
+        "--preset",
+        "three",
+        file.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert_ne!(o.status.code(), Some(101), "{}", stderr(&o));
+    assert!(!stderr(&o).contains("panicked"), "{}", stderr(&o));
 }
 
 /// A Bevy KTX2 with a short level panicked; a 39 KB zstd KTX2 claiming a huge extent reached
