@@ -12,7 +12,7 @@ use kiln::{Grid, Masking, Model, MuMapping, Ndf, Quantity, RoughnessConvention, 
 use std::path::{Path, PathBuf};
 
 /// Audit a table against the deterministic reference (or another table).
-#[derive(Args, Debug)]
+#[derive(Args, Debug, Clone)]
 #[command(
     long_about = "Audit a table, kiln's or an engine's. Reports the error of the stored values at \
                   the coordinates the table says it was computed at (node_max_error, \
@@ -70,9 +70,10 @@ pub struct VerifyArgs {
     /// Lookup points per texel along each axis.
     #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=64))]
     density: u32,
-    /// The smallest coordinate the table was actually computed at, on both axes (Cycles: 1e-4).
-    #[arg(long, default_value_t = 0.0, value_parser = parse_clamp, allow_negative_numbers = true)]
-    clamp_min: f64,
+    /// The smallest coordinate the table was actually computed at, on both axes [default: 0;
+    /// 1e-4 for a Cycles file not written by kiln, as Blender computes its tables there].
+    #[arg(long, value_parser = parse_clamp, allow_negative_numbers = true)]
+    clamp_min: Option<f64>,
     /// External tables: raw little-endian floats of this type (otherwise text is expected).
     #[arg(long, value_enum)]
     dtype: Option<Precision>,
@@ -426,7 +427,7 @@ fn run_furnace(args: &VerifyArgs, table: &Table) -> kiln::Result<bool> {
     let turquin_report = match forms.contains(&Form::Turquin) {
         true => {
             let settings = AuditSettings {
-                clamp_min: args.clamp_min,
+                clamp_min: args.clamp_min.unwrap_or(0.0),
                 density: args.density as usize,
             };
             let bar = crate::progress_bar(
@@ -590,6 +591,15 @@ pub fn run(args: VerifyArgs) -> kiln::Result<bool> {
         let tables = preset
             .read_tables(&bytes, &args.file.display().to_string())
             .map_err(in_file)?;
+        // Blender computes its tables' first row and column at mu and r = 1e-4, where Cycles
+        // clamps its lookups; kiln's own Cycles file holds the exact node values.
+        let kiln_written = bytes.starts_with(b"/* kiln");
+        let args = &VerifyArgs {
+            clamp_min: args
+                .clamp_min
+                .or((preset == kiln::preset::Preset::Cycles && !kiln_written).then_some(1e-4)),
+            ..args.clone()
+        };
         let mut passed = true;
         for table in &tables {
             passed &= if table.spec.quantity == Quantity::FMsNorm {
@@ -602,13 +612,13 @@ pub fn run(args: VerifyArgs) -> kiln::Result<bool> {
                     .ok_or_else(|| {
                         kiln::Error::InvalidInput(format!("{}: no E table", e_path.display()))
                     })?;
-                normalisation_audit(&args, table, &e, &e_path)?
+                normalisation_audit(args, table, &e, &e_path)?
             } else {
-                audit_one(&args, table)?
+                audit_one(args, table)?
             };
         }
         if let Some(audit) = preset.audit_extra(&bytes).map_err(in_file)? {
-            passed &= audit_extra(&args, &audit);
+            passed &= audit_extra(args, &audit);
         }
         return Ok(passed);
     }
@@ -764,7 +774,7 @@ fn audit_one(args: &VerifyArgs, table: &Table) -> kiln::Result<bool> {
         Against::Table(&other)
     };
     let settings = AuditSettings {
-        clamp_min: args.clamp_min,
+        clamp_min: args.clamp_min.unwrap_or(0.0),
         density: args.density as usize,
     };
     let bar = crate::progress_bar(
