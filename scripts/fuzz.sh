@@ -36,7 +36,7 @@ for ext in json exr bin ktx2 dds h rs; do
     done
     i=$((i + 1))
 done
-# preset_file: a selector byte in the order of fuzz_targets/preset_file.rs, then the file.
+# preset_file: a selector byte in the order of Preset::ALL, then the file.
 seed_preset() { { printf "\\x$(printf %02x "$1")"; cat "$2"; } > "$corpus/preset_file/$3"; }
 seed_preset 0 tests/data/engines/cycles/shader.tables blender-shader.tables
 seed_preset 1 tests/data/engines/bevy/dfg.ktx2 bevy-dfg.ktx2

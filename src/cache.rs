@@ -94,10 +94,6 @@ struct Entry {
     table: Table,
 }
 
-/// The largest cache entry kiln reads (a 256^3 table with three f64 channels in JSON is ~1.2 GB;
-/// kiln's cached tables are far smaller): a larger file is damaged, not read into memory.
-const MAX_ENTRY_BYTES: u64 = 1 << 30;
-
 /// A cache directory.
 #[derive(Clone, Debug)]
 pub struct Cache {
@@ -128,13 +124,11 @@ impl Cache {
     #[must_use]
     pub fn lookup(&self, key: &CacheKey) -> Lookup {
         let path = self.dir.join(key.file_name());
-        let Ok(metadata) = std::fs::metadata(&path) else {
+        if !path.exists() {
             return Lookup::Miss;
-        };
-        if metadata.len() > MAX_ENTRY_BYTES {
-            return Lookup::Damaged(format!("{} bytes", metadata.len()));
         }
-        let bytes = match std::fs::read(&path) {
+        // Through the reader of every file kiln is given: a regular file within its size cap.
+        let bytes = match crate::format::read_file(&path) {
             Ok(bytes) => bytes,
             Err(e) => return Lookup::Damaged(format!("unreadable: {e}")),
         };

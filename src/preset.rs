@@ -155,6 +155,19 @@ impl Preset {
         Ok((files, extra))
     }
 
+    /// The smallest `mu` and roughness the engine computed the file `bytes` at, where its
+    /// lookups clamp: Blender computes its Cycles tables' first row and column at 1e-4; kiln's
+    /// own Cycles file (it starts with kiln's header) and every other engine's hold the node
+    /// values themselves (0).
+    #[must_use]
+    pub fn computed_from(self, bytes: &[u8]) -> f64 {
+        if self == Preset::Cycles && !bytes.starts_with(b"/* kiln") {
+            1e-4
+        } else {
+            0.0
+        }
+    }
+
     /// The number of entries of the preset's `f_ms_norm` table (0 for a preset without one).
     #[must_use]
     pub fn normalisation_size(self) -> usize {

@@ -495,7 +495,9 @@ pub fn merge(shards: &[(PathBuf, ShardFile)]) -> Result<(ShardedBake, Vec<Table>
     }
     let options = first.bake.options.resolved();
     let mut tables: Vec<Table> = Vec::new();
-    for spec in first.bake.options.resolved().specs() {
+    // The index of the next integrated table in each shard's list.
+    let mut t = 0;
+    for spec in options.specs() {
         let command = first.bake.options.command_for(spec.model);
         if spec.quantity == Quantity::FMsNorm {
             let source = spec.lookup_of.as_deref();
@@ -508,10 +510,6 @@ pub fn merge(shards: &[(PathBuf, ShardFile)]) -> Result<(ShardedBake, Vec<Table>
             tables.push(table);
             continue;
         }
-        let t = specs
-            .iter()
-            .position(|s| *s == spec)
-            .expect("an integrated spec");
         let ranges = partition(&spec, count);
         let (mut value, mut one_minus_value, mut std_error, mut check) = (
             Vec::with_capacity(spec.len()),
@@ -598,6 +596,7 @@ pub fn merge(shards: &[(PathBuf, ShardFile)]) -> Result<(ShardedBake, Vec<Table>
         // concatenation is the unsharded bake's sequence of terms, summed in the same order.
         let terms = plan.map(|_| check);
         tables.push(first.bake.options.confirm_with(table, terms.as_deref())?);
+        t += 1;
     }
     Ok((first.bake.clone(), tables))
 }

@@ -78,14 +78,6 @@ pub fn decode(bytes: &[u8]) -> std::result::Result<super::texture::DecodedTextur
         dds.get_height().max(1) as usize,
         dds.get_depth().max(1) as usize,
     );
-    if extent.0.saturating_mul(extent.1).saturating_mul(extent.2) > super::MAX_TEXELS {
-        return Err(format!(
-            "{} x {} x {} texels, more than the {} kiln reads",
-            extent.0,
-            extent.1,
-            extent.2,
-            super::MAX_TEXELS
-        ));
-    }
+    super::texture::DecodedTexture::texels_within_limit(extent)?;
     super::texture::DecodedTexture::from_interleaved(extent, channels, precision, &dds.data, None)
 }

@@ -202,23 +202,14 @@ pub fn decode(bytes: &[u8]) -> std::result::Result<super::texture::DecodedTextur
         u32_at(24)?.max(1) as usize,
         u32_at(28)?.max(1) as usize,
     );
-    let texels = extent.0.saturating_mul(extent.1).saturating_mul(extent.2);
-    if texels > super::MAX_TEXELS {
-        return Err(format!(
-            "{} x {} x {} texels, more than the {} kiln reads",
-            extent.0,
-            extent.1,
-            extent.2,
-            super::MAX_TEXELS
-        ));
-    }
+    let texels = super::texture::DecodedTexture::texels_within_limit(extent)?;
     let level_count = u32_at(40)?.max(1) as usize;
     let scheme = u32_at(44)?;
     let (kvd_offset, kvd_length) = (u32_at(56)? as usize, u32_at(60)? as usize);
-    // The first level's index entry: byte offset, byte length, uncompressed length.
     if level_count > 64 {
         return Err(format!("{level_count} levels"));
     }
+    // The first level's index entry: byte offset, byte length (then the uncompressed length).
     let (offset, length) = (u64_at(80)?, u64_at(88)?);
     let level = usize::try_from(offset)
         .ok()

@@ -136,6 +136,28 @@ pub struct DecodedTexture {
 }
 
 impl DecodedTexture {
+    /// The number of texels of a container's `extent`, refused beyond
+    /// [`super::MAX_TEXELS`]: what a header claims is checked before anything is allocated or
+    /// decompressed.
+    ///
+    /// # Errors
+    /// An extent of more than [`super::MAX_TEXELS`] texels.
+    pub fn texels_within_limit(
+        extent: (usize, usize, usize),
+    ) -> std::result::Result<usize, String> {
+        let texels = extent.0.saturating_mul(extent.1).saturating_mul(extent.2);
+        if texels > super::MAX_TEXELS {
+            return Err(format!(
+                "{} x {} x {} texels, more than the {} kiln reads",
+                extent.0,
+                extent.1,
+                extent.2,
+                super::MAX_TEXELS
+            ));
+        }
+        Ok(texels)
+    }
+
     /// De-interleaves `count` little-endian float channels of `precision` from `data`, which
     /// must hold exactly `width * height * depth` texels.
     pub fn from_interleaved(

@@ -10,9 +10,10 @@
 //! normalisation that closes the furnace for the lookup the renderer really uses is
 //! `1 - Ē(r) = 2 ∫ (1 - E_lookup(mu, r)) mu dmu`.
 //!
-//! Its table: over the E table's roughness coordinate `x` (`r` or `alpha`), on nodes that subdivide every cell of the E table's roughness axis
-//! [`SUBDIVISIONS`] times (497 entries for a 32-row table; so the kinks of the bilinear lookup, at the E table's rows, fall on
-//! nodes and the linear interpolation between them is smooth), one of two forms
+//! Its table: over the E table's roughness coordinate `x` (`r` or `alpha`), on nodes that
+//! subdivide every cell of the E table's roughness axis [`SUBDIVISIONS`] times (497 entries for a
+//! 32-row table; so the kinks of the bilinear lookup, at the E table's rows, fall on nodes and
+//! the linear interpolation between them is smooth), one of two forms
 //! ([`divides_by_roughness`]):
 //!
 //! - `g(x) = (1 - Ē(x)) / x` for an E table on the adaptive `mu` axis with its rows on nodes

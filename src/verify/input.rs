@@ -199,11 +199,18 @@ pub fn read_kiln(path: &Path) -> Result<Option<Table>> {
                 .map_err(|e| invalid(path, format!("bad kiln metadata: {e}")))?;
             from_metadata(metadata, &image.channels).map(Some)
         }
-        "ktx2" => read_kiln_texture(path, &bytes, Container::Ktx2, &from_metadata),
+        "ktx2" => read_kiln_texture(path, &bytes, Container::Ktx2, None, &from_metadata),
         "dds" => {
-            let table = read_kiln_texture(path, &bytes, Container::Dds, &from_metadata)?;
-            if let Some(table) = &table {
-                agrees_with_sidecar(path, table)?;
+            let sidecar = sidecar_beside(path)?;
+            let table = read_kiln_texture(
+                path,
+                &bytes,
+                Container::Dds,
+                sidecar.as_ref(),
+                &from_metadata,
+            )?;
+            if let (Some(table), Some(sidecar)) = (&table, &sidecar) {
+                agrees_with_sidecar(path, sidecar, table)?;
             }
             Ok(table)
         }
@@ -214,7 +221,7 @@ pub fn read_kiln(path: &Path) -> Result<Option<Table>> {
             let metadata = match crate::format::metadata::find_embedded(text) {
                 Some(parsed) => parsed.map_err(|e| invalid(path, e))?,
                 None => match sidecar_beside(path)? {
-                    Some(metadata) => metadata,
+                    Some(sidecar) => sidecar.metadata,
                     None => return Ok(None),
                 },
             };
@@ -234,7 +241,7 @@ pub fn read_kiln(path: &Path) -> Result<Option<Table>> {
         }
         _ if bytes.starts_with(binary::MAGIC) => {
             let contents = binary::decode(&bytes).map_err(|e| invalid(path, e))?;
-            let metadata = sidecar_beside(path)?.ok_or_else(|| {
+            let sidecar = sidecar_beside(path)?.ok_or_else(|| {
                 invalid(
                     path,
                     format!(
@@ -243,6 +250,7 @@ pub fn read_kiln(path: &Path) -> Result<Option<Table>> {
                     ),
                 )
             })?;
+            let metadata = sidecar.metadata.clone();
             metadata
                 .spec
                 .check()
@@ -258,7 +266,7 @@ pub fn read_kiln(path: &Path) -> Result<Option<Table>> {
                 ));
             }
             let table = from_metadata(metadata, &contents.channels)?;
-            agrees_with_sidecar(path, &table)?;
+            agrees_with_sidecar(path, &sidecar, &table)?;
             Ok(Some(table))
         }
         _ => Ok(None),
@@ -275,29 +283,22 @@ enum Container {
     Dds,
 }
 
-/// The metadata in the kiln sidecar beside `path` (`NAME.json`), if there is one.
-fn sidecar_beside(path: &Path) -> Result<Option<Metadata>> {
+/// The kiln sidecar beside `path` (`NAME.json`), if there is one, read once for both its
+/// metadata and its values.
+fn sidecar_beside(path: &Path) -> Result<Option<Sidecar>> {
     let sidecar_path = path.with_extension("json");
     if !sidecar_path.is_file() {
         return Ok(None);
     }
     let bytes = read(&sidecar_path)?;
-    Ok(parse_sidecar(&sidecar_path, &bytes)?.map(|sidecar| sidecar.metadata))
+    parse_sidecar(&sidecar_path, &bytes)
 }
 
 /// Checks that a file read through the sidecar beside it (binary, DDS) holds the values that
 /// sidecar holds, as its precision stores them (relative 1e-3, the f16 rounding with room): a
 /// kill between the renames of a bake with `--force` can leave a new file beside an old
 /// sidecar of another table, which would otherwise be read under the wrong description.
-fn agrees_with_sidecar(path: &Path, table: &Table) -> Result<()> {
-    let sidecar_path = path.with_extension("json");
-    if !sidecar_path.is_file() {
-        return Ok(());
-    }
-    let bytes = read(&sidecar_path)?;
-    let Some(sidecar) = parse_sidecar(&sidecar_path, &bytes)? else {
-        return Ok(());
-    };
+fn agrees_with_sidecar(path: &Path, sidecar: &Sidecar, table: &Table) -> Result<()> {
     let Some(values) = sidecar.data.get(&sidecar.metadata.quantity) else {
         return Ok(());
     };
@@ -313,24 +314,25 @@ fn agrees_with_sidecar(path: &Path, table: &Table) -> Result<()> {
                 "it does not hold the values of its sidecar {}: the two are of different \
                  bakes (a bake interrupted while renaming its files?); bake the table again \
                  (with --force if its spec changed)",
-                sidecar_path.display()
+                path.with_extension("json").display()
             ),
         ));
     }
     Ok(())
 }
 
-/// A kiln KTX2 (metadata inside) or DDS (metadata in the sidecar beside it): R = the value, G =
-/// one minus the value.
+/// A kiln KTX2 (metadata inside) or DDS (metadata in the sidecar beside it, `beside`): R = the
+/// value, G = one minus the value.
 fn read_kiln_texture(
     path: &Path,
     bytes: &[u8],
     container: Container,
+    beside: Option<&Sidecar>,
     from_metadata: &FromMetadata<'_>,
 ) -> Result<Option<Table>> {
     #[cfg(not(feature = "containers"))]
     {
-        let _ = (bytes, container, from_metadata);
+        let _ = (bytes, container, beside, from_metadata);
         Err(invalid(
             path,
             "reading KTX2 and DDS files needs kiln's `containers` feature",
@@ -358,8 +360,8 @@ fn read_kiln_texture(
                 tables.remove(0)
             }
             (None, Container::Ktx2) => return Ok(None),
-            (None, Container::Dds) => match sidecar_beside(path)? {
-                Some(metadata) => metadata,
+            (None, Container::Dds) => match beside {
+                Some(sidecar) => sidecar.metadata.clone(),
                 None => {
                     return Err(invalid(
                         path,

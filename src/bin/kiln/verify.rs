@@ -591,13 +591,8 @@ pub fn run(args: VerifyArgs) -> kiln::Result<bool> {
         let tables = preset
             .read_tables(&bytes, &args.file.display().to_string())
             .map_err(in_file)?;
-        // Blender computes its tables' first row and column at mu and r = 1e-4, where Cycles
-        // clamps its lookups; kiln's own Cycles file holds the exact node values.
-        let kiln_written = bytes.starts_with(b"/* kiln");
         let args = &VerifyArgs {
-            clamp_min: args
-                .clamp_min
-                .or((preset == kiln::preset::Preset::Cycles && !kiln_written).then_some(1e-4)),
+            clamp_min: args.clamp_min.or(Some(preset.computed_from(&bytes))),
             ..args.clone()
         };
         let mut passed = true;
