@@ -23,6 +23,12 @@ fn estimators(c: &mut Criterion) {
             group.bench_with_input(BenchmarkId::new("E", &name), &model, |b, &model| {
                 b.iter(|| albedo(model, black_box(0.25), black_box(0.5), &settings))
             });
+            // Near a mirror, where the sum stratifies GGX's tail and Beckmann's ladder.
+            group.bench_with_input(
+                BenchmarkId::new("E-near-mirror", &name),
+                &model,
+                |b, &model| b.iter(|| albedo(model, black_box(1e-3), black_box(0.5), &settings)),
+            );
             group.bench_with_input(BenchmarkId::new("E_avg", &name), &model, |b, &model| {
                 b.iter(|| average_albedo(model, black_box(0.25), &settings))
             });

@@ -39,7 +39,7 @@ fn bake(dir: &Path, extra: &[&str]) {
         "--size",
         "6",
         "--samples",
-        "16384",
+        "65536",
         "--avg-samples",
         "16384",
         "--no-reference-check",

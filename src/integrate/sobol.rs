@@ -163,6 +163,7 @@ pub fn to_unit_f64(scrambled: u32, deep_seed: u32) -> f64 {
 /// One Owen-scrambled Sobol sequence: a seed fixing the index shuffle and each dimension's scramble.
 #[derive(Clone, Copy, Debug)]
 pub struct OwenSobol {
+    seed: u64,
     shuffle_seed: u32,
     dim_seeds: [u32; DIMENSIONS],
     deep_seeds: [u32; DIMENSIONS],
@@ -174,10 +175,18 @@ impl OwenSobol {
     pub fn new(seed: u64) -> Self {
         let word = |tag: u64, dim: usize| mix_seed(&[seed, tag, dim as u64]) as u32;
         Self {
+            seed,
             shuffle_seed: word(0, 0),
             dim_seeds: std::array::from_fn(|d| word(1, d)),
             deep_seeds: std::array::from_fn(|d| word(2, d)),
         }
+    }
+
+    /// An independent sequence derived from this one's seed: stream `k` of the same scramble
+    /// (for a second stratum sampled beside the first).
+    #[must_use]
+    pub fn stream(&self, k: u64) -> Self {
+        Self::new(mix_seed(&[self.seed, 0x5354_5245_414d, k]))
     }
 
     /// The scrambled 32-bit coordinate of point `index` in dimension `dim` (random access).

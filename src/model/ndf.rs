@@ -103,14 +103,32 @@ impl MicrofacetDistribution for Ggx {
     /// Dupuy & Benyoub 2023, "Sampling Visible GGX Normals with Spherical Caps": stretch `o` to
     /// the unit-roughness configuration, sample the spherical cap below it uniformly, add the
     /// stretched view to obtain the (unnormalised) half vector, and unstretch.
+    /// `u[1]` picks the cap's height: the cap coordinate `t = 1 - u[1]` of
+    /// [`Ggx::visible_normal_on_cap`].
     fn sample_visible_normal(&self, o: Vec3, u: [f64; 2]) -> Vec3 {
+        self.visible_normal_on_cap(o, u[0], 1.0 - u[1])
+    }
+}
+
+impl Ggx {
+    /// The visible normal at azimuth `phi = 2 pi u0` and cap coordinate `t` in [0, 1] of Dupuy &
+    /// Benyoub's spherical cap (see [`MicrofacetDistribution::sample_visible_normal`]): the cap
+    /// point's height is `z = t (1 + v_z) - v_z`, so `t` uniform is the visible-normal density and
+    /// `t -> 0` is the cap's rim, where the half vector turns horizontal and the normals of GGX's
+    /// heavy tail live. `z + v_z = t (1 + v_z)` and `1 - v_z = (v_x^2 + v_y^2) / (1 + v_z)` are
+    /// computed without cancellation, so the tail keeps its precision when `t` is tiny.
+    #[must_use]
+    pub fn visible_normal_on_cap(&self, o: Vec3, u0: f64, t: f64) -> Vec3 {
         let a = self.alpha;
         let v = Vec3::new(a * o.x, a * o.y, o.z).normalize();
-        let phi = 2.0 * PI * u[0];
-        let z = (1.0 - u[1]) * (1.0 + v.z) - v.z;
-        let s = ((1.0 - z) * (1.0 + z)).max(0.0).sqrt();
+        let phi = 2.0 * PI * u0;
+        let hz = t * (1.0 + v.z);
+        let one_minus_vz = (v.x * v.x + v.y * v.y) / (1.0 + v.z);
+        let s = ((1.0 + v.z) * (1.0 - t) * (one_minus_vz + hz))
+            .max(0.0)
+            .sqrt();
         let (sin_phi, cos_phi) = phi.sin_cos();
-        let h = Vec3::new(s * cos_phi, s * sin_phi, z) + v;
+        let h = Vec3::new(s * cos_phi + v.x, s * sin_phi + v.y, hz);
         Vec3::new(a * h.x, a * h.y, h.z).normalize()
     }
 }
@@ -248,8 +266,20 @@ impl BeckmannVisibleNormals {
     /// A visible normal for the point `u` of the unit square.
     #[must_use]
     pub fn sample(&self, u: [f64; 2]) -> Vec3 {
-        let slope_x = self.slope_x.sample(u[0]);
-        let slope_y = erf_inv_uniform(u[1]);
+        self.normal_from_slope_x(self.slope_x.sample(u[0]), u[1])
+    }
+
+    /// The sampler of the unit-roughness x-slope, in the view's azimuthal frame.
+    #[must_use]
+    pub fn slope_x(&self) -> &VisibleSlopeX {
+        &self.slope_x
+    }
+
+    /// The visible normal with unit-roughness x-slope `slope_x` (in the view's frame; positive
+    /// tilts the normal away from the view) and y-slope drawn from `u1`.
+    #[must_use]
+    pub fn normal_from_slope_x(&self, slope_x: f64, u1: f64) -> Vec3 {
+        let slope_y = erf_inv_uniform(u1);
         let sx = self.alpha * (self.cos_phi * slope_x - self.sin_phi * slope_y);
         let sy = self.alpha * (self.sin_phi * slope_x + self.cos_phi * slope_y);
         Vec3::new(-sx, -sy, 1.0).normalize()
@@ -325,6 +355,62 @@ impl VisibleSlopeX {
         (0.5 * (b * (1.0 / FRAC_1_SQRT_PI) * erfc(-x) + e), e)
     }
 
+    /// The share of the visible x-slopes above `x`, `(C(b) - C(x)) / C(b)`, with the upper tail
+    /// computed as `C(b) - C(x) = (b sqrt(pi) (erfc(x) - erfc(b)) + exp(-b^2) - exp(-x^2)) / 2`
+    /// (the difference of the CDF's two terms, each from `erfc` of a positive argument where it
+    /// matters), so that shares far below f64's epsilon keep their relative precision. At normal
+    /// incidence the slope is Gaussian: `erfc(x) / 2`.
+    #[must_use]
+    pub fn upper_share(&self, x: f64) -> f64 {
+        let b = self.b;
+        if x >= b {
+            return 0.0;
+        }
+        if b > 1e8 {
+            return 0.5 * erfc(x);
+        }
+        let upper = 0.5
+            * (b * (1.0 / FRAC_1_SQRT_PI) * (erfc(x) - erfc(b)) + (-b * b).exp() - (-x * x).exp());
+        (upper / self.total).clamp(0.0, 1.0)
+    }
+
+    /// The x-slope above which a share `w` in (0, 1) of the visible slopes lies: the inverse of
+    /// [`VisibleSlopeX::upper_share`], by Newton steps inside a bisection bracket. The same slope
+    /// as `sample(1 - w)`, but resolved where `1 - w` rounds to 1 (the far upper tail, where a
+    /// Beckmann normal tilts far enough to reflect a grazing view out of the hemisphere).
+    #[must_use]
+    pub fn sample_upper(&self, w: f64) -> f64 {
+        let b = self.b;
+        if b > 1e8 {
+            return -erf_inv_uniform(w);
+        }
+        if w >= 0.5 {
+            return self.sample(1.0 - w);
+        }
+        let (mut lo, mut hi) = ((-9.0_f64).min(b), b);
+        let mut x = self.sample(1.0 - w).clamp(lo, hi);
+        for iteration in 0..200 {
+            // Decreasing in x.
+            let g = self.upper_share(x) - w;
+            if g > 0.0 {
+                lo = x;
+            } else {
+                hi = x;
+            }
+            let density = (b - x) * (-x * x).exp() / self.total;
+            let mut next = x + g / density;
+            if !(next > lo && next < hi) || iteration >= 12 {
+                next = 0.5 * (lo + hi);
+            }
+            let step = (next - x).abs();
+            x = next;
+            if step <= 1e-14 * (1.0 + x.abs()) || hi - lo <= 1e-14 * (1.0 + x.abs()) {
+                break;
+            }
+        }
+        x
+    }
+
     /// The x-slope for the uniform variate `u`.
     #[must_use]
     pub fn sample(&self, u: f64) -> f64 {
@@ -386,6 +472,31 @@ impl VisibleSlopeX {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The upper share of the visible x-slopes against `∫_x^b (b - s) exp(-s^2) ds` over its
+    /// total, integrated in 30-digit arithmetic (mpmath `quad`), far into the tail; and the
+    /// inverse finds the slope again.
+    #[test]
+    fn visible_slope_upper_share_and_its_inverse() {
+        for (b, x, share) in [
+            (10.0, 5.0, 3.769_582_339_385_840_4e-13),
+            (10.0, 8.0, 1.087_881_594_350_896_6e-30),
+            (0.5, 0.2, 0.038_530_303_163_401_35),
+            (3.0, -1.0, 0.886_758_168_344_858_9),
+        ] {
+            let slopes = VisibleSlopeX::new(b);
+            let got = slopes.upper_share(x);
+            assert!(
+                (got - share).abs() <= 1e-9 * share,
+                "b {b} x {x}: {got:e} vs {share:e}"
+            );
+            let back = slopes.sample_upper(share);
+            assert!(
+                (back - x).abs() < 1e-9 * (1.0 + x.abs()),
+                "b {b}: {back} vs {x}"
+            );
+        }
+    }
 
     /// Gauss-Legendre nodes and weights on [-1, 1] by Newton on the Legendre recurrence.
     fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {

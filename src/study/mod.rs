@@ -7,6 +7,7 @@
 //! Timings are measurements of this machine at this moment, reported, never asserted.
 
 pub mod estimators;
+pub mod hard_grid;
 pub mod yardstick;
 
 use crate::bake::{BakeOptions, bake_table};

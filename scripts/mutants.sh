@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# Mutation testing of the modules that hold kiln's numbers (issue 18): every mutant cargo-mutants
+# makes in them must make some test fail. Usage:
+#   scripts/mutants.sh                 # the whole scope below (hours on 2 cores)
+#   scripts/mutants.sh src/format/f16.rs src/integrate/estimate.rs   # some files
+#   SHARD=0/4 scripts/mutants.sh       # one of four shards of the scope
+#   TESTS="--lib --test containers" scripts/mutants.sh src/format/f16.rs   # fewer test binaries
+# Needs cargo-mutants (`cargo install cargo-mutants --locked`). Results in mutants.out/: caught.txt,
+# missed.txt, timeout.txt, unviable.txt. Runs every test binary in release mode, as CI does.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+if ! command -v cargo-mutants > /dev/null; then
+    echo "cargo-mutants is not installed: cargo install cargo-mutants --locked" >&2
+    exit 2
+fi
+files=("$@")
+if [ ${#files[@]} -eq 0 ]; then
+    files=(src/model src/integrate/estimate.rs src/table src/verify src/format/f16.rs)
+fi
+args=()
+for f in "${files[@]}"; do
+    if [ -d "$f" ]; then
+        args+=(--file "$f/**/*.rs")
+    else
+        args+=(--file "$f")
+    fi
+done
+if [ -n "${SHARD:-}" ]; then
+    args+=(--shard "$SHARD")
+fi
+test_args=(--cargo-test-arg=--release)
+for t in ${TESTS:-}; do
+    test_args+=("--cargo-test-arg=$t")
+done
+exec cargo mutants "${args[@]}" --jobs 1 --timeout 300 --build-timeout 900 "${test_args[@]}"
