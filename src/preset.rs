@@ -179,33 +179,62 @@ impl Preset {
             .map_or(0, TableSpec::len)
     }
 
-    /// The file of the lookup-consistent Kulla-Conty normalisation (`f_ms_norm`,
-    /// [`crate::table::normalisation`]) of a preset whose engine normalises by `E_avg`, beside
-    /// the engine's own files (which stay exactly as the engine ships them): derived from the E
-    /// table as the engine file stores it (Enterprise PBR's half floats: `1 - E` from the f16
-    /// `E`, as its shader computes it), so that it is the average of the lookup the engine
-    /// makes. `None` for the other presets, or when `tables` has no `f_ms_norm`.
-    fn normalisation_file(self, tables: &[Table]) -> Result<Option<(&'static str, Vec<u8>)>> {
-        let Some(norm) = tables.iter().find(|t| t.spec.quantity == Quantity::FMsNorm) else {
-            return Ok(None);
+    /// How the engine file stores `E`, for the presets that carry `f_ms_norm` beside it: Cycles'
+    /// f32 arrays, Enterprise PBR's half floats. `None` for the other presets.
+    fn stored_e(self) -> Option<fn(f64) -> f64> {
+        match self {
+            Preset::Cycles => Some(|v| f64::from(v as f32)),
+            Preset::EnterprisePbr => Some(crate::format::f16::stored),
+            _ => None,
+        }
+    }
+
+    /// The tables as the preset's files hold them: `f_ms_norm` derived from the E table as the
+    /// engine file stores it ([`Preset::stored_e`]; Enterprise PBR's shader computes `1 - E` from
+    /// the f16 `E`), so that it is the average of the lookup the engine makes; the others as
+    /// given. The engine's files and kiln's sidecars beside them are both written from these, so
+    /// a sidecar describes the bytes beside it. Idempotent.
+    pub fn engine_tables(self, tables: &[Table]) -> Result<Vec<Table>> {
+        let Some(round) = self.stored_e() else {
+            return Ok(tables.to_vec());
         };
+        if !tables.iter().any(|t| t.spec.quantity == Quantity::FMsNorm) {
+            return Ok(tables.to_vec());
+        }
         let e = tables
             .iter()
             .find(|t| t.spec.quantity == Quantity::E)
             .ok_or_else(|| Error::InvalidInput("f_ms_norm needs the E table".into()))?;
-        // The E table as the engine file stores it, and 1 - E as the engine computes it.
-        let as_stored = |round: fn(f64) -> f64| -> Table {
-            let value: Vec<f64> = e.value.iter().map(|&v| round(v)).collect();
-            let stored = Table {
-                one_minus_value: value.iter().map(|v| 1.0 - v).collect(),
-                value,
-                ..e.clone()
-            };
-            crate::table::normalisation::derive(&stored, norm.command.clone())
+        let value: Vec<f64> = e.value.iter().map(|&v| round(v)).collect();
+        let stored = Table {
+            one_minus_value: value.iter().map(|v| 1.0 - v).collect(),
+            value,
+            ..e.clone()
+        };
+        Ok(tables
+            .iter()
+            .map(|t| {
+                if t.spec.quantity == Quantity::FMsNorm {
+                    crate::table::normalisation::derive(&stored, t.command.clone())
+                } else {
+                    t.clone()
+                }
+            })
+            .collect())
+    }
+
+    /// The file of the lookup-consistent Kulla-Conty normalisation (`f_ms_norm`,
+    /// [`crate::table::normalisation`]) of a preset whose engine normalises by `E_avg`, beside
+    /// the engine's own files (which stay exactly as the engine ships them), from
+    /// [`Preset::engine_tables`]. `None` for the other presets, or when `tables` has no
+    /// `f_ms_norm`.
+    fn normalisation_file(self, tables: &[Table]) -> Result<Option<(&'static str, Vec<u8>)>> {
+        let engine = self.engine_tables(tables)?;
+        let Some(norm) = engine.iter().find(|t| t.spec.quantity == Quantity::FMsNorm) else {
+            return Ok(None);
         };
         match self {
             Preset::Cycles => {
-                let norm = as_stored(|v| f64::from(v as f32));
                 let rows = norm.value.len();
                 let mut out = format!(
                     "/* kiln {}: the lookup-consistent normalisation of the Kulla-Conty lobe for \
@@ -223,8 +252,7 @@ impl Preset {
             }
             Preset::EnterprisePbr => {
                 // Values from 1e-7 to 1: stored in f32, as f16 would lose the small ones.
-                let norm = as_stored(crate::format::f16::stored);
-                let bytes = crate::format::exr::encode_value_as(&norm, "Y", Precision::F32)
+                let bytes = crate::format::exr::encode_value_as(norm, "Y", Precision::F32)
                     .map_err(Error::InvalidInput)?;
                 Ok(Some((ENTERPRISE_NORMALISATION_FILE, bytes)))
             }

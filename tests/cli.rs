@@ -976,6 +976,37 @@ fn presets_bake_and_verify() {
     assert_eq!(refused.status.code(), Some(2));
 }
 
+/// The sidecar of Enterprise PBR's `f_ms_norm` describes the file beside it: both are derived
+/// from the half-float `E` the engine file holds (the sidecar held the normalisation of the f64
+/// `E`, off by the f16 rounding of `E`, up to 2e-4 relative).
+#[test]
+fn a_preset_sidecar_holds_the_values_of_the_engine_file_beside_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().to_str().unwrap();
+    let baked = kiln(&["bake", "--preset", "enterprise-pbr", "--out", out, "-q"]);
+    assert!(baked.status.success(), "{}", stderr(&baked));
+    let preset = kiln::preset::Preset::EnterprisePbr;
+    let name = kiln::preset::ENTERPRISE_NORMALISATION_FILE;
+    let bytes = std::fs::read(dir.path().join(name)).unwrap();
+    let engine = preset.read_tables(&bytes, name).unwrap().remove(0);
+    let sidecar = files_in(dir.path())
+        .into_iter()
+        .find(|f| f.contains("f_ms_norm") && f.ends_with(".json"))
+        .expect("a sidecar of f_ms_norm");
+    let described = kiln::verify::input::read_kiln(&dir.path().join(sidecar))
+        .unwrap()
+        .unwrap();
+    assert_eq!(described.value.len(), engine.value.len());
+    for (k, (s, e)) in described.value.iter().zip(&engine.value).enumerate() {
+        // The file stores f32.
+        assert_eq!(
+            f64::from(*s as f32),
+            *e,
+            "entry {k}: sidecar {s:e}, file {e:e}"
+        );
+    }
+}
+
 /// `kiln eval --quantity e-dielectric --ior ETA`: the energy albedo in the usual JSON object,
 /// with the reference's reflected and transmitted parts and the radiance albedo beside it.
 #[test]

@@ -386,6 +386,8 @@ fn bake_preset(preset: kiln::preset::Preset, args: &BakeArgs) -> kiln::Result<()
     let start = Instant::now();
     let tables = options.bake(&|samples| bar.inc(samples))?;
     bar.finish_and_clear();
+    // The tables as the engine's files hold them, for the files and the sidecars alike.
+    let tables = preset.engine_tables(&tables)?;
     let (mut files, extra) = preset.files_and_extra(&tables)?;
     let engine_files: Vec<String> = files.iter().map(|(name, _)| name.clone()).collect();
     // kiln's sidecars of the tables the engine file holds, named after the preset (the layout
