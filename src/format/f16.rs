@@ -105,6 +105,35 @@ mod tests {
         );
     }
 
+    /// The edges of each outcome, from the half crate's constants: f16's largest value is
+    /// stored as itself, not clamped; its smallest normal is normal; its smallest subnormal is a
+    /// subnormal; a value that rounds to zero is clamped with its sign.
+    #[test]
+    fn outcomes_at_the_edges_of_the_range() {
+        assert_eq!(encode(f64::from(f16::MAX)), (f16::MAX, Outcome::Exact));
+        assert_eq!(encode(-f64::from(f16::MAX)), (f16::MIN, Outcome::Exact));
+        let normal = f64::from(f16::MIN_POSITIVE);
+        assert_eq!(normal, MIN_NORMAL);
+        assert_eq!(encode(normal), (f16::MIN_POSITIVE, Outcome::Exact));
+        let subnormal = f64::from(f16::MIN_POSITIVE_SUBNORMAL);
+        assert_eq!(subnormal, MIN_SUBNORMAL);
+        assert_eq!(
+            encode(subnormal),
+            (f16::MIN_POSITIVE_SUBNORMAL, Outcome::Subnormal)
+        );
+        assert_eq!(encode(0.99 * normal).1, Outcome::Subnormal);
+        let (negative, outcome) = encode(-1e-9);
+        assert_eq!(outcome, Outcome::Clamped);
+        assert_eq!(f64::from(negative.to_f32()), -MIN_SUBNORMAL);
+        assert_eq!(
+            counts(&[7e4, -7e4, 1e-9, 1e-6, 3e-7, 0.5]),
+            Counts {
+                clamped: 3,
+                subnormal: 2
+            }
+        );
+    }
+
     #[test]
     fn normal_range_keeps_relative_precision() {
         // 0.1 % relative accuracy down to 1e-4 (kiln's promise for one_minus_E): rounding to
