@@ -120,63 +120,54 @@ pub fn albedo(model: Model, alpha: f64, mu: f64, settings: &QmcSettings) -> Esti
     }
     let (alpha, mu) = smooth_point(alpha, mu);
     let key = [TAG_E, model_key(model), alpha.to_bits(), mu.to_bits()];
-    replicates(settings, &key, |seq, log2_n| {
-        match (model.ndf, model.masking) {
-            (Ndf::Ggx, Masking::HeightCorrelated) => {
-                let view = GgxView::new(alpha, mu, sin_from_cos(mu));
+    // Everything that depends on the view only is set up once, outside the scrambles.
+    match (model.ndf, model.masking) {
+        (Ndf::Ggx, Masking::HeightCorrelated) => {
+            let view = GgxView::new(alpha, mu, sin_from_cos(mu));
+            let levels = view.levels();
+            replicates(settings, &key, |seq, log2_n| {
                 levels_sum(
                     seq,
                     log2_n,
-                    &view.levels(),
+                    &levels,
                     #[inline(always)]
                     |u0, t| ggx_loss::<true>(&view, u0, t),
                 )
-            }
-            (Ndf::Ggx, Masking::Separable) => {
-                let view = GgxView::new(alpha, mu, sin_from_cos(mu));
+            })
+        }
+        (Ndf::Ggx, Masking::Separable) => {
+            let view = GgxView::new(alpha, mu, sin_from_cos(mu));
+            let levels = view.levels();
+            replicates(settings, &key, |seq, log2_n| {
                 levels_sum(
                     seq,
                     log2_n,
-                    &view.levels(),
+                    &levels,
                     #[inline(always)]
                     |u0, t| ggx_loss::<false>(&view, u0, t),
                 )
-            }
-            (Ndf::Ggx, masking) => {
-                // Schlick-GGX: the generic loss on the GGX cap, stratified like the Smith forms.
-                let ndf = Ggx { alpha };
-                let o = Vec3::from_mu(mu);
-                let lambda_o = ndf.lambda(o);
-                let levels = GgxView::new(alpha, mu, sin_from_cos(mu)).levels();
-                levels_sum(seq, log2_n, &levels, |u0, t| {
-                    reflection_loss(
-                        ndf,
-                        masking,
-                        o,
-                        lambda_o,
-                        ndf.visible_normal_on_cap(o, u0, t),
-                    )
-                })
-            }
-            (Ndf::Beckmann, masking) => {
-                let ndf = Beckmann { alpha };
-                let o = Vec3::from_mu(mu);
-                let lambda_o = ndf.lambda(o);
-                let visible = BeckmannVisibleNormals::tabulated(ndf, o);
-                let strata = beckmann_strata(&visible, alpha, mu);
-                ladder_sum(
-                    seq,
-                    log2_n,
-                    &strata,
-                    |slope_x, u1| {
-                        let m = visible.normal_from_slope_x(slope_x, u1);
-                        reflection_loss(ndf, masking, o, lambda_o, m)
-                    },
-                    &visible,
-                )
-            }
+            })
         }
-    })
+        (Ndf::Ggx, masking) => {
+            // Schlick-GGX: the generic loss on the GGX cap, stratified like the Smith forms.
+            let ndf = Ggx { alpha };
+            let o = Vec3::from_mu(mu);
+            let lambda_o = ndf.lambda(o);
+            let levels = GgxView::new(alpha, mu, sin_from_cos(mu)).levels();
+            replicates(settings, &key, |seq, log2_n| {
+                levels_sum(seq, log2_n, &levels, |u0, t| {
+                    let m = ndf.visible_normal_on_cap(o, u0, t);
+                    reflection_loss(ndf, masking, o, lambda_o, m)
+                })
+            })
+        }
+        (Ndf::Beckmann, masking) => {
+            let view = BeckmannView::new(alpha, mu);
+            replicates(settings, &key, |seq, log2_n| {
+                view.sum(seq, log2_n, |m| view.loss(masking, m))
+            })
+        }
+    }
 }
 
 /// A weighted directional albedo `E_h(mu) = ∫ f(o, i) h(o.m) mu_i dω_i` with `F = 1` inside `f`
@@ -184,8 +175,8 @@ pub fn albedo(model: Model, alpha: f64, mu: f64, settings: &QmcSettings) -> Esti
 /// vector) in `[0, 1]`: a Fresnel reflectance `F(o.m)`, or Schlick's `Fc = (1 - o.m)^5` and
 /// `1 - Fc` for the split-sum tables. The estimate is `1 - w h` averaged over visible normals
 /// (`w = G2 / G1(o)`, 0 below the horizon), so `one_minus_value` is `1 - E_h` estimated directly.
-/// Generic visible-normal sampling ([`MicrofacetDistribution::sample_visible_normal`]), not the
-/// specialised GGX kernel.
+/// Visible normals on GGX's cap ([`Ggx::visible_normal_on_cap`]) or from Beckmann's slopes,
+/// stratified as for `E`; not the specialised GGX kernel.
 ///
 /// # Panics
 /// As [`albedo`].
@@ -226,25 +217,12 @@ pub fn weighted_albedo(
             })
         }
         Ndf::Beckmann => {
-            // Beckmann's tail is Gaussian: plain visible-normal sampling reaches all of it.
-            let ndf = Beckmann { alpha };
-            let masking = model.masking;
-            let o = Vec3::from_mu(mu);
-            let lambda_o = ndf.lambda(o);
-            let visible = BeckmannVisibleNormals::tabulated(ndf, o);
-            let strata = beckmann_strata(&visible, alpha, mu);
+            let view = BeckmannView::new(alpha, mu);
             replicates(settings, &key, |seq, log2_n| {
-                ladder_sum(
-                    seq,
-                    log2_n,
-                    &strata,
-                    |slope_x, u1| {
-                        let m = visible.normal_from_slope_x(slope_x, u1);
-                        let w = 1.0 - reflection_loss(ndf, masking, o, lambda_o, m);
-                        1.0 - w * h(o.dot(m).clamp(0.0, 1.0))
-                    },
-                    &visible,
-                )
+                view.sum(seq, log2_n, |m| {
+                    let w = 1.0 - view.loss(model.masking, m);
+                    1.0 - w * h(view.o.dot(m).clamp(0.0, 1.0))
+                })
             })
         }
     }
@@ -488,6 +466,8 @@ pub struct GgxView {
     one_minus_vz: f64,
     /// `1 + Lambda(o)`.
     one_plus_lambda_o: f64,
+    /// [`ggx_tail_bound`] for this view.
+    tail_bound: f64,
     /// The share of the cap coordinate given to the tail stratum ([`GgxView::strata`]).
     tail_share: f64,
 }
@@ -557,8 +537,8 @@ impl GgxView {
         let lambda_o = Ggx { alpha }.lambda(Vec3::new(so, 0.0, mu));
         let vx = alpha * so / stretched;
         let vz = mu / stretched;
-        let tail_share = (TAIL_MARGIN * ggx_tail_bound(alpha, mu, so, vx, vz).min(ggx_rim(vz)))
-            .min(MAX_TAIL_SHARE);
+        let tail_bound = ggx_tail_bound(alpha, mu, so, vx, vz);
+        let tail_share = (TAIL_MARGIN * tail_bound.min(ggx_rim(vz))).min(MAX_TAIL_SHARE);
         Self {
             alpha,
             alpha2: alpha * alpha,
@@ -568,6 +548,7 @@ impl GgxView {
             vz,
             one_minus_vz: vx * vx / (1.0 + vz),
             one_plus_lambda_o: 1.0 + lambda_o,
+            tail_bound,
             tail_share,
         }
     }
@@ -602,7 +583,7 @@ impl GgxView {
     #[must_use]
     pub fn levels(&self) -> Levels {
         let delta = self.tail_share;
-        let crossing = ggx_tail_bound(self.alpha, self.mu, self.so, self.vx, self.vz);
+        let crossing = self.tail_bound;
         let centre = delta / TAIL_MARGIN;
         if delta >= MAX_TAIL_SHARE {
             return Levels::from_edges(&[0.0, delta, 1.0], delta);
@@ -847,44 +828,69 @@ fn beckmann_strata(visible: &BeckmannVisibleNormals, alpha: f64, mu: f64) -> Vec
     strata
 }
 
-/// A stratified sum over one scramble for the strata of [`beckmann_strata`]: the first stratum
-/// (the body) gets half the points, the others share the other half ([`points_per_level`]),
-/// each level from its own stream of the scramble; with fewer than `2^MIN_LEVEL_LOG2` points per
-/// level, plain sampling. `loss(slope_x, u1)` is
-/// evaluated at the x-slope whose upper share is drawn uniformly within the level
-/// ([`crate::model::ndf::VisibleSlopeX::sample_upper`]); the level means, weighted by their measure, add up to the
-/// integral, returned as a sum over `2^log2_n` points as [`sum_over_block`] does.
-fn ladder_sum(
-    seq: &OwenSobol,
-    log2_n: u32,
-    strata: &[Stratum],
-    loss: impl Fn(f64, f64) -> f64,
-    visible: &BeckmannVisibleNormals,
-) -> f64 {
-    let slopes = visible.slope_x();
-    let tail_levels = strata.len().saturating_sub(1);
-    let body_log2 = log2_n.saturating_sub(1);
-    if strata.len() == 1 || points_per_level(body_log2, tail_levels, 0) < MIN_LEVEL_LOG2 {
-        return sum_over_block(seq, log2_n, |[u0, u1]: [f64; 2]| {
-            loss(slopes.sample(u0), u1)
-        });
+/// What the Beckmann sums need of one view `o = (so, 0, mu)`, set up once per estimate: the
+/// visible-normal sampler (with its table of starting points) and the strata of
+/// [`beckmann_strata`].
+struct BeckmannView {
+    ndf: Beckmann,
+    o: Vec3,
+    lambda_o: f64,
+    visible: BeckmannVisibleNormals,
+    strata: Vec<Stratum>,
+}
+
+impl BeckmannView {
+    fn new(alpha: f64, mu: f64) -> Self {
+        let ndf = Beckmann { alpha };
+        let o = Vec3::from_mu(mu);
+        let visible = BeckmannVisibleNormals::tabulated(ndf, o);
+        let strata = beckmann_strata(&visible, alpha, mu);
+        Self {
+            ndf,
+            o,
+            lambda_o: ndf.lambda(o),
+            visible,
+            strata,
+        }
     }
-    let mut mean = 0.0;
-    for (k, stratum) in strata.iter().enumerate() {
-        let (stream, log2) = if k == 0 {
-            (*seq, body_log2)
-        } else {
-            (
-                seq.stream(k as u64),
-                points_per_level(body_log2, tail_levels, k - 1),
-            )
-        };
-        let sum = sum_over_block(&stream, log2, |[v0, u1]: [f64; 2]| {
-            loss(slopes.sample_upper(stratum.t(v0)), u1)
-        });
-        mean += stratum.weight * (sum / (1u64 << log2) as f64);
+
+    /// The loss `1 - w` of the visible normal `m` ([`reflection_loss`]).
+    fn loss(&self, masking: Masking, m: Vec3) -> f64 {
+        reflection_loss(self.ndf, masking, self.o, self.lambda_o, m)
     }
-    mean * (1u64 << log2_n) as f64
+
+    /// A stratified sum of `integrand(m)` over one scramble: the first stratum (the body) gets
+    /// half the points, the others share the other half ([`points_per_level`]), each level from
+    /// its own stream of the scramble; with fewer than `2^MIN_LEVEL_LOG2` points per level, plain
+    /// sampling. Each level draws the x-slope whose upper share is uniform within it
+    /// ([`crate::model::ndf::VisibleSlopeX::sample_upper`]); the level means, weighted by their
+    /// measure, add up to the integral, returned as a sum over `2^log2_n` points as
+    /// [`sum_over_block`] does.
+    fn sum(&self, seq: &OwenSobol, log2_n: u32, integrand: impl Fn(Vec3) -> f64) -> f64 {
+        let slopes = self.visible.slope_x();
+        let at = |slope_x: f64, u1: f64| integrand(self.visible.normal_from_slope_x(slope_x, u1));
+        let tail_levels = self.strata.len().saturating_sub(1);
+        let body_log2 = log2_n.saturating_sub(1);
+        if self.strata.len() == 1 || points_per_level(body_log2, tail_levels, 0) < MIN_LEVEL_LOG2 {
+            return sum_over_block(seq, log2_n, |[u0, u1]: [f64; 2]| at(slopes.sample(u0), u1));
+        }
+        let mut mean = 0.0;
+        for (k, stratum) in self.strata.iter().enumerate() {
+            let (stream, log2) = if k == 0 {
+                (*seq, body_log2)
+            } else {
+                (
+                    seq.stream(k as u64),
+                    points_per_level(body_log2, tail_levels, k - 1),
+                )
+            };
+            let sum = sum_over_block(&stream, log2, |[v0, u1]: [f64; 2]| {
+                at(slopes.sample_upper(stratum.t(v0)), u1)
+            });
+            mean += stratum.weight * (sum / (1u64 << log2) as f64);
+        }
+        mean * (1u64 << log2_n) as f64
+    }
 }
 
 /// The loss `1 - w` of one GGX visible normal at azimuth `pi u0` and cap coordinate `t`
