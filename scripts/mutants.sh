@@ -5,8 +5,9 @@
 #   scripts/mutants.sh src/format/f16.rs src/integrate/estimate.rs   # some files
 #   SHARD=0/4 scripts/mutants.sh       # one of four shards of the scope
 #   TESTS="--lib --test containers" scripts/mutants.sh src/format/f16.rs   # fewer test binaries
-# Needs cargo-mutants (`cargo install cargo-mutants --locked`). Results in mutants.out/: caught.txt,
-# missed.txt, timeout.txt, unviable.txt. Runs every test binary in release mode, as CI does.
+# Needs cargo-mutants (`cargo install cargo-mutants --locked`). Results in target/mutants.out/:
+# caught.txt, missed.txt, timeout.txt, unviable.txt (under target/, which git ignores). Runs every
+# test binary in release mode, as CI does.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if ! command -v cargo-mutants > /dev/null; then
@@ -32,4 +33,4 @@ test_args=(--cargo-test-arg=--release)
 for t in ${TESTS:-}; do
     test_args+=("--cargo-test-arg=$t")
 done
-exec cargo mutants "${args[@]}" --jobs 1 --timeout 300 --build-timeout 900 "${test_args[@]}"
+exec cargo mutants "${args[@]}" --output target --jobs 1 --timeout 300 --build-timeout 900 "${test_args[@]}"

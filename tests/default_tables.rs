@@ -49,7 +49,7 @@ fn default_e_table_meets_the_lookup_error_goal() {
         &e,
         &Against::Reference(ReferenceSettings::default()),
         &AuditSettings::default(),
-        &|| {},
+        &|_| {},
     );
     assert!(report.reference_converged);
     assert!(

@@ -164,7 +164,7 @@ fn audit_against_the_reference() {
                 density: 1,
                 ..AuditSettings::default()
             },
-            &|| {},
+            &|_| {},
         );
         assert!(report.reference_converged);
         assert!(report.node_max_error <= MAX_ERROR, "{report:?}");

@@ -38,7 +38,7 @@ fn a_nan_texel_is_never_a_zero_error() {
         &table,
         &Against::Reference(settings),
         &AuditSettings::default(),
-        &|| {},
+        &|_| {},
     );
     assert!(report.node_max_error.is_nan() && report.lookup_max_error.is_nan());
     // And the bake's check refuses the table before anything is written.

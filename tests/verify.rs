@@ -88,7 +88,7 @@ fn node_errors_of_a_kiln_table_are_consistent_with_its_standard_errors() {
         e,
         &Against::Reference(ReferenceSettings::default()),
         &AuditSettings::default(),
-        &|| {},
+        &|_| {},
     );
     let mut largest_ratio: f64 = 0.0;
     for k in 0..e.spec.len() {

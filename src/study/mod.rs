@@ -15,7 +15,7 @@ use crate::integrate::reference::{ReferenceSettings, reference_albedo};
 use crate::model::Model;
 use crate::table::axis::{Grid, MuMapping};
 use crate::table::{Method, Quantity, TableSpec};
-use crate::verify::{Against, AuditSettings, audit, audit_points};
+use crate::verify::{Against, AuditSettings, Progress, audit, audit_points};
 use estimators::{Estimator, estimate};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -340,9 +340,13 @@ pub fn run(settings: &StudySettings, progress: &(dyn Fn(u64) + Sync)) -> StudyRe
             let table = bake_table(spec, String::new(), &|_| progress(1));
             let report = audit(
                 &table,
-                &Against::Reference(audit_reference),
+                &Against::ReferenceAt(audit_reference),
                 &AuditSettings::default(),
-                &|| progress(1),
+                &|step| {
+                    if step == Progress::Compared {
+                        progress(1);
+                    }
+                },
             );
             lookup.push(LookupRun {
                 mapping: mapping.name().to_string(),

@@ -21,8 +21,12 @@ use serde::Serialize;
 /// What the table is compared with.
 #[derive(Clone, Copy, Debug)]
 pub enum Against<'a> {
-    /// The deterministic reference quadrature ([`crate::integrate::reference`]).
+    /// The deterministic reference quadrature ([`crate::integrate::reference`]) at a tolerance
+    /// tied to the errors measured ([`audit`]), never finer than these settings'.
     Reference(ReferenceSettings),
+    /// The reference at exactly these settings' tolerance at every point, in one pass (what
+    /// `kiln study` compares sizes with, so that its work is known in advance).
+    ReferenceAt(ReferenceSettings),
     /// Another table, through its own bilinear lookup.
     Table(&'a Table),
 }
@@ -82,6 +86,8 @@ pub struct Report {
     pub nodes: usize,
     pub node_max_error: f64,
     pub node_rms_error: f64,
+    /// The reference tolerance the nodes were measured at (0 against a table; see [`audit`]).
+    pub node_reference_tolerance: f64,
     pub worst_node: Point,
     /// The bilinear lookup against the truth on a dense grid that includes the axis ends, plus
     /// grazing probes down to `mu = 0` ([`lookup_coordinates`]).
@@ -89,6 +95,8 @@ pub struct Report {
     pub lookup_max_error: f64,
     pub lookup_rms_error: f64,
     pub lookup_p99_error: f64,
+    /// The reference tolerance the lookups were measured at (0 against a table).
+    pub lookup_reference_tolerance: f64,
     pub worst_lookup: Point,
     /// The largest error estimate of the reference values used (0 against a table).
     pub reference_error_estimate: f64,
@@ -166,25 +174,6 @@ pub fn fresnel_weighted_reference(
     reference_weighted_albedo(model, alpha, mu, |c| fresnel.reflectance(c)[0], settings)
 }
 
-/// The truth at `(mu, alpha, eta)`: value, error estimate and whether it converged.
-fn truth(against: &Against, table: &Table, at: Coordinates) -> (f64, f64, bool) {
-    match against {
-        Against::Reference(settings) => {
-            let r = reference_value(&table.spec, at.alpha, at.mu, at.eta, settings);
-            (r.value, r.error, r.converged)
-        }
-        Against::Table(other) => {
-            let theirs = other.spec.roughness_convention().from_alpha(at.alpha);
-            let eta = at.eta.unwrap_or(1.0);
-            (
-                other.lookup_eta(at.mu.unwrap_or(1.0), theirs, eta),
-                0.0,
-                true,
-            )
-        }
-    }
-}
-
 /// Where a value is compared: `alpha`, and `mu` and the relative `eta` where the table has them.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Coordinates {
@@ -193,54 +182,108 @@ pub struct Coordinates {
     pub eta: Option<f64>,
 }
 
+/// The audit's reference aims at this fraction of the smallest figure it reports for a group
+/// of points (the nodes; the lookups), and settles anywhere between it and twice it: a lookup
+/// error of 1e-4 does not need the truth to 1e-11. Gauss-Kronrod's estimate runs about a
+/// hundred times above the quadrature's actual error (`integrate::reference`), so figures
+/// stated to three digits keep them.
+pub const REFERENCE_FRACTION: f64 = 1e-2;
+
+/// The tolerance at which a sample of each group is scouted first to size its errors.
+pub const SCOUT_TOLERANCE: f64 = 1e-6;
+
+/// One point in this many is scouted (groups of fewer than four times as many are not scouted:
+/// they start at the finest tolerance).
+const SCOUT_STRIDE: usize = 8;
+
+/// What [`audit`] tells its progress callback.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Progress {
+    /// This many more comparisons are planned (a pass over a group begins).
+    Planned(u64),
+    /// One comparison is done.
+    Compared,
+}
+
+/// The compared points of one group with their truth's error estimates and convergence, and the
+/// reference tolerance they were measured at (0 against a table).
+struct Measured {
+    points: Vec<(Point, f64, bool)>,
+    tolerance: f64,
+}
+
+impl Measured {
+    fn max(&self) -> f64 {
+        crate::stats::max_or_nan(self.points.iter().map(|p| p.0.error))
+    }
+
+    fn rms(&self) -> f64 {
+        let n = self.points.len() as f64;
+        (self
+            .points
+            .iter()
+            .map(|p| p.0.error * p.0.error)
+            .sum::<f64>()
+            / n)
+            .sqrt()
+    }
+
+    /// The 99th percentile of the errors.
+    fn p99(&self) -> f64 {
+        let mut errors: Vec<f64> = self.points.iter().map(|p| p.0.error).collect();
+        errors.sort_by(f64::total_cmp);
+        errors[((0.99 * errors.len() as f64).ceil() as usize).clamp(1, errors.len()) - 1]
+    }
+
+    fn worst(&self) -> Point {
+        self.points
+            .iter()
+            .map(|p| p.0)
+            .max_by(|a, b| a.error.total_cmp(&b.error))
+            .expect("points")
+    }
+
+    /// The smallest figure the report states for this group.
+    fn smallest_figure(&self, with_p99: bool) -> f64 {
+        let smallest = self.max().min(self.rms());
+        if with_p99 {
+            smallest.min(self.p99())
+        } else {
+            smallest
+        }
+    }
+}
+
+/// The reference tolerance for a group whose smallest figure is `figure`: [`REFERENCE_FRACTION`]
+/// of it, within `[finest, SCOUT_TOLERANCE]` (the finest when the figure is 0).
+fn tolerance_for(figure: f64, finest: f64) -> f64 {
+    (REFERENCE_FRACTION * figure).clamp(finest, SCOUT_TOLERANCE.max(finest))
+}
+
 /// Compares the stored values with the truth at the nodes ([`node_errors`]) and the table's
 /// lookup with the truth on a dense grid. Reference evaluations run in parallel (deterministic:
-/// each point is a pure function of its coordinates).
-/// `progress` is called once per compared point (see [`audit_points`] for the count).
+/// each point is a pure function of its coordinates and the tolerance).
+///
+/// Against the reference, each group (nodes, lookups) is measured at a tolerance tied to the
+/// errors it reports ([`REFERENCE_FRACTION`] of its smallest figure), never finer than the
+/// given settings' tolerance: every eighth point is scouted at [`SCOUT_TOLERANCE`], the group is
+/// measured at the tolerance the scout's figures call for, and again at a finer one if its own
+/// figures call for that. The report states the tolerances used.
+/// `progress` hears of each pass as it is planned and of each comparison.
 #[must_use]
 pub fn audit(
     table: &Table,
     against: &Against,
     settings: &AuditSettings,
-    progress: &(dyn Fn() + Sync),
+    progress: &(dyn Fn(Progress) + Sync),
 ) -> Report {
     let spec = &table.spec;
     let convention = spec.roughness_convention();
     let clamp = |x: f64| x.max(settings.clamp_min);
 
-    // One table value against the truth at (mu, alpha), with the truth's error estimate.
-    let compare = |at: Coordinates, value: f64| {
-        let (reference, error_estimate, converged) = truth(against, table, at);
-        progress();
-        let error = (value - reference).abs();
-        let Coordinates { alpha, mu, eta } = at;
-        let roughness = convention.from_alpha(alpha);
-        (
-            Point {
-                mu,
-                eta,
-                roughness,
-                alpha,
-                table: value,
-                reference,
-                error,
-            },
-            error_estimate,
-            converged,
-        )
-    };
-
     // Nodes: each stored value against the truth where the table says it was computed (with
     // the roughness and mu clamped as the author says they clamped them).
-    // Against a table of the same layout, node k is compared with its node k (a lookup at the
-    // physical point of the `alpha = 0` row of an adaptive axis, computed at alpha = 1e-7, would
-    // sit a hair off that row).
-    let same_layout = match against {
-        Against::Table(other) => other.spec.axes() == spec.axes(),
-        Against::Reference(_) => false,
-    };
-    let nodes: Vec<(Point, f64, bool)> = (0..spec.len())
-        .into_par_iter()
+    let nodes: Vec<(Coordinates, f64)> = (0..spec.len())
         .map(|k| {
             let (alpha, mu) = spec.texel_coordinates(k);
             let at = Coordinates {
@@ -248,46 +291,111 @@ pub fn audit(
                 mu: mu.map(clamp),
                 eta: spec.texel_eta(k),
             };
-            let (mut point, estimate, converged) = compare(at, table.value[k]);
-            if let (true, Against::Table(other)) = (same_layout, against) {
-                point.reference = other.value[k];
-                point.error = (point.table - point.reference).abs();
-            }
-            (point, estimate, converged)
+            (at, table.value[k])
         })
         .collect();
-
     // Lookups at every point of `lookup_coordinates`.
-    let lookups: Vec<(Point, f64, bool)> = lookup_coordinates(spec, settings)
-        .into_par_iter()
+    let lookups: Vec<(Coordinates, f64)> = lookup_coordinates(spec, settings)
+        .into_iter()
         .map(|at| {
             let value = table.lookup_eta(
                 at.mu.unwrap_or(1.0),
                 convention.from_alpha(at.alpha),
                 at.eta.unwrap_or(1.0),
             );
-            compare(at, value)
+            (at, value)
         })
         .collect();
 
-    let worst = |points: &[(Point, f64, bool)]| {
-        points
-            .iter()
-            .map(|p| p.0)
-            .max_by(|a, b| a.error.total_cmp(&b.error))
-            .expect("points")
+    // One group's values against the truth, with its error estimate, at `tolerance`.
+    let compare = |group: &[(Coordinates, f64)], tolerance: f64| -> Measured {
+        progress(Progress::Planned(group.len() as u64));
+        let points = group
+            .par_iter()
+            .map(|&(at, value)| {
+                let (reference, error_estimate, converged) = match against {
+                    Against::Reference(finest) | Against::ReferenceAt(finest) => {
+                        let settings = ReferenceSettings {
+                            tolerance,
+                            ..*finest
+                        };
+                        let r = reference_value(spec, at.alpha, at.mu, at.eta, &settings);
+                        (r.value, r.error, r.converged)
+                    }
+                    Against::Table(other) => {
+                        let theirs = other.spec.roughness_convention().from_alpha(at.alpha);
+                        let eta = at.eta.unwrap_or(1.0);
+                        let v = other.lookup_eta(at.mu.unwrap_or(1.0), theirs, eta);
+                        (v, 0.0, true)
+                    }
+                };
+                progress(Progress::Compared);
+                let Coordinates { alpha, mu, eta } = at;
+                let point = Point {
+                    mu,
+                    eta,
+                    roughness: convention.from_alpha(alpha),
+                    alpha,
+                    table: value,
+                    reference,
+                    error: (value - reference).abs(),
+                };
+                (point, error_estimate, converged)
+            })
+            .collect();
+        Measured { points, tolerance }
     };
-    let rms = |points: &[(Point, f64, bool)]| {
-        (points.iter().map(|p| p.0.error * p.0.error).sum::<f64>() / points.len() as f64).sqrt()
+    // A group against the reference at the tolerance its figures call for.
+    let measure = |group: &[(Coordinates, f64)], with_p99: bool| -> Measured {
+        let finest = match against {
+            Against::Reference(finest) => finest,
+            Against::ReferenceAt(fixed) => return compare(group, fixed.tolerance),
+            Against::Table(_) => return compare(group, 0.0),
+        };
+        let finest = finest.tolerance;
+        let mut tolerance = finest;
+        if group.len() >= 4 * SCOUT_STRIDE && finest < SCOUT_TOLERANCE {
+            let sample: Vec<(Coordinates, f64)> =
+                group.iter().copied().step_by(SCOUT_STRIDE).collect();
+            let scout = compare(&sample, SCOUT_TOLERANCE);
+            let figure = scout.smallest_figure(with_p99);
+            tolerance = if figure.is_finite() {
+                tolerance_for(figure, finest)
+            } else {
+                SCOUT_TOLERANCE
+            };
+        }
+        loop {
+            let measured = compare(group, tolerance);
+            let figure = measured.smallest_figure(with_p99);
+            let needed = tolerance_for(figure, finest);
+            // Settled within a factor of two of what the figures call for (or NaN: nothing to
+            // refine).
+            if !figure.is_finite() || needed >= 0.5 * tolerance {
+                return measured;
+            }
+            tolerance = needed;
+        }
     };
-    let mut lookup_errors: Vec<f64> = lookups.iter().map(|p| p.0.error).collect();
-    lookup_errors.sort_by(f64::total_cmp);
-    let p99 = lookup_errors
-        [((0.99 * lookup_errors.len() as f64).ceil() as usize).clamp(1, lookup_errors.len()) - 1];
-    let all = nodes.iter().chain(&lookups);
+
+    let mut node_group = measure(&nodes, false);
+    // Against a table of the same layout, node k is compared with its node k (a lookup at the
+    // physical point of the `alpha = 0` row of an adaptive axis, computed at alpha = 1e-7, would
+    // sit a hair off that row).
+    if let Against::Table(other) = against
+        && other.spec.axes() == spec.axes()
+    {
+        for (k, p) in node_group.points.iter_mut().enumerate() {
+            p.0.reference = other.value[k];
+            p.0.error = (p.0.table - p.0.reference).abs();
+        }
+    }
+    let lookup_group = measure(&lookups, true);
+
+    let all = node_group.points.iter().chain(&lookup_group.points);
     let reference_error_estimate = crate::stats::max_or_nan(all.clone().map(|p| p.1));
     let reference_converged = all.clone().all(|p| p.2);
-    let (worst_node, worst_lookup) = (worst(&nodes), worst(&lookups));
+    let (worst_node, worst_lookup) = (node_group.worst(), lookup_group.worst());
     Report {
         quantity: spec.quantity.symbol().to_string(),
         ndf: spec.model.ndf.name().to_string(),
@@ -304,17 +412,19 @@ pub fn audit(
         shape: spec.shape(),
         clamp_min: settings.clamp_min,
         against: match against {
-            Against::Reference(_) => "reference".to_string(),
+            Against::Reference(_) | Against::ReferenceAt(_) => "reference".to_string(),
             Against::Table(other) => format!("table {}", other.spec.id()),
         },
-        nodes: nodes.len(),
+        nodes: node_group.points.len(),
         node_max_error: worst_node.error,
-        node_rms_error: rms(&nodes),
+        node_rms_error: node_group.rms(),
+        node_reference_tolerance: node_group.tolerance,
         worst_node,
-        lookup_points: lookups.len(),
+        lookup_points: lookup_group.points.len(),
         lookup_max_error: worst_lookup.error,
-        lookup_rms_error: rms(&lookups),
-        lookup_p99_error: p99,
+        lookup_rms_error: lookup_group.rms(),
+        lookup_p99_error: lookup_group.p99(),
+        lookup_reference_tolerance: lookup_group.tolerance,
         worst_lookup,
         reference_error_estimate,
         reference_converged,
@@ -374,7 +484,9 @@ pub fn lookup_coordinates(spec: &TableSpec, settings: &AuditSettings) -> Vec<Coo
     points
 }
 
-/// How many points [`audit`] compares: every node and every [`lookup_coordinates`] point.
+/// How many points one pass of [`audit`] compares: every node and every [`lookup_coordinates`]
+/// point (against the reference, the scouts and any refining pass come on top:
+/// [`Progress::Planned`] announces each).
 #[must_use]
 pub fn audit_points(spec: &TableSpec, settings: &AuditSettings) -> u64 {
     (spec.len() + lookup_coordinates(spec, settings).len()) as u64

@@ -7,7 +7,7 @@ use kiln::format::Precision;
 use kiln::integrate::reference::ReferenceSettings;
 use kiln::verify::furnace::furnace;
 use kiln::verify::input::{AxisName, Encoding, Layout, read_external, read_kiln};
-use kiln::verify::{Against, AuditSettings, Point, audit, audit_points};
+use kiln::verify::{Against, AuditSettings, Point, Progress, audit};
 use kiln::{Grid, Masking, Model, MuMapping, Ndf, Quantity, RoughnessConvention, Table};
 use std::path::{Path, PathBuf};
 
@@ -772,12 +772,11 @@ fn audit_one(args: &VerifyArgs, table: &Table) -> kiln::Result<bool> {
         clamp_min: args.clamp_min.unwrap_or(0.0),
         density: args.density as usize,
     };
-    let bar = crate::progress_bar(
-        args.quiet || args.json,
-        audit_points(&table.spec, &settings),
-        "verifying",
-    );
-    let report = audit(table, &against, &settings, &|| bar.inc(1));
+    let bar = crate::progress_bar(args.quiet || args.json, 0, "verifying");
+    let report = audit(table, &against, &settings, &|step| match step {
+        Progress::Planned(points) => bar.inc_length(points),
+        Progress::Compared => bar.inc(1),
+    });
     bar.finish_and_clear();
     let passed = args
         .max_error
@@ -824,6 +823,16 @@ fn audit_one(args: &VerifyArgs, table: &Table) -> kiln::Result<bool> {
             report.lookup_p99_error,
             describe(&report.worst_lookup, &report.roughness_axis)
         );
+        if report.node_reference_tolerance > 0.0 {
+            println!(
+                "  reference tolerance {:.0e} at the nodes, {:.0e} at the lookups (a hundredth of \
+                 the smallest figure above, within [{:.0e}, {:.0e}])",
+                report.node_reference_tolerance,
+                report.lookup_reference_tolerance,
+                ReferenceSettings::default().tolerance,
+                kiln::verify::SCOUT_TOLERANCE
+            );
+        }
         if !report.reference_converged {
             println!(
                 "  note: some reference values did not reach their tolerance (estimate {:.1e})",
