@@ -122,7 +122,7 @@ impl Preset {
         match self {
             Preset::Cycles => "shader.tables",
             Preset::Bevy => "dfg.ktx2",
-            Preset::Three => "DFGLUT.js",
+            Preset::Three => "DFGLUTData.js",
             Preset::EnterprisePbr => "GGX_E.exr",
             Preset::Filament => "dfg.inc",
             Preset::Godot => "dfg_lut.dds",
@@ -308,7 +308,12 @@ impl Preset {
     /// where in the engine's flat array it sits (in texels; channels interleave within one).
     #[must_use]
     pub fn texel(self, r: usize, m: usize) -> usize {
-        let n = self.options().size;
+        self.texel_of_size(r, m, self.options().size)
+    }
+
+    /// [`Preset::texel`] in an `n x n` table of the engine's layout (three.js shipped 32 x 32
+    /// before 16 x 16).
+    fn texel_of_size(self, r: usize, m: usize, n: usize) -> usize {
         match self {
             // mu-major (Cycles), roughness rows (Bevy), NoV rows (three.js).
             Preset::Cycles | Preset::Three => m * n + r,
@@ -403,27 +408,13 @@ impl Preset {
                 let scheme = ktx2::Supercompression::None;
                 ktx2::encode_with(&texture, Precision::F16, scheme).map_err(Error::InvalidInput)
             }
-            Preset::Three => {
-                let (scale, bias) = (
-                    engine_order(&tables[0].value),
-                    engine_order(&tables[1].value),
-                );
-                let mut out = format!(
-                    "// kiln {}: three.js DFG LUT, 16 x 16, x = roughness, y = dot(N, V), texel \
-                     centres;\n// RG half floats: R = scale (integral of (1 - Fc) f mu_i), G = bias \
-                     (integral of Fc f mu_i).\n// Regenerate: {}\n\nexport const DFGLUT_DATA = new \
-                     Uint16Array( [",
-                    crate::format::metadata::KILN_VERSION,
-                    tables[0].command
-                );
-                for k in 0..n * n {
-                    out.push_str(if k % 4 == 0 { "\n\t" } else { " " });
-                    let half = |v: f64| crate::format::f16::encode(v).0.to_bits();
-                    let _ = write!(out, "0x{:04x}, 0x{:04x},", half(scale[k]), half(bias[k]));
-                }
-                out.push_str("\n] );\n");
-                Ok(out.into_bytes())
-            }
+            Preset::Three => Ok(three_module(
+                n,
+                &engine_order(&tables[0].value),
+                &engine_order(&tables[1].value),
+                &tables[0].command,
+            )
+            .into_bytes()),
             Preset::Filament => {
                 let sheen = extra.expect("filament has a cloth channel");
                 let planes = [
@@ -518,22 +509,54 @@ impl Preset {
         Ok(self.decode_all(bytes)?.1)
     }
 
+    /// The error for bytes that are not this engine's file.
+    fn not_its_file(self, message: String) -> Error {
+        Error::InvalidInput(format!(
+            "not a {} file ({} in that engine's layout): {message}",
+            self.name(),
+            self.file_name()
+        ))
+    }
+
+    /// The size of the engine's table in `bytes`: the preset's, or for three.js whichever
+    /// square its `DATA` holds (16 x 16 since three r182, 32 x 32 in r181 and before), which must
+    /// agree with the size its `DataTexture` is built with.
+    fn size_in(self, bytes: &[u8]) -> Result<usize> {
+        if self != Preset::Three {
+            return Ok(self.options().size);
+        }
+        let bad = |m: String| self.not_its_file(m);
+        let halves = three_data(bytes).map_err(bad)?.len();
+        let n = (1..=MAX_THREE_SIZE)
+            .find(|&n| 2 * n * n == halves)
+            .ok_or_else(|| {
+                bad(format!(
+                    "{halves} half floats in DATA: not the two of each texel of a square table \
+                     (16 x 16 holds 512, 32 x 32 holds 2048)"
+                ))
+            })?;
+        let text = String::from_utf8_lossy(bytes);
+        if let Some(declared) = three_texture_size(&text)
+            && declared != (n, n)
+        {
+            return Err(bad(format!(
+                "DATA holds {n} x {n} texels but the DataTexture is built {} x {}",
+                declared.0, declared.1
+            )));
+        }
+        Ok(n)
+    }
+
     /// [`Preset::decode`] and [`Preset::decode_extra`] in one reading.
     fn decode_all(self, bytes: &[u8]) -> Result<Decoded> {
-        let n = self.options().size;
+        let n = self.size_in(bytes)?;
         let mut extra = None;
-        let bad = |m: String| {
-            Error::InvalidInput(format!(
-                "not a {} file ({} in that engine's layout): {m}",
-                self.name(),
-                self.file_name()
-            ))
-        };
+        let bad = |m: String| self.not_its_file(m);
         let kiln_order = |engine: &[f64]| -> Vec<f64> {
             let mut out = vec![0.0; n * n];
             for r in 0..n {
                 for m in 0..n {
-                    out[r * n + m] = engine[self.texel(r, m)];
+                    out[r * n + m] = engine[self.texel_of_size(r, m, n)];
                 }
             }
             out
@@ -618,34 +641,7 @@ impl Preset {
                 Ok(vec![(Quantity::EScale, scale), (Quantity::EBias, bias)])
             }
             Preset::Three => {
-                let text = String::from_utf8_lossy(bytes);
-                let start = text
-                    .find("Uint16Array")
-                    .ok_or_else(|| bad("no Uint16Array".into()))?;
-                let body = &text[start..];
-                let open = body.find('[').ok_or_else(|| bad("no [".into()))?;
-                // The first ] after the [ (one before it is not this array's).
-                let close = body[open..]
-                    .find(']')
-                    .map(|c| open + c)
-                    .ok_or_else(|| bad("no ] after the [".into()))?;
-                let bits: Vec<u16> = body[open + 1..close]
-                    .split(',')
-                    .map(str::trim)
-                    .filter(|s| !s.is_empty())
-                    .map(|s| {
-                        let s = s.trim_start_matches("0x").trim_start_matches("0X");
-                        u16::from_str_radix(s, 16)
-                            .map_err(|e| bad(format!("{}: {e}", crate::error::quoted(s))))
-                    })
-                    .collect::<Result<_>>()?;
-                if bits.len() != 2 * n * n {
-                    return Err(bad(format!(
-                        "{} half floats (expected {})",
-                        bits.len(),
-                        2 * n * n
-                    )));
-                }
+                let bits = three_data(bytes).map_err(bad)?;
                 Ok(vec![
                     (Quantity::EScale, half_channel(&bits, 2, 0)),
                     (Quantity::EBias, half_channel(&bits, 2, 1)),
@@ -834,7 +830,11 @@ impl Preset {
     /// An engine's own file read as kiln tables of the preset's specs (values as stored; `1 -
     /// value` by subtraction; no standard errors), for auditing.
     pub fn read_tables(self, bytes: &[u8], origin: &str) -> Result<Vec<Table>> {
-        let specs = self.options().resolved().specs();
+        let options = BakeOptions {
+            size: self.size_in(bytes)?,
+            ..self.options()
+        };
+        let specs = options.resolved().specs();
         let tables: Vec<Table> = self
             .decode(bytes)?
             .into_iter()
@@ -910,5 +910,123 @@ fn c_array(text: &str, name: &str) -> Option<Vec<f64>> {
                     .map(f64::from)
             })
             .collect();
+    }
+}
+
+/// The largest three.js table kiln reads (its releases shipped 16 and 32).
+const MAX_THREE_SIZE: usize = 256;
+
+/// three.js' `DFGLUTData.js` as three ships it (`src/renderers/shaders/DFGLUTData.js`): a header
+/// comment, the imports of `DataTexture` and the constants, the private `DATA` (half-float
+/// bits, RG interleaved, one row of `n` texels per line) and the exported `getDFGLUT()` that
+/// builds the `DataTexture` once, so that kiln's file replaces three's as is. `scale` and
+/// `bias` are in the engine's order ([`Preset::texel`]).
+fn three_module(n: usize, scale: &[f64], bias: &[f64], command: &str) -> String {
+    let half = |v: f64| crate::format::f16::encode(v).0.to_bits();
+    let mut out = format!(
+        "/**\n * Precomputed DFG LUT for physically based specular lighting, used by both\n * \
+         image-based lighting and direct-light multi-scattering energy compensation\n * \
+         Resolution: {n}x{n}\n * Written by kiln {}: GGX, height-correlated Smith masking, by \
+         quadrature\n * (not sampled), each value the nearest half float\n * Format: RG16F (2 half floats per texel: scale, bias); u = \
+         roughness, v = dotNV, texel centres\n * Regenerate: {}\n */\n\n\
+         import {{ DataTexture }} from '../../textures/DataTexture.js';\n\
+         import {{ RGFormat, HalfFloatType, LinearFilter, ClampToEdgeWrapping }} from \
+         '../../constants.js';\n\nconst DATA = new Uint16Array( [",
+        crate::format::metadata::KILN_VERSION,
+        command.replace("*/", "* /")
+    );
+    for row in 0..n {
+        out.push_str("\n\t");
+        for column in 0..n {
+            let k = row * n + column;
+            let _ = write!(out, "0x{:04x}, 0x{:04x}", half(scale[k]), half(bias[k]));
+            out.push_str(match (column + 1 == n, k + 1 == n * n) {
+                (_, true) => "",
+                (true, false) => ",",
+                (false, false) => ", ",
+            });
+        }
+    }
+    let _ = write!(
+        out,
+        "\n] );\n\nlet lut = null;\n\nexport function getDFGLUT() {{\n\n\tif ( lut === null ) {{\n\n\
+         \t\tlut = new DataTexture( DATA, {n}, {n}, RGFormat, HalfFloatType );\n\
+         \t\tlut.name = 'DFG_LUT';\n\t\tlut.minFilter = LinearFilter;\n\
+         \t\tlut.magFilter = LinearFilter;\n\t\tlut.wrapS = ClampToEdgeWrapping;\n\
+         \t\tlut.wrapT = ClampToEdgeWrapping;\n\t\tlut.generateMipmaps = false;\n\
+         \t\tlut.needsUpdate = true;\n\n\t}}\n\n\treturn lut;\n\n}}\n"
+    );
+    out
+}
+
+/// The half-float bits of the `Uint16Array` in a three.js `DFGLUTData.js`, in file order.
+fn three_data(bytes: &[u8]) -> std::result::Result<Vec<u16>, String> {
+    let text = String::from_utf8_lossy(bytes);
+    let start = text.find("Uint16Array").ok_or("no Uint16Array")?;
+    let body = &text[start..];
+    let open = body.find('[').ok_or("no [ after Uint16Array")?;
+    // The first ] after the [ (one before it is not this array's).
+    let close = body[open..]
+        .find(']')
+        .map(|c| open + c)
+        .ok_or("no ] after the [")?;
+    body[open + 1..close]
+        .split(',')
+        .map(str::trim)
+        .filter(|s| !s.is_empty())
+        .map(|s| {
+            let digits = s.trim_start_matches("0x").trim_start_matches("0X");
+            u16::from_str_radix(digits, 16).map_err(|e| format!("{}: {e}", crate::error::quoted(s)))
+        })
+        .collect()
+}
+
+/// The `(width, height)` a three.js `DFGLUTData.js` builds its `DataTexture` with, if it says.
+fn three_texture_size(text: &str) -> Option<(usize, usize)> {
+    let call = &text[text.find("new DataTexture(")? + "new DataTexture(".len()..];
+    let arguments: Vec<&str> = call[..call.find(')')?].split(',').map(str::trim).collect();
+    Some((
+        arguments.get(1)?.parse().ok()?,
+        arguments.get(2)?.parse().ok()?,
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A three.js module holding `pairs` RG pairs and building a `w x h` texture.
+    fn three_file(pairs: usize, w: usize, h: usize) -> Vec<u8> {
+        let data: Vec<&str> = vec!["0x3c00, 0x0000"; pairs];
+        format!(
+            "const DATA = new Uint16Array( [ {} ] );\nlut = new DataTexture( DATA, {w}, {h}, \
+             RGFormat, HalfFloatType );\n",
+            data.join(", ")
+        )
+        .into_bytes()
+    }
+
+    #[test]
+    fn a_three_table_s_size_is_read_from_its_data_and_checked_against_its_texture() {
+        assert_eq!(Preset::Three.size_in(&three_file(256, 16, 16)).unwrap(), 16);
+        assert_eq!(
+            Preset::Three.size_in(&three_file(1024, 32, 32)).unwrap(),
+            32
+        );
+        assert_eq!(Preset::Three.size_in(&three_file(64, 8, 8)).unwrap(), 8);
+        let wrong = Preset::Three
+            .size_in(&three_file(256, 32, 32))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            wrong.contains("16 x 16") && wrong.contains("32 x 32"),
+            "{wrong}"
+        );
+        let not_square = Preset::Three
+            .size_in(&three_file(200, 16, 16))
+            .unwrap_err()
+            .to_string();
+        assert!(not_square.contains("400 half floats"), "{not_square}");
+        assert_eq!(three_texture_size("no texture here"), None);
     }
 }

@@ -942,12 +942,12 @@ fn presets_bake_and_verify() {
     assert_eq!(
         files_in(dir.path()),
         [
-            "DFGLUT.js",
+            "DFGLUTData.js",
             "three-ggx-height-correlated-E_bias.json",
             "three-ggx-height-correlated-E_scale.json"
         ]
     );
-    let file = dir.path().join("DFGLUT.js");
+    let file = dir.path().join("DFGLUTData.js");
     let audited = kiln(&[
         "verify",
         "--preset",

@@ -542,7 +542,7 @@ fn names_and_metadata_agree() {
         &std::fs::read(web.join("three-ggx-height-correlated-E_scale.json")).unwrap(),
     )
     .unwrap();
-    assert_eq!(three["files"]["three"], "DFGLUT.js");
+    assert_eq!(three["files"]["three"], "DFGLUTData.js");
     // eval's text names the masking.
     let output = kiln(&[
         "eval",

@@ -207,7 +207,7 @@ fn engine_files_with_nan_texels_are_refused() {
     let text = std::fs::read_to_string(source).unwrap();
     let at = text.find("0x").unwrap();
     let poisoned = format!("{}0x7e00{}", &text[..at], &text[at + 6..]);
-    let file = dir.path().join("DFGLUT.js");
+    let file = dir.path().join("DFGLUTData.js");
     std::fs::write(&file, poisoned).unwrap();
     refused(
         &kiln(&["verify", "--preset", "three", file.to_str().unwrap()]),

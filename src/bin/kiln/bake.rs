@@ -101,8 +101,8 @@ pub struct BakeArgs {
     scene: Option<PathBuf>,
     /// Bake an engine's table in that engine's own layout, to drop in for its file: cycles
     /// (shader.tables: table_ggx_E, table_ggx_Eavg), bevy (dfg.ktx2, RG16F scale/bias, 64 x 64,
-    /// zstd), three (DFGLUT.js, 16 x 16 transposed half bits), enterprise-pbr (GGX_E.exr and
-    /// GGX_E_avg.exr, half channel Y), filament (dfg.inc, 128 x 128 RGB16F half bits, cloth in
+    /// zstd), three (DFGLUTData.js as three ships it, 16 x 16 transposed half bits),
+    /// enterprise-pbr (GGX_E.exr and GGX_E_avg.exr, half channel Y), filament (dfg.inc, 128 x 128 RGB16F half bits, cloth in
     /// B), godot (dfg_lut.dds, RGBA16F, rows at 1 - r, Schlick-GGX), unity-hdrp
     /// (preIntegratedFGD_GGXDisneyDiffuse.exr, 64 x 64, sqrt(NoV) nodes, Disney diffuse in B) or
     /// unreal (ShadingEnergyGGXSpec.exr, 32 x 32, R = E, G = E*Fc); with kiln's JSON sidecars
