@@ -1,0 +1,622 @@
+//! Reading and writing an engine's file by its [`Container`]: the generic texture containers
+//! (KTX2, DDS, EXR planes, one EXR per table) take any [`Layout`]; the engines' own text formats
+//! (Cycles' C arrays, three.js' module, Filament's include) are written here once each.
+
+use super::layout::{Channel, Container, Layout, Normalisation};
+use super::{ExtraChannel, Files};
+use crate::error::{Error, Result};
+use crate::format::Precision;
+use crate::format::texture::Texture;
+use crate::table::{Quantity, Table};
+use std::fmt::Write as _;
+
+/// An engine file's tables (quantity, values in kiln's order) and its extra channel.
+pub(super) type Decoded = (Vec<(Quantity, Vec<f64>)>, Option<Vec<f64>>);
+
+/// The values of an `n x n` plane moved between kiln's order (roughness rows, `mu` columns)
+/// and the engine's ([`super::layout::TexelOrder`]).
+struct Orders<'a> {
+    layout: &'a Layout,
+    n: usize,
+}
+
+impl Orders<'_> {
+    fn engine(&self, values: &[f64]) -> Vec<f64> {
+        let n = self.n;
+        let mut out = vec![0.0; n * n];
+        for r in 0..n {
+            for m in 0..n {
+                out[self.layout.order.index(r, m, n)] = values[r * n + m];
+            }
+        }
+        out
+    }
+
+    fn kiln(&self, engine: &[f64]) -> Vec<f64> {
+        let n = self.n;
+        let mut out = vec![0.0; n * n];
+        for r in 0..n {
+            for m in 0..n {
+                out[r * n + m] = engine[self.layout.order.index(r, m, n)];
+            }
+        }
+        out
+    }
+}
+
+/// The table of `quantity` among `tables`.
+fn table_of(tables: &[Table], quantity: Quantity) -> Result<&Table> {
+    tables
+        .iter()
+        .find(|t| t.spec.quantity == quantity)
+        .ok_or_else(|| {
+            Error::InvalidInput(format!("the layout needs the {} table", quantity.symbol()))
+        })
+}
+
+/// The layout's channels as planes in the engine's order, with their names in a container that
+/// names them (the table's symbol, the extra channel's name, `A` for a constant).
+fn planes(
+    layout: &Layout,
+    n: usize,
+    tables: &[Table],
+    extra: Option<&ExtraChannel>,
+) -> Result<Vec<(String, Vec<f64>)>> {
+    let orders = Orders { layout, n };
+    layout
+        .channels
+        .iter()
+        .map(|channel| {
+            Ok(match *channel {
+                Channel::Table(q) => (
+                    q.symbol().to_string(),
+                    orders.engine(&table_of(tables, q)?.value),
+                ),
+                Channel::Extra => {
+                    let extra = extra.ok_or_else(|| {
+                        Error::InvalidInput(format!("{} has an extra channel", layout.name))
+                    })?;
+                    let name = layout.extra.map_or("extra", |e| e.channel_name());
+                    (name.to_string(), orders.engine(&extra.value))
+                }
+                Channel::Constant(c) => ("A".to_string(), vec![c; n * n]),
+            })
+        })
+        .collect()
+}
+
+/// The tables a texture container's metadata describes: those of its channels, in order.
+fn channel_tables<'a>(layout: &Layout, tables: &'a [Table]) -> Result<Vec<&'a Table>> {
+    layout
+        .channels
+        .iter()
+        .filter_map(|c| match c {
+            Channel::Table(q) => Some(table_of(tables, *q)),
+            _ => None,
+        })
+        .collect()
+}
+
+/// Every file of the engine's own (the normalisation beside them is the caller's): the main file
+/// first.
+pub(super) fn encode(
+    layout: &Layout,
+    tables: &[Table],
+    extra: Option<&ExtraChannel>,
+) -> Result<Files> {
+    let n = layout.size;
+    let invalid = Error::InvalidInput;
+    let main = |bytes: Vec<u8>| -> Files { vec![(layout.file_name.to_string(), bytes)] };
+    match layout.container {
+        Container::CycleTables(arrays) => {
+            let orders = Orders { layout, n };
+            let mut out = format!(
+                "/* kiln {}: Cycles' GGX energy-compensation tables (GGX, height-correlated, F = \
+                 1).\n * table_ggx_E: index = mu_index * {n} + r_index, mu = j / {}, r = i / {} \
+                 (alpha = r^2), exact nodes.\n * Regenerate: {}\n */\n",
+                crate::format::metadata::KILN_VERSION,
+                n - 1,
+                n - 1,
+                tables[0].command
+            );
+            for &(name, quantity) in arrays {
+                let table = table_of(tables, quantity)?;
+                let values = if quantity.has_mu() {
+                    orders.engine(&table.value)
+                } else {
+                    table.value.clone()
+                };
+                crate::format::c_header::float_array(&mut out, name, &values);
+            }
+            Ok(main(out.into_bytes()))
+        }
+        Container::Ktx2 => {
+            let mut texture =
+                Texture::of_values(&channel_tables(layout, tables)?).map_err(invalid)?;
+            texture.channels = planes(layout, n, tables, extra)?;
+            #[cfg(feature = "containers")]
+            let scheme = crate::format::ktx2::Supercompression::Zstd;
+            #[cfg(not(feature = "containers"))]
+            let scheme = crate::format::ktx2::Supercompression::None;
+            crate::format::ktx2::encode_with(&texture, Precision::F16, scheme)
+                .map_err(invalid)
+                .map(main)
+        }
+        #[cfg(not(feature = "containers"))]
+        Container::Dds => Err(invalid(
+            "writing DDS needs kiln's `containers` feature".to_string(),
+        )),
+        #[cfg(feature = "containers")]
+        Container::Dds => {
+            let mut texture =
+                Texture::of_values(&channel_tables(layout, tables)?).map_err(invalid)?;
+            texture.channels = planes(layout, n, tables, extra)?;
+            crate::format::dds::encode(&texture, Precision::F16)
+                .map_err(invalid)
+                .map(main)
+        }
+        Container::ExrPlanes => {
+            let planes = planes(layout, n, tables, extra)?;
+            let named: Vec<(&str, &[f64])> = ["R", "G", "B", "A"]
+                .into_iter()
+                .zip(&planes)
+                .map(|(name, (_, values))| (name, values.as_slice()))
+                .collect();
+            // The metadata is the E table's (the one every such engine holds).
+            let described = table_of(tables, Quantity::E)?;
+            crate::format::exr::encode_planes(described, &named, Precision::F16)
+                .map_err(invalid)
+                .map(main)
+        }
+        Container::ExrPerTable(files) => files
+            .iter()
+            .map(|&(file, quantity)| {
+                let table = table_of(tables, quantity)?;
+                let bytes = crate::format::exr::encode_value_as(table, "Y", Precision::F16)
+                    .map_err(invalid)?;
+                Ok((file.to_string(), bytes))
+            })
+            .collect(),
+        Container::ThreeModule => {
+            let planes = planes(layout, n, tables, extra)?;
+            Ok(main(
+                three_module(n, &planes, &tables[0].command).into_bytes(),
+            ))
+        }
+        Container::HalfBitsInclude => {
+            let planes = planes(layout, n, tables, extra)?;
+            let max_error = extra.map_or(0.0, |e| e.max_error);
+            Ok(main(
+                filament_include(n, &planes, max_error, &tables[0].command).into_bytes(),
+            ))
+        }
+    }
+}
+
+/// The file of the lookup-consistent normalisation `norm` ([`Normalisation`]).
+pub(super) fn encode_normalisation(form: Normalisation, norm: &Table) -> Result<Vec<u8>> {
+    match form {
+        Normalisation::CycleTable(_) => {
+            let rows = norm.value.len();
+            let mut out = format!(
+                "/* kiln {}: the lookup-consistent normalisation of the Kulla-Conty lobe for \
+                 Cycles' table_ggx_E (shader.tables).\n * table_ggx_f_ms_norm[i] = 1 - \
+                 Ebar(r) at r = i / {}, Ebar the cosine-weighted average of table_ggx_E's \
+                 bilinear lookup (as\n * lookup_table_read_2D reads it), linear between \
+                 entries; f_ms = (1 - E(mu_o)) (1 - E(mu_i)) / (pi (1 - Ebar(r))).\n * \
+                 Regenerate: {}\n */\n",
+                crate::format::metadata::KILN_VERSION,
+                rows - 1,
+                norm.command
+            );
+            crate::format::c_header::float_array(&mut out, "table_ggx_f_ms_norm", &norm.value);
+            Ok(out.into_bytes())
+        }
+        // Values from 1e-7 to 1: stored in f32, as f16 would lose the small ones.
+        Normalisation::ExrF32(_) => crate::format::exr::encode_value_as(norm, "Y", Precision::F32)
+            .map_err(Error::InvalidInput),
+    }
+}
+
+/// Reads an engine's file of an `n x n` layout: its tables in kiln's order and its extra
+/// channel. `normalisation_size` is the length of the layout's `f_ms_norm` (0 without).
+/// `bad` makes the error for bytes that are not the engine's file.
+pub(super) fn decode(
+    layout: &Layout,
+    bytes: &[u8],
+    n: usize,
+    normalisation_size: usize,
+    bad: &dyn Fn(String) -> Error,
+) -> Result<Decoded> {
+    let orders = Orders { layout, n };
+    // The layout's channels from planes in the engine's order: the tables (each required) and
+    // the extra channel (kept if present).
+    let from_planes = |planes: &[Option<&[f64]>]| -> Result<Decoded> {
+        let mut tables = Vec::new();
+        let mut extra = None;
+        for (k, channel) in layout.channels.iter().enumerate() {
+            let plane = planes.get(k).copied().flatten();
+            match channel {
+                Channel::Table(q) => {
+                    let plane =
+                        plane.ok_or_else(|| bad(format!("no channel for {}", q.symbol())))?;
+                    tables.push((*q, orders.kiln(plane)));
+                }
+                Channel::Extra => extra = plane.map(|p| orders.kiln(p)),
+                Channel::Constant(_) => {}
+            }
+        }
+        Ok((tables, extra))
+    };
+    // Channel `c` of `stride` interleaved half floats per texel.
+    let half_plane = |bits: &[u16], stride: usize, c: usize| -> Vec<f64> {
+        (0..n * n)
+            .map(|k| f64::from(half::f16::from_bits(bits[stride * k + c]).to_f32()))
+            .collect()
+    };
+    // Interleaved half floats with every channel, or only the tables' (an RG16F Filament include
+    // from before the cloth channel, a Godot texture without it).
+    let from_half_bits = |bits: &[u16], strides: &[usize]| -> Result<Decoded> {
+        let stride = strides
+            .iter()
+            .copied()
+            .find(|&s| bits.len() == s * n * n)
+            .ok_or_else(|| {
+                let expected: Vec<String> =
+                    strides.iter().map(|s| (s * n * n).to_string()).collect();
+                bad(format!(
+                    "{} half floats (expected {} for {n} x {n} texels)",
+                    bits.len(),
+                    expected.join(" or ")
+                ))
+            })?;
+        let planes: Vec<Vec<f64>> = (0..stride).map(|c| half_plane(bits, stride, c)).collect();
+        let planes: Vec<Option<&[f64]>> = planes.iter().map(|p| Some(p.as_slice())).collect();
+        from_planes(&planes)
+    };
+    let table_channels = layout
+        .channels
+        .iter()
+        .filter(|c| matches!(c, Channel::Table(_)))
+        .count();
+    match layout.container {
+        Container::CycleTables(arrays) => {
+            let text = String::from_utf8_lossy(bytes);
+            if let Some(Normalisation::CycleTable(_)) = layout.normalisation
+                && let Some(norm) = c_array(&text, "table_ggx_f_ms_norm")
+            {
+                if norm.len() != normalisation_size {
+                    return Err(bad(format!(
+                        "table_ggx_f_ms_norm has {} values (expected {normalisation_size})",
+                        norm.len()
+                    )));
+                }
+                return Ok((vec![(Quantity::FMsNorm, norm)], None));
+            }
+            let found: Vec<(Quantity, &str, Vec<f64>)> = arrays
+                .iter()
+                .map(|&(name, quantity)| {
+                    c_array(&text, name)
+                        .map(|values| (quantity, name, values))
+                        .ok_or_else(|| bad(format!("no {name}")))
+                })
+                .collect::<Result<_>>()?;
+            let mut tables = Vec::new();
+            for (quantity, name, values) in found {
+                let expected = if quantity.has_mu() { n * n } else { n };
+                if values.len() != expected {
+                    return Err(bad(format!(
+                        "{name} has {} values (expected {expected})",
+                        values.len()
+                    )));
+                }
+                let values = if quantity.has_mu() {
+                    orders.kiln(&values)
+                } else {
+                    values
+                };
+                tables.push((quantity, values));
+            }
+            Ok((tables, None))
+        }
+        #[cfg(not(feature = "containers"))]
+        Container::Ktx2 => Err(bad(
+            "reading KTX2 needs kiln's `containers` feature".to_string()
+        )),
+        #[cfg(feature = "containers")]
+        Container::Ktx2 => {
+            let texture = crate::format::ktx2::decode(bytes).map_err(bad)?;
+            let channels = layout.channels.len();
+            if texture.channels.len() != channels
+                || texture.precision != Precision::F16
+                || texture.extent != (n, n, 1)
+            {
+                return Err(bad(format!(
+                    "expected {n} x {n} with {channels} f16 channels, found {} x {} x {} with {} \
+                     {} channels",
+                    texture.extent.0,
+                    texture.extent.1,
+                    texture.extent.2,
+                    texture.channels.len(),
+                    texture.precision.name()
+                )));
+            }
+            let planes: Vec<Option<&[f64]>> = texture
+                .channels
+                .iter()
+                .map(|v| Some(v.as_slice()))
+                .collect();
+            from_planes(&planes)
+        }
+        #[cfg(not(feature = "containers"))]
+        Container::Dds => Err(bad(
+            "reading DDS needs kiln's `containers` feature".to_string()
+        )),
+        #[cfg(feature = "containers")]
+        Container::Dds => {
+            let dds =
+                ddsfile::Dds::read(bytes).map_err(|e| bad(format!("not a DDS file ({e})")))?;
+            let format = dds.get_dxgi_format();
+            let stride = match format {
+                Some(ddsfile::DxgiFormat::R16G16B16A16_Float) => 4,
+                Some(ddsfile::DxgiFormat::R16G16_Float) => 2,
+                _ => 0,
+            };
+            if !(stride == layout.channels.len() || stride == table_channels)
+                || (dds.get_width(), dds.get_height()) != (n as u32, n as u32)
+                || dds.data.len() < 2 * stride * n * n
+            {
+                return Err(bad(format!(
+                    "expected {n} x {n} with {} f16 channels, found {} x {} {format:?}",
+                    layout.channels.len(),
+                    dds.get_width(),
+                    dds.get_height()
+                )));
+            }
+            let bits = little_endian(&dds.data[..2 * stride * n * n]);
+            from_half_bits(&bits, &[stride])
+        }
+        Container::ExrPlanes => {
+            let image = crate::format::exr::decode(bytes)
+                .map_err(|e| bad(format!("not an EXR file ({e})")))?;
+            if (image.width, image.height) != (n, n) {
+                return Err(bad(format!(
+                    "{} x {} (expected {n} x {n})",
+                    image.width, image.height
+                )));
+            }
+            let plane = |name: &str| {
+                image
+                    .channels
+                    .iter()
+                    .find(|(c, _)| c == name)
+                    .map(|(_, values)| values.as_slice())
+            };
+            let planes: Vec<Option<&[f64]>> = ["R", "G", "B", "A"]
+                .iter()
+                .take(layout.channels.len())
+                .map(|name| plane(name))
+                .collect();
+            from_planes(&planes)
+        }
+        Container::ExrPerTable(files) => {
+            let image = crate::format::exr::decode(bytes).map_err(bad)?;
+            let (_, values) = image
+                .channels
+                .iter()
+                .find(|(name, _)| name == "Y")
+                .ok_or_else(|| bad("no channel Y".into()))?;
+            let size = (image.width, image.height);
+            for &(_, quantity) in files {
+                match (quantity.has_mu(), size) {
+                    (true, s) if s == (n, n) => {
+                        return Ok((vec![(quantity, orders.kiln(values))], None));
+                    }
+                    (false, s) if s == (n, 1) => {
+                        return Ok((vec![(quantity, values.clone())], None));
+                    }
+                    _ => {}
+                }
+            }
+            if let Some(Normalisation::ExrF32(_)) = layout.normalisation
+                && size == (normalisation_size, 1)
+            {
+                return Ok((vec![(Quantity::FMsNorm, values.clone())], None));
+            }
+            let mut expected: Vec<String> = files
+                .iter()
+                .map(|&(file, q)| {
+                    let (w, h) = if q.has_mu() { (n, n) } else { (n, 1) };
+                    format!("{file}, {w} x {h}")
+                })
+                .collect();
+            if let Some(form) = layout.normalisation {
+                expected.push(format!("{}, {normalisation_size} x 1", form.file()));
+            }
+            Err(bad(format!(
+                "{} x {} (expected {})",
+                size.0,
+                size.1,
+                expected.join(", or ")
+            )))
+        }
+        Container::ThreeModule => {
+            let bits = three_data(bytes).map_err(bad)?;
+            from_half_bits(&bits, &[layout.channels.len()])
+        }
+        Container::HalfBitsInclude => {
+            let bits = include_half_bits(bytes).map_err(bad)?;
+            from_half_bits(&bits, &[layout.channels.len(), table_channels])
+        }
+    }
+}
+
+/// Little-endian 16-bit words (a container's half floats).
+#[cfg(feature = "containers")]
+fn little_endian(data: &[u8]) -> Vec<u16> {
+    data.chunks_exact(2)
+        .map(|b| u16::from_le_bytes([b[0], b[1]]))
+        .collect()
+}
+
+/// The numbers of the C float array `name` (`name[...] = { ... }`), `f` suffixes allowed, read
+/// as f32 (what the C compiler stores) and widened.
+fn c_array(text: &str, name: &str) -> Option<Vec<f64>> {
+    let mut rest = text;
+    loop {
+        let at = rest.find(name)?;
+        let after = &rest[at + name.len()..];
+        // The whole identifier: not table_ggx_E inside table_ggx_Eavg.
+        if after.starts_with(|c: char| c.is_alphanumeric() || c == '_') {
+            rest = after;
+            continue;
+        }
+        let open = after.find('{')?;
+        let close = after[open..].find('}')? + open;
+        return after[open + 1..close]
+            .split(',')
+            .map(str::trim)
+            .filter(|s| !s.is_empty())
+            .map(|s| {
+                s.trim_end_matches(['f', 'F'])
+                    .parse::<f32>()
+                    .ok()
+                    .map(f64::from)
+            })
+            .collect();
+    }
+}
+
+/// Half-float bits, one per channel per texel, as hex literals.
+fn half_bits(value: f64) -> u16 {
+    crate::format::f16::encode(value).0.to_bits()
+}
+
+/// Filament's `dfg.inc` (included inside `DFG_LUT[]`): the planes' half-float bits interleaved
+/// per texel as C hex literals, four texels per line, after a comment saying what they hold.
+fn filament_include(
+    n: usize,
+    planes: &[(String, Vec<f64>)],
+    sheen_max_error: f64,
+    command: &str,
+) -> String {
+    let mut out = format!(
+        "// kiln {}: Filament's DFG LUT (dfg.inc), {n} x {n} RGB16F half-float bits in GL \
+         order,\n// x = NoV = (i + 0.5) / {n}, y = perceptual roughness = (j + 0.5) / {n} \
+         (alpha = r^2), texel centres.\n// R = integral of Fc f mu_i, G = integral of f mu_i \
+         (GGX, height-correlated, F = 1);\n// B = cloth albedo (Charlie NDF, Ashikhmin \
+         visibility), quadrature error estimate <= {sheen_max_error:.0e}.\n// Regenerate: \
+         {command}\n",
+        crate::format::metadata::KILN_VERSION,
+    );
+    for k in 0..n * n {
+        for (_, plane) in planes {
+            let _ = write!(out, "0x{:04x}, ", half_bits(plane[k]));
+        }
+        if k % 4 == 3 {
+            out.truncate(out.trim_end().len());
+            out.push('\n');
+        }
+    }
+    out
+}
+
+/// Every `0x` number outside `//` comments of a Filament include: RGB (or, from cmgen before
+/// the cloth channel, RG) half-float bits per texel.
+fn include_half_bits(bytes: &[u8]) -> std::result::Result<Vec<u16>, String> {
+    let text = String::from_utf8_lossy(bytes);
+    text.lines()
+        .map(|line| line.split("//").next().unwrap_or(""))
+        .flat_map(|line| line.split(','))
+        .map(str::trim)
+        .filter(|s| !s.is_empty())
+        .filter_map(|s| s.strip_prefix("0x").or_else(|| s.strip_prefix("0X")))
+        // The digits only: the last number may run into the closing `};`.
+        .map(|s| {
+            s.split(|c: char| !c.is_ascii_hexdigit())
+                .next()
+                .unwrap_or("")
+        })
+        .map(|s| u16::from_str_radix(s, 16).map_err(|e| format!("'0x{s}': {e}")))
+        .collect()
+}
+
+/// The largest three.js table kiln reads (its releases shipped 16 and 32).
+pub(super) const MAX_THREE_SIZE: usize = 256;
+
+/// three.js' `DFGLUTData.js` as three ships it (`src/renderers/shaders/DFGLUTData.js`): a header
+/// comment, the imports of `DataTexture` and the constants, the private `DATA` (the planes'
+/// half-float bits interleaved, one row of `n` texels per line) and the exported `getDFGLUT()`
+/// that builds the `DataTexture` once, so that kiln's file replaces three's as is.
+fn three_module(n: usize, planes: &[(String, Vec<f64>)], command: &str) -> String {
+    let mut out = format!(
+        "/**\n * Precomputed DFG LUT for physically based specular lighting, used by both\n * \
+         image-based lighting and direct-light multi-scattering energy compensation\n * \
+         Resolution: {n}x{n}\n * Written by kiln {}: GGX, height-correlated Smith masking, by \
+         quadrature\n * (not sampled), each value the nearest half float\n * Format: RG16F (2 \
+         half floats per texel: scale, bias); u = roughness, v = dotNV, texel centres\n * \
+         Regenerate: {}\n */\n\nimport {{ DataTexture }} from \
+         '../../textures/DataTexture.js';\nimport {{ RGFormat, HalfFloatType, LinearFilter, \
+         ClampToEdgeWrapping }} from '../../constants.js';\n\nconst DATA = new Uint16Array( [",
+        crate::format::metadata::KILN_VERSION,
+        command.replace("*/", "* /")
+    );
+    for row in 0..n {
+        out.push_str("\n\t");
+        for column in 0..n {
+            let k = row * n + column;
+            let texel: Vec<String> = planes
+                .iter()
+                .map(|(_, plane)| format!("0x{:04x}", half_bits(plane[k])))
+                .collect();
+            out.push_str(&texel.join(", "));
+            out.push_str(match (column + 1 == n, k + 1 == n * n) {
+                (_, true) => "",
+                (true, false) => ",",
+                (false, false) => ", ",
+            });
+        }
+    }
+    let _ = write!(
+        out,
+        "\n] );\n\nlet lut = null;\n\nexport function getDFGLUT() {{\n\n\tif ( lut === null ) {{\n\n\
+         \t\tlut = new DataTexture( DATA, {n}, {n}, RGFormat, HalfFloatType );\n\
+         \t\tlut.name = 'DFG_LUT';\n\t\tlut.minFilter = LinearFilter;\n\
+         \t\tlut.magFilter = LinearFilter;\n\t\tlut.wrapS = ClampToEdgeWrapping;\n\
+         \t\tlut.wrapT = ClampToEdgeWrapping;\n\t\tlut.generateMipmaps = false;\n\
+         \t\tlut.needsUpdate = true;\n\n\t}}\n\n\treturn lut;\n\n}}\n"
+    );
+    out
+}
+
+/// The half-float bits of the `Uint16Array` in a three.js `DFGLUTData.js`, in file order.
+pub(super) fn three_data(bytes: &[u8]) -> std::result::Result<Vec<u16>, String> {
+    let text = String::from_utf8_lossy(bytes);
+    let start = text.find("Uint16Array").ok_or("no Uint16Array")?;
+    let body = &text[start..];
+    let open = body.find('[').ok_or("no [ after Uint16Array")?;
+    // The first ] after the [ (one before it is not this array's).
+    let close = body[open..]
+        .find(']')
+        .map(|c| open + c)
+        .ok_or("no ] after the [")?;
+    body[open + 1..close]
+        .split(',')
+        .map(str::trim)
+        .filter(|s| !s.is_empty())
+        .map(|s| {
+            let digits = s.trim_start_matches("0x").trim_start_matches("0X");
+            u16::from_str_radix(digits, 16).map_err(|e| format!("{}: {e}", crate::error::quoted(s)))
+        })
+        .collect()
+}
+
+/// The `(width, height)` a three.js `DFGLUTData.js` builds its `DataTexture` with, if it says.
+pub(super) fn three_texture_size(text: &str) -> Option<(usize, usize)> {
+    let call = &text[text.find("new DataTexture(")? + "new DataTexture(".len()..];
+    let arguments: Vec<&str> = call[..call.find(')')?].split(',').map(str::trim).collect();
+    Some((
+        arguments.get(1)?.parse().ok()?,
+        arguments.get(2)?.parse().ok()?,
+    ))
+}

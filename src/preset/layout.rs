@@ -1,0 +1,332 @@
+//! Engine layouts as data: for each engine, one [`Layout`] value says what kiln bakes for it
+//! (size, grid, `mu` mapping, masking, tables), where each texel sits in the engine's array
+//! ([`TexelOrder`]), what each channel of its texture holds ([`Channel`]), how the engine stores
+//! the numbers ([`Stored`]) and in what file ([`Container`]). The code that reads and writes the
+//! files is per container, not per engine ([`super::container`]); only the text formats that no
+//! other engine shares (Cycles' C arrays, three.js' module, Filament's include) have their own.
+//! The sources of each layout (engines' files and commits) are in `docs/engines.md`.
+
+use crate::model::Masking;
+use crate::table::Quantity;
+use crate::table::axis::{Grid, MuMapping};
+
+/// Where the engine's flat array puts the texel at roughness index `r` and `mu` index `m` of an
+/// `n x n` table (in texels; channels interleave within one).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TexelOrder {
+    /// `m n + r`: rows of `mu`, roughness across (Cycles' `mu_index * 32 + r_index`; three.js'
+    /// texture with `u` = roughness, `v` = `NoV`).
+    MuRows,
+    /// `r n + m`: rows of roughness from the smooth end, `mu` across.
+    RoughnessRows,
+    /// `(n - 1 - r) n + m`: rows of roughness from the rough end (the image's top row at
+    /// `r = 1`), `mu` across.
+    RoughnessRowsFromRough,
+}
+
+impl TexelOrder {
+    /// The engine's index of kiln's texel `(r, m)`.
+    #[must_use]
+    pub fn index(self, r: usize, m: usize, n: usize) -> usize {
+        match self {
+            TexelOrder::MuRows => m * n + r,
+            TexelOrder::RoughnessRows => r * n + m,
+            TexelOrder::RoughnessRowsFromRough => (n - 1 - r) * n + m,
+        }
+    }
+}
+
+/// What one channel of an engine's texture holds.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Channel {
+    /// One of the tables kiln bakes for the layout.
+    Table(Quantity),
+    /// The layout's [`Extra`] channel.
+    Extra,
+    /// The same number at every texel (an alpha of 1, an unused 0).
+    Constant(f64),
+}
+
+/// A channel kiln computes beside its tables for an engine's texture.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Extra {
+    /// The cloth albedo of Filament's and Godot's DFG texture: Charlie NDF, Ashikhmin visibility
+    /// ([`crate::integrate::sheen`]).
+    ClothAlbedo,
+    /// Unity HDRP's Disney diffuse albedo minus 0.5 ([`crate::model::disney_diffuse`]).
+    DisneyDiffuseMinusHalf,
+}
+
+impl Extra {
+    /// What the channel holds, for reports.
+    #[must_use]
+    pub fn description(self) -> &'static str {
+        match self {
+            Extra::ClothAlbedo => "cloth albedo (Charlie NDF, Ashikhmin visibility)",
+            Extra::DisneyDiffuseMinusHalf => "Disney diffuse albedo - 0.5",
+        }
+    }
+
+    /// The channel's name in a container that names its channels.
+    #[must_use]
+    pub fn channel_name(self) -> &'static str {
+        match self {
+            Extra::ClothAlbedo => "E_sheen",
+            Extra::DisneyDiffuseMinusHalf => "B",
+        }
+    }
+}
+
+/// How the engine stores each number.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stored {
+    /// IEEE single precision (C `float`).
+    F32,
+    /// IEEE half precision, nearest ([`crate::format::f16`]).
+    F16,
+}
+
+impl Stored {
+    /// A value as the engine's file holds it, widened back.
+    #[must_use]
+    pub fn round(self, value: f64) -> f64 {
+        match self {
+            Stored::F32 => f64::from(value as f32),
+            Stored::F16 => crate::format::f16::stored(value),
+        }
+    }
+}
+
+/// The file format of an engine's table.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Container {
+    /// C `float` arrays, one per table under its name (2-D tables in the layout's
+    /// [`TexelOrder`], 1-D ones by roughness): Cycles' `shader.tables`.
+    CycleTables(&'static [(&'static str, Quantity)]),
+    /// KTX2 with the layout's channels interleaved, half floats, one level; zstd
+    /// supercompression with kiln's `containers` feature (as Bevy ships it).
+    Ktx2,
+    /// DDS with the layout's channels interleaved, half floats (`containers` feature).
+    Dds,
+    /// One EXR image with the layout's channels as planes R, G, B, A, half floats.
+    ExrPlanes,
+    /// One EXR image per table, `(file, quantity)`, its values in one half-float channel `Y`
+    /// (2-D tables `n x n`, 1-D ones `n x 1`).
+    ExrPerTable(&'static [(&'static str, Quantity)]),
+    /// three.js' `DFGLUTData.js` module: the channels' half-float bits interleaved in a
+    /// `Uint16Array` with the `getDFGLUT()` that builds the `DataTexture`.
+    ThreeModule,
+    /// Filament's `dfg.inc`: the channels' half-float bits interleaved as C hex literals, four
+    /// texels per line, to be included inside an array.
+    HalfBitsInclude,
+}
+
+/// How an engine that normalises its multiple-scattering lobe by `E_avg` gets kiln's
+/// lookup-consistent `f_ms_norm` ([`crate::table::normalisation`]) beside its own files.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Normalisation {
+    /// A C `float` array `table_ggx_f_ms_norm` in its own file.
+    CycleTable(&'static str),
+    /// A one-row EXR, channel `Y` in f32 (its values reach 1e-7, below half-float range).
+    ExrF32(&'static str),
+}
+
+impl Normalisation {
+    /// The file it is written to.
+    #[must_use]
+    pub fn file(self) -> &'static str {
+        match self {
+            Normalisation::CycleTable(file) | Normalisation::ExrF32(file) => file,
+        }
+    }
+}
+
+/// One engine's layout: everything kiln needs to write a file that replaces the engine's own,
+/// and to read the engine's file for an audit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Layout {
+    /// The preset's name on the command line.
+    pub name: &'static str,
+    /// The engine's file (the first, for a container of several).
+    pub file_name: &'static str,
+    /// Texels per axis (both axes; 1-D tables have `size` entries).
+    pub size: usize,
+    /// Texel centres or nodes, on both axes.
+    pub grid: Grid,
+    /// The `mu` axis' mapping (the roughness axis is always perceptual `r`, `alpha = r^2`).
+    pub mu_mapping: MuMapping,
+    /// The Smith masking the engine's BRDF uses (always GGX).
+    pub masking: Masking,
+    /// The tables kiln bakes, in order.
+    pub tables: &'static [Quantity],
+    /// Where each texel sits in the engine's arrays.
+    pub order: TexelOrder,
+    /// The channels of the engine's texture, in texel order (for the containers of one
+    /// texture).
+    pub channels: &'static [Channel],
+    /// How the numbers are stored.
+    pub stored: Stored,
+    /// The file format.
+    pub container: Container,
+    /// The channel kiln computes beside its tables, if any.
+    pub extra: Option<Extra>,
+    /// `f_ms_norm` beside the engine's files, if the engine normalises by `E_avg`.
+    pub normalisation: Option<Normalisation>,
+    /// The smallest `mu` and roughness the engine itself computed its file at (its first row
+    /// and column stand for this value), for a file kiln did not write: Cycles' 1e-4.
+    pub engine_computed_from: f64,
+}
+
+/// The file of `f_ms_norm` beside Cycles' `shader.tables`.
+pub const CYCLES_NORMALISATION_FILE: &str = "ggx_f_ms_norm.tables";
+
+/// The file of `f_ms_norm` beside Enterprise PBR's `GGX_E.exr` and `GGX_E_avg.exr`.
+pub const ENTERPRISE_NORMALISATION_FILE: &str = "GGX_f_ms_norm.exr";
+
+use Channel::{Constant, Table};
+use Quantity::{E, EAvg, EBias, EScale, FMsNorm};
+
+/// Blender Cycles' `table_ggx_E[1024]` and `table_ggx_Eavg[32]` (`shader.tables`).
+pub const CYCLES: Layout = Layout {
+    name: "cycles",
+    file_name: "shader.tables",
+    size: 32,
+    grid: Grid::Nodes,
+    mu_mapping: MuMapping::Linear,
+    masking: Masking::HeightCorrelated,
+    tables: &[E, EAvg, FMsNorm],
+    order: TexelOrder::MuRows,
+    channels: &[Table(E)],
+    stored: Stored::F32,
+    container: Container::CycleTables(&[("table_ggx_E", E), ("table_ggx_Eavg", EAvg)]),
+    extra: None,
+    normalisation: Some(Normalisation::CycleTable(CYCLES_NORMALISATION_FILE)),
+    engine_computed_from: 1e-4,
+};
+
+/// Bevy's `dfg.ktx2`.
+pub const BEVY: Layout = Layout {
+    name: "bevy",
+    file_name: "dfg.ktx2",
+    size: 64,
+    grid: Grid::Centers,
+    mu_mapping: MuMapping::Linear,
+    masking: Masking::HeightCorrelated,
+    tables: &[EScale, EBias],
+    order: TexelOrder::RoughnessRows,
+    channels: &[Table(EScale), Table(EBias)],
+    stored: Stored::F16,
+    container: Container::Ktx2,
+    extra: None,
+    normalisation: None,
+    engine_computed_from: 0.0,
+};
+
+/// three.js' `DFGLUTData.js` (16 x 16 since r182; r181 and before shipped 32 x 32, which
+/// reads alike).
+pub const THREE: Layout = Layout {
+    name: "three",
+    file_name: "DFGLUTData.js",
+    size: 16,
+    grid: Grid::Centers,
+    mu_mapping: MuMapping::Linear,
+    masking: Masking::HeightCorrelated,
+    tables: &[EScale, EBias],
+    order: TexelOrder::MuRows,
+    channels: &[Table(EScale), Table(EBias)],
+    stored: Stored::F16,
+    container: Container::ThreeModule,
+    extra: None,
+    normalisation: None,
+    engine_computed_from: 0.0,
+};
+
+/// Enterprise PBR's `res/GGX_E.exr` and `res/GGX_E_avg.exr`.
+pub const ENTERPRISE_PBR: Layout = Layout {
+    name: "enterprise-pbr",
+    file_name: "GGX_E.exr",
+    size: 32,
+    grid: Grid::Centers,
+    mu_mapping: MuMapping::Linear,
+    masking: Masking::HeightCorrelated,
+    tables: &[E, EAvg, FMsNorm],
+    order: TexelOrder::RoughnessRows,
+    channels: &[Table(E)],
+    stored: Stored::F16,
+    container: Container::ExrPerTable(&[("GGX_E.exr", E), ("GGX_E_avg.exr", EAvg)]),
+    extra: None,
+    normalisation: Some(Normalisation::ExrF32(ENTERPRISE_NORMALISATION_FILE)),
+    engine_computed_from: 0.0,
+};
+
+/// Filament's `dfg.inc` (`cmgen --ibl-dfg-multiscatter --ibl-dfg-cloth`).
+pub const FILAMENT: Layout = Layout {
+    name: "filament",
+    file_name: "dfg.inc",
+    size: 128,
+    grid: Grid::Centers,
+    mu_mapping: MuMapping::Linear,
+    masking: Masking::HeightCorrelated,
+    tables: &[EBias, E],
+    order: TexelOrder::RoughnessRows,
+    channels: &[Table(EBias), Table(E), Channel::Extra],
+    stored: Stored::F16,
+    container: Container::HalfBitsInclude,
+    extra: Some(Extra::ClothAlbedo),
+    normalisation: None,
+    engine_computed_from: 0.0,
+};
+
+/// Godot 4's DFG texture (`integrate_dfg.glsl`), as a DDS to upload in its place.
+pub const GODOT: Layout = Layout {
+    name: "godot",
+    file_name: "dfg_lut.dds",
+    size: 128,
+    grid: Grid::Centers,
+    mu_mapping: MuMapping::Linear,
+    masking: Masking::SchlickGgx,
+    tables: &[EBias, E],
+    order: TexelOrder::RoughnessRowsFromRough,
+    channels: &[Table(EBias), Table(E), Channel::Extra, Constant(1.0)],
+    stored: Stored::F16,
+    container: Container::Dds,
+    extra: Some(Extra::ClothAlbedo),
+    normalisation: None,
+    engine_computed_from: 0.0,
+};
+
+/// Unity HDRP's `_PreIntegratedFGD_GGXDisneyDiffuse`, as an EXR to import in its place.
+pub const UNITY_HDRP: Layout = Layout {
+    name: "unity-hdrp",
+    file_name: "preIntegratedFGD_GGXDisneyDiffuse.exr",
+    size: 64,
+    grid: Grid::Nodes,
+    mu_mapping: MuMapping::Sqrt,
+    masking: Masking::HeightCorrelated,
+    tables: &[EBias, E],
+    order: TexelOrder::RoughnessRowsFromRough,
+    channels: &[Table(EBias), Table(E), Channel::Extra],
+    stored: Stored::F16,
+    container: Container::ExrPlanes,
+    extra: Some(Extra::DisneyDiffuseMinusHalf),
+    normalisation: None,
+    engine_computed_from: 0.0,
+};
+
+/// Unreal Engine 5's `ShadingEnergyGGXSpecTexture`, as an EXR to import in its place.
+pub const UNREAL: Layout = Layout {
+    name: "unreal",
+    file_name: "ShadingEnergyGGXSpec.exr",
+    size: 32,
+    grid: Grid::Centers,
+    mu_mapping: MuMapping::Linear,
+    masking: Masking::HeightCorrelated,
+    tables: &[E, EBias],
+    order: TexelOrder::RoughnessRows,
+    channels: &[Table(E), Table(EBias), Constant(0.0), Constant(1.0)],
+    stored: Stored::F16,
+    container: Container::ExrPlanes,
+    extra: None,
+    normalisation: None,
+    engine_computed_from: 0.0,
+};
