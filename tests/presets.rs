@@ -536,3 +536,129 @@ fn cycles_and_enterprise_pbr_get_the_normalisation_of_their_own_lookup() {
         }
     }
 }
+
+/// An 8-bit grey PNG read independently (the `png` crate, red channel; R = G = B checked).
+fn grey_png(bytes: &[u8]) -> (usize, usize, Vec<u8>) {
+    let decoder = png::Decoder::new(bytes);
+    let mut reader = decoder.read_info().unwrap();
+    let mut buffer = vec![0; reader.output_buffer_size()];
+    let frame = reader.next_frame(&mut buffer).unwrap();
+    assert_eq!(
+        (frame.color_type, frame.bit_depth),
+        (png::ColorType::Rgb, png::BitDepth::Eight)
+    );
+    let pixels: Vec<u8> = buffer[..frame.buffer_size()]
+        .chunks_exact(3)
+        .map(|p| {
+            assert!(p[0] == p[1] && p[1] == p[2], "{p:?}");
+            p[0]
+        })
+        .collect();
+    (frame.width as usize, frame.height as usize, pixels)
+}
+
+/// GAMES202's homework reads `GGX_E_LUT.png` (row `i` at roughness `(i + 0.5) / 128`, column `j`
+/// at NdotV `(j + 0.5) / 128`, written flipped so the roughest row is on top) and
+/// `GGX_Eavg_LUT.png` (each row that roughness' `E_avg`), for GGX with separable Schlick-GGX
+/// masking, `k = alpha / 2`. Checked against the reference computed here at the homework's own
+/// coordinates, rounded to 8 bits.
+#[test]
+fn games202_layout_is_flipped_8_bit_grey_with_schlick_ggx() {
+    use kiln::integrate::reference::{
+        ReferenceSettings, reference_albedo, reference_average_albedo,
+    };
+    let tables = bake_to(Preset::Games202, 1e-4);
+    let files = Preset::Games202.files(&tables).unwrap();
+    let names: Vec<&str> = files.iter().map(|(n, _)| n.as_str()).collect();
+    assert_eq!(names, ["GGX_E_LUT.png", "GGX_Eavg_LUT.png"]);
+    let model = kiln::Model {
+        ndf: kiln::Ndf::Ggx,
+        masking: kiln::Masking::SchlickGgx,
+    };
+    let settings = ReferenceSettings {
+        tolerance: 1e-7,
+        ..ReferenceSettings::default()
+    };
+    let unorm8 = |v: f64| (v * 255.0).round() as u8;
+    let (w, h, e) = grey_png(&files[0].1);
+    assert_eq!((w, h), (128, 128));
+    for (y, x) in [
+        (0, 0),
+        (0, 127),
+        (127, 0),
+        (127, 127),
+        (64, 3),
+        (100, 40),
+        (5, 90),
+    ] {
+        // The image's row y holds the homework's row i = 127 - y.
+        let r = (127.0 - y as f64 + 0.5) / 128.0;
+        let mu = (x as f64 + 0.5) / 128.0;
+        let truth = reference_albedo(model, r * r, mu, &settings).value;
+        assert_eq!(e[y * 128 + x], unorm8(truth), "y {y}, x {x}: {truth}");
+    }
+    let (w, h, avg) = grey_png(&files[1].1);
+    assert_eq!((w, h), (128, 128));
+    for y in [0, 1, 63, 126, 127] {
+        let r = (127.0 - y as f64 + 0.5) / 128.0;
+        let truth = reference_average_albedo(model, r * r, &settings).value;
+        let row = &avg[y * 128..(y + 1) * 128];
+        assert!(row.iter().all(|&p| p == unorm8(truth)), "y {y}: {truth}");
+    }
+    // Read back: each file gives its own table.
+    let e_back = Preset::Games202.read_tables(&files[0].1, "e").unwrap();
+    let avg_back = Preset::Games202.read_tables(&files[1].1, "avg").unwrap();
+    assert_eq!(e_back[0].spec.quantity, kiln::Quantity::E);
+    assert_eq!(avg_back[0].spec.quantity, kiln::Quantity::EAvg);
+    assert_eq!(e_back[0].value[0], f64::from(e[127 * 128]) / 255.0);
+}
+
+/// A student's table as the homework writes it (`uint8(x * 255)`, truncated) audits at twice
+/// what 8-bit storage alone costs, and the audit says both: storage alone (the true values
+/// rounded) is at most half a step at the nodes, truncation up to a whole step.
+#[test]
+fn games202_audit_shows_what_8_bits_alone_cost_beside_a_truncated_table() {
+    use kiln::integrate::reference::ReferenceSettings;
+    use kiln::verify::{Against, AuditSettings, audit};
+    let average = BakeOptions {
+        max_error: Some(1e-6),
+        quantities: vec![kiln::Quantity::EAvg],
+        ..Preset::Games202.options()
+    }
+    .bake(&|_| {})
+    .unwrap()
+    .remove(0);
+    let student: Vec<f64> = average
+        .value
+        .iter()
+        .map(|&v| f64::from((v * 255.0) as u8) / 255.0)
+        .collect();
+    let table = Table {
+        one_minus_value: student.iter().map(|v| 1.0 - v).collect(),
+        value: student,
+        ..average.clone()
+    };
+    assert_eq!(table.spec.quantity, kiln::Quantity::EAvg);
+    let report = audit(
+        &table,
+        &Against::Reference(ReferenceSettings::default()),
+        &AuditSettings {
+            storage: Preset::Games202.storage(),
+            ..AuditSettings::default()
+        },
+        &|_| {},
+    );
+    let cost = report.storage_cost.clone().expect("8-bit storage");
+    assert_eq!(cost.storage, "8-bit");
+    let step = 1.0 / 255.0;
+    assert!(cost.node_max_error <= 0.5 * step + 1e-9, "{cost:?}");
+    assert!(cost.node_max_error > 0.4 * step, "{cost:?}");
+    assert!(
+        report.node_max_error > 0.9 * step && report.node_max_error <= step,
+        "{report:?}"
+    );
+    assert!(
+        report.node_rms_error > 1.5 * cost.node_rms_error,
+        "{report:?}"
+    );
+}

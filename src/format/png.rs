@@ -68,3 +68,87 @@ pub fn encode(table: &Table) -> Option<std::result::Result<Vec<u8>, String>> {
     })();
     Some(result.map(|()| bytes).map_err(|e| e.to_string()))
 }
+
+/// An 8-bit RGB image whose three channels hold the same grey level, `round(255 v)` clamped to
+/// [0, 255], of `values` (`width x height`, rows top to bottom): the lookup tables of the
+/// GAMES202 homework. `comment` goes into a `tEXt` chunk.
+pub fn encode_grey8(
+    (width, height): (usize, usize),
+    values: &[f64],
+    comment: &str,
+) -> std::result::Result<Vec<u8>, String> {
+    if values.len() != width * height {
+        return Err(format!(
+            "{} values for a {width} x {height} image",
+            values.len()
+        ));
+    }
+    let pixels: Vec<u8> = values.iter().flat_map(|&v| [unorm8(v); 3]).collect();
+    let mut bytes = Vec::new();
+    let result = (|| {
+        let mut encoder = png::Encoder::new(&mut bytes, width as u32, height as u32);
+        encoder.set_color(png::ColorType::Rgb);
+        encoder.set_depth(png::BitDepth::Eight);
+        encoder.add_text_chunk("Comment".into(), comment.to_string())?;
+        let mut writer = encoder.write_header()?;
+        writer.write_image_data(&pixels)?;
+        writer.finish()
+    })();
+    result.map(|()| bytes).map_err(|e| e.to_string())
+}
+
+/// `v` as an 8-bit unsigned normalised number: `round(255 v)`, clamped to [0, 255] (NaN to 0).
+#[must_use]
+pub fn unorm8(v: f64) -> u8 {
+    (v * 255.0).round().clamp(0.0, 255.0) as u8
+}
+
+/// A PNG image read as grey levels in [0, 1]: its first channel (grey or red), 8 or 16 bits
+/// (fewer bits and palettes expanded to 8), rows top to bottom. Refused before anything is
+/// decoded unless it is `expected` (width, height).
+pub fn decode_grey(
+    bytes: &[u8],
+    expected: (usize, usize),
+) -> std::result::Result<Vec<f64>, String> {
+    let mut decoder = png::Decoder::new(bytes);
+    decoder.set_transformations(png::Transformations::EXPAND);
+    let mut reader = decoder
+        .read_info()
+        .map_err(|e| format!("not a PNG file ({e})"))?;
+    let (width, height) = {
+        let info = reader.info();
+        (info.width as usize, info.height as usize)
+    };
+    if (width, height) != expected {
+        return Err(format!(
+            "a {width} x {height} image (expected {} x {})",
+            expected.0, expected.1
+        ));
+    }
+    let mut buffer = vec![0; reader.output_buffer_size()];
+    let frame = reader
+        .next_frame(&mut buffer)
+        .map_err(|e| format!("a damaged PNG file ({e})"))?;
+    let samples = frame.color_type.samples();
+    let sixteen = frame.bit_depth == png::BitDepth::Sixteen;
+    let bytes_per_sample = if sixteen { 2 } else { 1 };
+    let stride = samples * bytes_per_sample;
+    let data = &buffer[..frame.buffer_size()];
+    let mut values = Vec::with_capacity(width * height);
+    for row in data.chunks_exact(frame.line_size).take(height) {
+        for pixel in row.chunks_exact(stride).take(width) {
+            values.push(if sixteen {
+                f64::from(u16::from_be_bytes([pixel[0], pixel[1]])) / 65535.0
+            } else {
+                f64::from(pixel[0]) / 255.0
+            });
+        }
+    }
+    if values.len() != width * height {
+        return Err(format!(
+            "{} pixels decoded of {width} x {height}",
+            values.len()
+        ));
+    }
+    Ok(values)
+}

@@ -177,6 +177,33 @@ pub(super) fn encode(
                 Ok((file.to_string(), bytes))
             })
             .collect(),
+        Container::Png8(files) => files
+            .iter()
+            .map(|&(file, quantity)| {
+                let table = table_of(tables, quantity)?;
+                let plane = if quantity.has_mu() {
+                    Orders { layout, n }.engine(&table.value)
+                } else {
+                    // Each roughness' value along its row, the rows in the layout's order.
+                    let mut plane = vec![0.0; n * n];
+                    for (r, &v) in table.value.iter().enumerate() {
+                        let row = layout.order.index(r, 0, n) / n;
+                        plane[row * n..(row + 1) * n].fill(v);
+                    }
+                    plane
+                };
+                let comment = format!(
+                    "kiln {}: {} of GGX with separable Schlick-GGX masking (k = alpha / 2), \
+                     rounded to 8 bits; regenerate: {}",
+                    crate::format::metadata::KILN_VERSION,
+                    quantity.symbol(),
+                    table.command
+                );
+                let bytes =
+                    crate::format::png::encode_grey8((n, n), &plane, &comment).map_err(invalid)?;
+                Ok((file.to_string(), bytes))
+            })
+            .collect(),
         Container::ThreeModule => {
             let planes = planes(layout, n, tables, extra)?;
             Ok(main(
@@ -439,6 +466,23 @@ pub(super) fn decode(
                 size.1,
                 expected.join(", or ")
             )))
+        }
+        Container::Png8(files) => {
+            let plane = crate::format::png::decode_grey(bytes, (n, n)).map_err(bad)?;
+            // A file whose rows are each one value is the 1-D table's; otherwise the 2-D one's.
+            let rows_are_constant = plane
+                .chunks_exact(n)
+                .all(|row| row.iter().all(|&v| v == row[0]));
+            let one_d = files.iter().find(|(_, q)| !q.has_mu());
+            let two_d = files.iter().find(|(_, q)| q.has_mu());
+            match (rows_are_constant, one_d, two_d) {
+                (true, Some(&(_, quantity)), _) => {
+                    let values = (0..n).map(|r| plane[layout.order.index(r, 0, n)]).collect();
+                    Ok((vec![(quantity, values)], None))
+                }
+                (_, _, Some(&(_, quantity))) => Ok((vec![(quantity, orders.kiln(&plane))], None)),
+                _ => Err(bad("no table of this layout fits the image".to_string())),
+            }
         }
         Container::ThreeModule => {
             let bits = three_data(bytes).map_err(bad)?;

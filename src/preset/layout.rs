@@ -2,7 +2,7 @@
 //! (size, grid, `mu` mapping, masking, tables), where each texel sits in the engine's array
 //! ([`TexelOrder`]), what each channel of its texture holds ([`Channel`]), how the engine stores
 //! the numbers ([`Stored`]) and in what file ([`Container`]). The code that reads and writes the
-//! files is per container, not per engine ([`super::container`]); only the text formats that no
+//! files is per container, not per engine (`container.rs`); only the text formats that no
 //! other engine shares (Cycles' C arrays, three.js' module, Filament's include) have their own.
 //! The sources of each layout (engines' files and commits) are in `docs/engines.md`.
 
@@ -84,6 +84,8 @@ pub enum Stored {
     F32,
     /// IEEE half precision, nearest ([`crate::format::f16`]).
     F16,
+    /// 8-bit unsigned normalised, `round(255 v) / 255` ([`crate::format::png::unorm8`]).
+    Unorm8,
 }
 
 impl Stored {
@@ -93,6 +95,17 @@ impl Stored {
         match self {
             Stored::F32 => f64::from(value as f32),
             Stored::F16 => crate::format::f16::stored(value),
+            Stored::Unorm8 => f64::from(crate::format::png::unorm8(value)) / 255.0,
+        }
+    }
+
+    /// What the storage is called in reports.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Stored::F32 => "f32",
+            Stored::F16 => "f16",
+            Stored::Unorm8 => "8-bit",
         }
     }
 }
@@ -119,6 +132,10 @@ pub enum Container {
     /// Filament's `dfg.inc`: the channels' half-float bits interleaved as C hex literals, four
     /// texels per line, to be included inside an array.
     HalfBitsInclude,
+    /// One 8-bit grey PNG image (R = G = B) per table, `(file, quantity)`, all `n x n`: a 2-D
+    /// table in the layout's [`TexelOrder`], a 1-D table (by roughness) repeated along each of
+    /// its rows (the GAMES202 homework's `GGX_E_LUT.png` and `GGX_Eavg_LUT.png`).
+    Png8(&'static [(&'static str, Quantity)]),
 }
 
 /// How an engine that normalises its multiple-scattering lobe by `E_avg` gets kiln's
@@ -326,6 +343,28 @@ pub const UNREAL: Layout = Layout {
     channels: &[Table(E), Table(EBias), Constant(0.0), Constant(1.0)],
     stored: Stored::F16,
     container: Container::ExrPlanes,
+    extra: None,
+    normalisation: None,
+    engine_computed_from: 0.0,
+};
+
+/// The Kulla-Conty homework of the GAMES202 course (assignment 4): `GGX_E_LUT.png` and
+/// `GGX_Eavg_LUT.png`, 128 x 128 8-bit grey, row `i` at roughness `(i + 0.5) / 128` and column
+/// `j` at `NdotV = (j + 0.5) / 128`, written flipped so that the roughest row is on top; GGX with
+/// separable Schlick-GGX masking, `k = alpha / 2`. The homework's renderer samples
+/// `vec2(NdotV, roughness)`.
+pub const GAMES202: Layout = Layout {
+    name: "games202",
+    file_name: "GGX_E_LUT.png",
+    size: 128,
+    grid: Grid::Centers,
+    mu_mapping: MuMapping::Linear,
+    masking: Masking::SchlickGgx,
+    tables: &[E, EAvg],
+    order: TexelOrder::RoughnessRowsFromRough,
+    channels: &[Table(E)],
+    stored: Stored::Unorm8,
+    container: Container::Png8(&[("GGX_E_LUT.png", E), ("GGX_Eavg_LUT.png", EAvg)]),
     extra: None,
     normalisation: None,
     engine_computed_from: 0.0,

@@ -4,7 +4,7 @@
 //!
 //! Each engine is one declarative [`Layout`] ([`layout`]: size, grid, `mu` mapping, masking,
 //! tables, texel order, channels, storage, container); the files are written and read per
-//! container ([`container`]), so adding an engine is one `Layout` value, one arm of
+//! container (`container.rs`), so adding an engine is one `Layout` value, one arm of
 //! [`Preset::layout`] and a test.
 //!
 //! Conventions (`docs/engines.md`, with the engines' source files and commits):
@@ -81,11 +81,15 @@ pub enum Preset {
     UnityHdrp,
     /// Unreal Engine 5: E and E*Fc, 32 x 32, centres, half RGBA EXR.
     Unreal,
+    /// The GAMES202 Kulla-Conty homework: GGX_E_LUT.png and GGX_Eavg_LUT.png, 128 x 128 8-bit
+    /// grey, roughest row on top, Schlick-GGX k = alpha/2.
+    #[cfg_attr(feature = "cli", value(name = "games202"))]
+    Games202,
 }
 
 impl Preset {
     /// Every preset.
-    pub const ALL: [Preset; 8] = [
+    pub const ALL: [Preset; 9] = [
         Preset::Cycles,
         Preset::Bevy,
         Preset::Three,
@@ -94,6 +98,7 @@ impl Preset {
         Preset::Godot,
         Preset::UnityHdrp,
         Preset::Unreal,
+        Preset::Games202,
     ];
 
     /// The absolute tolerance of the cloth channel's quadrature (Filament, Godot): well below
@@ -112,7 +117,24 @@ impl Preset {
             Preset::Godot => &layout::GODOT,
             Preset::UnityHdrp => &layout::UNITY_HDRP,
             Preset::Unreal => &layout::UNREAL,
+            Preset::Games202 => &layout::GAMES202,
         }
+    }
+
+    /// How the engine's file stores its numbers, for an audit to show what that alone costs
+    /// (half floats, 8 bits); `None` for f32, whose cost is below anything an audit reports.
+    #[must_use]
+    pub fn storage(self) -> Option<crate::verify::Storage> {
+        let stored = self.layout().stored;
+        let round: fn(f64) -> f64 = match stored {
+            layout::Stored::F32 => return None,
+            layout::Stored::F16 => crate::format::f16::stored,
+            layout::Stored::Unorm8 => |v| f64::from(crate::format::png::unorm8(v)) / 255.0,
+        };
+        Some(crate::verify::Storage {
+            name: stored.name(),
+            round,
+        })
     }
 
     /// The name on the command line.

@@ -39,6 +39,9 @@ pub struct AuditSettings {
     pub clamp_min: f64,
     /// Lookup points per texel along each axis (the axis ends are always included).
     pub density: usize,
+    /// How the audited file stores its numbers, when that costs accuracy worth showing (an
+    /// 8-bit image): the report then says what the storage alone costs ([`StorageCost`]).
+    pub storage: Option<Storage>,
 }
 
 impl Default for AuditSettings {
@@ -46,8 +49,31 @@ impl Default for AuditSettings {
         Self {
             clamp_min: 0.0,
             density: 2,
+            storage: None,
         }
     }
+}
+
+/// A way of storing numbers: its name and what it makes of a value.
+#[derive(Clone, Copy, Debug)]
+pub struct Storage {
+    /// `8-bit`, say.
+    pub name: &'static str,
+    /// A value as stored, widened back.
+    pub round: fn(f64) -> f64,
+}
+
+/// What storing the truth itself would cost: the table of the true node values as the storage
+/// holds them, audited at the same points against the same truth (no new reference values).
+/// The floor of any table kept in that storage, to read beside the measured errors.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct StorageCost {
+    /// The storage's name.
+    pub storage: String,
+    pub node_max_error: f64,
+    pub node_rms_error: f64,
+    pub lookup_max_error: f64,
+    pub lookup_rms_error: f64,
 }
 
 /// One compared point.
@@ -102,6 +128,9 @@ pub struct Report {
     pub reference_error_estimate: f64,
     /// Whether every reference quadrature met its tolerance.
     pub reference_converged: bool,
+    /// What the file's storage alone costs ([`AuditSettings::storage`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub storage_cost: Option<StorageCost>,
 }
 
 /// The reference value of `spec`'s quantity at `(alpha, mu)` and, for the tables with an IOR
@@ -392,6 +421,9 @@ pub fn audit(
     }
     let lookup_group = measure(&lookups, true);
 
+    let storage_cost = settings
+        .storage
+        .map(|storage| storage_cost(table, storage, &node_group, &lookup_group, &lookups));
     let all = node_group.points.iter().chain(&lookup_group.points);
     let reference_error_estimate = crate::stats::max_or_nan(all.clone().map(|p| p.1));
     let reference_converged = all.clone().all(|p| p.2);
@@ -428,6 +460,58 @@ pub fn audit(
         worst_lookup,
         reference_error_estimate,
         reference_converged,
+        storage_cost,
+    }
+}
+
+/// [`StorageCost`]: the true node values as `storage` holds them, compared with the truth at the
+/// nodes and, through the table's own lookup, at the lookup points.
+fn storage_cost(
+    table: &Table,
+    storage: Storage,
+    nodes: &Measured,
+    lookups: &Measured,
+    lookup_points: &[(Coordinates, f64)],
+) -> StorageCost {
+    let stored: Vec<f64> = nodes
+        .points
+        .iter()
+        .map(|p| (storage.round)(p.0.reference))
+        .collect();
+    let truth = Table {
+        one_minus_value: stored.iter().map(|v| 1.0 - v).collect(),
+        value: stored,
+        ..table.clone()
+    };
+    let convention = table.spec.roughness_convention();
+    let rms = |errors: &[f64]| {
+        (errors.iter().map(|e| e * e).sum::<f64>() / errors.len().max(1) as f64).sqrt()
+    };
+    let node_errors: Vec<f64> = nodes
+        .points
+        .iter()
+        .zip(&truth.value)
+        .map(|(p, v)| (v - p.0.reference).abs())
+        .collect();
+    let lookup_errors: Vec<f64> = lookups
+        .points
+        .iter()
+        .zip(lookup_points)
+        .map(|(p, (at, _))| {
+            let value = truth.lookup_eta(
+                at.mu.unwrap_or(1.0),
+                convention.from_alpha(at.alpha),
+                at.eta.unwrap_or(1.0),
+            );
+            (value - p.0.reference).abs()
+        })
+        .collect();
+    StorageCost {
+        storage: storage.name.to_string(),
+        node_max_error: crate::stats::max_or_nan(node_errors.iter().copied()),
+        node_rms_error: rms(&node_errors),
+        lookup_max_error: crate::stats::max_or_nan(lookup_errors.iter().copied()),
+        lookup_rms_error: rms(&lookup_errors),
     }
 }
 

@@ -102,11 +102,12 @@ pub struct BakeArgs {
     /// Bake an engine's table in that engine's own layout, to drop in for its file: cycles
     /// (shader.tables: table_ggx_E, table_ggx_Eavg), bevy (dfg.ktx2, RG16F scale/bias, 64 x 64,
     /// zstd), three (DFGLUTData.js as three ships it, 16 x 16 transposed half bits),
-    /// enterprise-pbr (GGX_E.exr and GGX_E_avg.exr, half channel Y), filament (dfg.inc, 128 x 128 RGB16F half bits, cloth in
-    /// B), godot (dfg_lut.dds, RGBA16F, rows at 1 - r, Schlick-GGX), unity-hdrp
-    /// (preIntegratedFGD_GGXDisneyDiffuse.exr, 64 x 64, sqrt(NoV) nodes, Disney diffuse in B) or
-    /// unreal (ShadingEnergyGGXSpec.exr, 32 x 32, R = E, G = E*Fc); with kiln's JSON sidecars
-    /// of the tables it holds. --max-error and --out apply.
+    /// enterprise-pbr (GGX_E.exr and GGX_E_avg.exr, half channel Y), filament (dfg.inc, 128 x
+    /// 128 RGB16F half bits, cloth in B), godot (dfg_lut.dds, RGBA16F, rows at 1 - r,
+    /// Schlick-GGX), unity-hdrp (preIntegratedFGD_GGXDisneyDiffuse.exr, 64 x 64, sqrt(NoV)
+    /// nodes, Disney diffuse in B), unreal (ShadingEnergyGGXSpec.exr, 32 x 32, R = E, G = E*Fc)
+    /// or games202 (GGX_E_LUT.png and GGX_Eavg_LUT.png for the GAMES202 Kulla-Conty homework,
+    /// 128 x 128 8-bit grey, rounded); with kiln's JSON sidecars of the tables it holds. --max-error and --out apply.
     #[arg(
         long,
         value_enum,

@@ -57,9 +57,11 @@ pub struct VerifyArgs {
     /// FILE is an engine's own table in that engine's layout (cycles: shader.tables with
     /// table_ggx_E and table_ggx_Eavg; bevy: dfg.ktx2, zstd or not; three: the DFG LUT's
     /// Uint16Array; enterprise-pbr: GGX_E.exr or GGX_E_avg.exr; filament: dfg.inc, RGB or RG
-    /// half bits; godot: dfg_lut.dds; unity-hdrp and unreal: their EXR): audit each of its
-    /// tables against the reference for the model the engine evaluates (GGX, height-correlated;
-    /// Godot: separable Schlick-GGX); a blue channel (Filament's and Godot's cloth, HDRP's
+    /// half bits; godot: dfg_lut.dds; unity-hdrp and unreal: their EXR; games202:
+    /// GGX_E_LUT.png or GGX_Eavg_LUT.png, told apart by their rows): audit each of its tables
+    /// against the reference for the model the engine evaluates (GGX, height-correlated; Godot
+    /// and GAMES202: separable Schlick-GGX), with what half-float or 8-bit storage alone costs
+    /// beside the measured error; a blue channel (Filament's and Godot's cloth, HDRP's
     /// Disney diffuse) is compared with kiln's values at its texels (node errors only).
     #[arg(long, value_enum, conflicts_with_all = ["furnace", "shape", "channel", "dtype",
         "order", "grid", "roughness_axis", "mu_axis", "ndf", "masking", "quantity"])]
@@ -429,6 +431,7 @@ fn run_furnace(args: &VerifyArgs, table: &Table) -> kiln::Result<bool> {
             let settings = AuditSettings {
                 clamp_min: args.clamp_min.unwrap_or(0.0),
                 density: args.density as usize,
+                storage: None,
             };
             let bar = crate::progress_bar(
                 args.quiet || args.json,
@@ -609,7 +612,7 @@ pub fn run(args: VerifyArgs) -> kiln::Result<bool> {
                     })?;
                 normalisation_audit(args, table, &e, &e_path)?
             } else {
-                audit_one(args, table)?
+                audit_one(args, table, preset.storage())?
             };
         }
         if let Some(audit) = preset.audit_extra(&bytes).map_err(in_file)? {
@@ -624,7 +627,7 @@ pub fn run(args: VerifyArgs) -> kiln::Result<bool> {
     if table.spec.quantity == Quantity::FMsNorm && args.against == "reference" {
         return run_normalisation_audit(&args, &table);
     }
-    audit_one(&args, &table)
+    audit_one(&args, &table, None)
 }
 
 /// Audits an `f_ms_norm` table against the average of its E table's lookup (the E table beside
@@ -750,8 +753,13 @@ fn audit_extra(args: &VerifyArgs, audit: &kiln::preset::ExtraAudit) -> bool {
     passed
 }
 
-/// Audits one table and prints the report; whether it passed `--max-error`.
-fn audit_one(args: &VerifyArgs, table: &Table) -> kiln::Result<bool> {
+/// Audits one table and prints the report; whether it passed `--max-error`. `storage`: how the
+/// file stores its numbers, to show what that alone costs.
+fn audit_one(
+    args: &VerifyArgs,
+    table: &Table,
+    storage: Option<kiln::verify::Storage>,
+) -> kiln::Result<bool> {
     let other;
     let against = if args.against == "reference" {
         Against::Reference(ReferenceSettings::default())
@@ -771,6 +779,7 @@ fn audit_one(args: &VerifyArgs, table: &Table) -> kiln::Result<bool> {
     let settings = AuditSettings {
         clamp_min: args.clamp_min.unwrap_or(0.0),
         density: args.density as usize,
+        storage,
     };
     let bar = crate::progress_bar(args.quiet || args.json, 0, "verifying");
     let report = audit(table, &against, &settings, &|step| match step {
@@ -823,6 +832,17 @@ fn audit_one(args: &VerifyArgs, table: &Table) -> kiln::Result<bool> {
             report.lookup_p99_error,
             describe(&report.worst_lookup, &report.roughness_axis)
         );
+        if let Some(cost) = &report.storage_cost {
+            println!(
+                "  the true values in {} (the best this file can be): nodes max {:.2e}, rms {:.2e}; \
+                 lookups max {:.2e}, rms {:.2e}",
+                cost.storage,
+                cost.node_max_error,
+                cost.node_rms_error,
+                cost.lookup_max_error,
+                cost.lookup_rms_error
+            );
+        }
         if report.node_reference_tolerance > 0.0 {
             println!(
                 "  reference tolerance {:.0e} at the nodes, {:.0e} at the lookups (a hundredth of \
