@@ -512,6 +512,68 @@ fn furnace_plot_draws_each_form() {
     assert!(!bad.exists());
 }
 
+/// `--plot` without `--furnace` draws the audit's error maps: an engine file audited with
+/// `--preset` gives one picture per table (its quantity in the name), each naming its groups and
+/// their worst error; a PNG is a PNG; a plot that is neither is refused before any work.
+#[test]
+fn plot_draws_where_a_table_is_wrong() {
+    let three =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/engines/three/DFGLUTData-16.js");
+    let dir = tempfile::tempdir().unwrap();
+    let svg = dir.path().join("three.svg");
+    let output = kiln(&[
+        "verify",
+        "--preset",
+        "three",
+        three.to_str().unwrap(),
+        "--plot",
+        svg.to_str().unwrap(),
+        "--quiet",
+        "--density",
+        "1",
+    ]);
+    assert_eq!(
+        output.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    for quantity in ["E_scale", "E_bias"] {
+        let text = std::fs::read_to_string(dir.path().join(format!("three-{quantity}.svg")))
+            .unwrap_or_else(|e| panic!("{quantity}: {e}"));
+        assert!(text.starts_with("<svg"), "{quantity}");
+        assert!(text.contains("nodes: max") && text.contains("lookups: max"));
+    }
+    // three's scale is 1.42e-2 off at its worst node.
+    let text = std::fs::read_to_string(dir.path().join("three-E_scale.svg")).unwrap();
+    assert!(text.contains("nodes: max 1.42e-2"), "{text}");
+    assert!(!svg.exists());
+    let average =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("tables/ggx-height-correlated-E_avg.json");
+    let png = dir.path().join("average.png");
+    let output = kiln(&[
+        "verify",
+        average.to_str().unwrap(),
+        "--plot",
+        png.to_str().unwrap(),
+        "--quiet",
+        "--against",
+        average.to_str().unwrap(),
+    ]);
+    assert_eq!(output.status.code(), Some(0));
+    assert!(std::fs::read(&png).unwrap().starts_with(b"\x89PNG"));
+    let bad = dir.path().join("plot.jpg");
+    let output = kiln(&[
+        "verify",
+        average.to_str().unwrap(),
+        "--plot",
+        bad.to_str().unwrap(),
+    ]);
+    assert_eq!(output.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&output.stderr).contains(".svg or .png"));
+    assert!(!bad.exists());
+}
+
 /// The furnace of glass: Turquin's `1 / E` form on an `E_dielectric` table, its worst point
 /// with its IOR; at least the audit's absolute lookup error (E <= 1 in the energy convention).
 /// The Kulla-Conty lobe of glass is refused with a reason.

@@ -311,3 +311,149 @@ where
     root.present()?;
     Ok(())
 }
+
+/// The audit's error maps side by side (nodes, lookups): for a 2-D table a heat map over the
+/// table's texture coordinates (`mu`'s across, roughness up), colour by log10 of the error from
+/// dark (the panel's smallest, or a millionth of its largest) to bright (its largest), empty cells
+/// white, NaN magenta, the worst point ringed; for a 1-D table the error against roughness on a
+/// log axis.
+pub fn error_map_plot(
+    title: &str,
+    maps: &[kiln::verify::ErrorMap],
+) -> Result<(String, Vec<u8>), String> {
+    register_font();
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
+        error_panels(&root, title, maps).map_err(|e| e.to_string())?;
+    }
+    let mut pixels = vec![255u8; (SIZE.0 * SIZE.1 * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut pixels, SIZE).into_drawing_area();
+        error_panels(&root, title, maps).map_err(|e| e.to_string())?;
+    }
+    Ok((svg, png_of(&pixels)?))
+}
+
+/// Viridis at `s` in [0, 1] (van der Walt and Smith), from nine stops.
+fn viridis(s: f64) -> RGBColor {
+    const STOPS: [[f64; 3]; 9] = [
+        [68.0, 1.0, 84.0],
+        [71.0, 44.0, 122.0],
+        [59.0, 81.0, 139.0],
+        [44.0, 113.0, 142.0],
+        [33.0, 144.0, 141.0],
+        [39.0, 173.0, 129.0],
+        [92.0, 200.0, 99.0],
+        [170.0, 220.0, 50.0],
+        [253.0, 231.0, 37.0],
+    ];
+    let x = s.clamp(0.0, 1.0) * 8.0;
+    let i = (x.floor() as usize).min(7);
+    let f = x - i as f64;
+    let c = |k: usize| (STOPS[i][k] * (1.0 - f) + STOPS[i + 1][k] * f).round() as u8;
+    RGBColor(c(0), c(1), c(2))
+}
+
+fn error_panels<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    title: &str,
+    maps: &[kiln::verify::ErrorMap],
+) -> Result<(), Box<dyn std::error::Error>>
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE)?;
+    let root = root.titled(title, ("sans-serif", 20))?;
+    let panels = root.split_evenly((1, maps.len().max(1)));
+    for (panel, map) in panels.iter().zip(maps) {
+        let finite = || {
+            map.cells
+                .iter()
+                .flatten()
+                .copied()
+                .filter(|e| e.is_finite() && *e > 0.0)
+        };
+        let hi = finite().fold(0.0_f64, f64::max);
+        let lo = finite().fold(f64::INFINITY, f64::min).max(hi * 1e-6);
+        let (x, y, worst) = map.worst;
+        let slice = map
+            .eta
+            .map(|eta| format!(", slice eta = {eta:.4}"))
+            .unwrap_or_default();
+        if map.rows > 1 {
+            let caption = format!(
+                "{}: max {worst:.2e}{slice}; colour log10 error {lo:.0e} to {hi:.0e}",
+                map.group
+            );
+            let mut chart = ChartBuilder::on(panel)
+                .caption(caption, ("sans-serif", 15))
+                .margin(12)
+                .x_label_area_size(40)
+                .y_label_area_size(50)
+                .build_cartesian_2d(0.0..1.0, 0.0..1.0)?;
+            chart
+                .configure_mesh()
+                .disable_mesh()
+                .x_desc(map.x_axis.as_str())
+                .y_desc(map.y_axis.as_str())
+                .draw()?;
+            let (dx, dy) = (1.0 / map.columns as f64, 1.0 / map.rows as f64);
+            let span = (hi / lo).log10().max(1e-12);
+            chart.draw_series(map.cells.iter().enumerate().filter_map(|(k, cell)| {
+                let e = (*cell)?;
+                let colour = if e.is_nan() {
+                    RGBColor(255, 0, 255)
+                } else if e <= 0.0 {
+                    viridis(0.0)
+                } else {
+                    viridis((e / lo).log10() / span)
+                };
+                let (i, j) = ((k % map.columns) as f64, (k / map.columns) as f64);
+                Some(Rectangle::new(
+                    [(i * dx, j * dy), ((i + 1.0) * dx, (j + 1.0) * dy)],
+                    colour.filled(),
+                ))
+            }))?;
+            chart.draw_series(std::iter::once(Circle::new((x, y), 9, RED.stroke_width(2))))?;
+        } else {
+            let caption = format!("{}: max {worst:.2e}{slice}", map.group);
+            let points: Vec<(f64, f64)> = map
+                .cells
+                .iter()
+                .enumerate()
+                .filter_map(|(k, cell)| {
+                    let e = (*cell)?;
+                    (e > 0.0 && e.is_finite()).then_some(((k as f64 + 0.5) / map.columns as f64, e))
+                })
+                .collect();
+            let mut chart = ChartBuilder::on(panel)
+                .caption(caption, ("sans-serif", 15))
+                .margin(12)
+                .x_label_area_size(40)
+                .y_label_area_size(60)
+                .build_cartesian_2d(0.0..1.0, log_range(points.iter().map(|p| p.1)).log_scale())?;
+            chart
+                .configure_mesh()
+                .x_desc(map.x_axis.as_str())
+                .y_desc("error")
+                .y_label_formatter(&|v| format!("{v:.0e}"))
+                .draw()?;
+            chart.draw_series(LineSeries::new(points.clone(), COLOURS[5].stroke_width(2)))?;
+            chart.draw_series(
+                points
+                    .iter()
+                    .map(|&p| Circle::new(p, 3, COLOURS[5].filled())),
+            )?;
+            if worst > 0.0 && worst.is_finite() {
+                chart.draw_series(std::iter::once(Circle::new(
+                    (x, worst),
+                    9,
+                    RED.stroke_width(2),
+                )))?;
+            }
+        }
+    }
+    root.present()?;
+    Ok(())
+}

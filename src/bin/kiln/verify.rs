@@ -44,9 +44,12 @@ pub struct VerifyArgs {
     /// With --furnace: the compensation forms to check, comma-separated [default: both].
     #[arg(long, value_enum, value_delimiter = ',', requires = "furnace")]
     form: Option<Vec<kiln::verify::furnace::Form>>,
-    /// With --furnace: also draw the deviation of each form over (mu, r) as heat maps, the worst
-    /// point ringed, into this .svg or .png file.
-    #[arg(long, requires = "furnace")]
+    /// Draw where the table is wrong into this .svg or .png file: the node and the lookup error
+    /// over the table's axes (heat maps on a log colour scale, or error against roughness for
+    /// E_avg; for a table with an IOR axis, the slice of the worst point), the worst point
+    /// ringed. With --furnace: the deviation of each form over (mu, r) instead. With --preset
+    /// and several tables, one file per table, its quantity added to the name (plot-E_bias.svg).
+    #[arg(long)]
     plot: Option<PathBuf>,
     /// The E_avg table for --furnace (default: beside FILE).
     #[arg(long, requires = "furnace")]
@@ -369,19 +372,7 @@ fn run_furnace(args: &VerifyArgs, table: &Table) -> kiln::Result<bool> {
             vec![Form::KullaConty, Form::Turquin]
         }
     });
-    let plot_kind = match &args.plot {
-        Some(path) => match path.extension().and_then(|e| e.to_str()) {
-            Some("svg") => Some(true),
-            Some("png") => Some(false),
-            _ => {
-                return Err(kiln::Error::InvalidInput(format!(
-                    "--plot {}: give a .svg or .png file",
-                    path.display()
-                )));
-            }
-        },
-        None => None,
-    };
+    let plot_kind = plot_kind(args)?;
     let normalisation = match forms.contains(&Form::KullaConty) {
         true => {
             let average_path = match &args.average {
@@ -598,8 +589,19 @@ pub fn run(args: VerifyArgs) -> kiln::Result<bool> {
             clamp_min: args.clamp_min.or(Some(preset.computed_from(&bytes))),
             ..args.clone()
         };
+        plot_kind(args)?;
+        let several = tables.len() > 1;
         let mut passed = true;
         for table in &tables {
+            let args = &VerifyArgs {
+                plot: args
+                    .plot
+                    .as_ref()
+                    .filter(|_| several)
+                    .map(|path| plot_for(path, table))
+                    .or_else(|| args.plot.clone()),
+                ..args.clone()
+            };
             passed &= if table.spec.quantity == Quantity::FMsNorm {
                 let e_path = args.file.with_file_name(preset.file_name());
                 let e_bytes = kiln::format::read_file(&e_path)?;
@@ -620,6 +622,7 @@ pub fn run(args: VerifyArgs) -> kiln::Result<bool> {
         }
         return Ok(passed);
     }
+    plot_kind(&args)?;
     let table = args.load(&args.file)?;
     if args.furnace {
         return run_furnace(&args, &table);
@@ -753,6 +756,55 @@ fn audit_extra(args: &VerifyArgs, audit: &kiln::preset::ExtraAudit) -> bool {
     passed
 }
 
+/// `plot.svg` for one of several tables: `plot-QUANTITY.svg`.
+fn plot_for(path: &Path, table: &Table) -> PathBuf {
+    let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("plot");
+    let extension = path.extension().and_then(|e| e.to_str()).unwrap_or("svg");
+    path.with_file_name(format!(
+        "{stem}-{}.{extension}",
+        table.spec.quantity.symbol()
+    ))
+}
+
+/// Whether `--plot` asks for SVG (true) or PNG (false); `None` without it.
+fn plot_kind(args: &VerifyArgs) -> kiln::Result<Option<bool>> {
+    match &args.plot {
+        Some(path) => match path.extension().and_then(|e| e.to_str()) {
+            Some("svg") => Ok(Some(true)),
+            Some("png") => Ok(Some(false)),
+            _ => Err(kiln::Error::InvalidInput(format!(
+                "--plot {}: give a .svg or .png file",
+                path.display()
+            ))),
+        },
+        None => Ok(None),
+    }
+}
+
+/// Writes the error maps of an audit to `path` (SVG or PNG by its extension).
+fn write_error_maps(path: &Path, table: &Table, report: &kiln::verify::Report) -> kiln::Result<()> {
+    let svg = path.extension().and_then(|e| e.to_str()) == Some("svg");
+    let maps = kiln::verify::error_maps(&table.spec, report);
+    let title = format!(
+        "{}: error against {} (ringed: the worst point)",
+        table.spec.id(),
+        report.against
+    );
+    let (text, png) =
+        crate::plot::error_map_plot(&title, &maps).map_err(|message| kiln::Error::Format {
+            path: path.to_path_buf(),
+            message,
+        })?;
+    let bytes = if svg { text.into_bytes() } else { png };
+    let dir = path.parent().filter(|p| !p.as_os_str().is_empty());
+    let name = path
+        .file_name()
+        .and_then(|n| n.to_str())
+        .unwrap_or("errors.svg");
+    kiln::format::write_files(dir.unwrap_or(Path::new(".")), &[(name.to_string(), bytes)])?;
+    Ok(())
+}
+
 /// Audits one table and prints the report; whether it passed `--max-error`. `storage`: how the
 /// file stores its numbers, to show what that alone costs.
 fn audit_one(
@@ -787,6 +839,9 @@ fn audit_one(
         Progress::Compared => bar.inc(1),
     });
     bar.finish_and_clear();
+    if let Some(path) = &args.plot {
+        write_error_maps(path, table, &report)?;
+    }
     let passed = args
         .max_error
         .is_none_or(|bound| report.node_max_error <= bound);
