@@ -21,7 +21,9 @@ const VIRIDIS: [[f64; 3]; 9] = [
     [253.0, 231.0, 37.0],
 ];
 
-fn colour(t: f64) -> [u8; 3] {
+/// Viridis at `t` in [0, 1] (clamped), as 8-bit RGB.
+#[must_use]
+pub fn viridis(t: f64) -> [u8; 3] {
     let x = t.clamp(0.0, 1.0) * 8.0;
     let i = (x.floor() as usize).min(7);
     let f = x - i as f64;
@@ -47,7 +49,7 @@ pub fn encode(table: &Table) -> Option<std::result::Result<Vec<u8>, String>> {
     for y in 0..height {
         for x in 0..width {
             let v = table.value[(y / SCALE) * columns + x / SCALE];
-            pixels.extend_from_slice(&colour((v - lo) / span));
+            pixels.extend_from_slice(&viridis((v - lo) / span));
         }
     }
     let mut bytes = Vec::new();

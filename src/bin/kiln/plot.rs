@@ -335,24 +335,10 @@ pub fn error_map_plot(
     Ok((svg, png_of(&pixels)?))
 }
 
-/// Viridis at `s` in [0, 1] (van der Walt and Smith), from nine stops.
+/// Viridis at `s` in [0, 1] ([`kiln::format::png::viridis`]).
 fn viridis(s: f64) -> RGBColor {
-    const STOPS: [[f64; 3]; 9] = [
-        [68.0, 1.0, 84.0],
-        [71.0, 44.0, 122.0],
-        [59.0, 81.0, 139.0],
-        [44.0, 113.0, 142.0],
-        [33.0, 144.0, 141.0],
-        [39.0, 173.0, 129.0],
-        [92.0, 200.0, 99.0],
-        [170.0, 220.0, 50.0],
-        [253.0, 231.0, 37.0],
-    ];
-    let x = s.clamp(0.0, 1.0) * 8.0;
-    let i = (x.floor() as usize).min(7);
-    let f = x - i as f64;
-    let c = |k: usize| (STOPS[i][k] * (1.0 - f) + STOPS[i + 1][k] * f).round() as u8;
-    RGBColor(c(0), c(1), c(2))
+    let [r, g, b] = kiln::format::png::viridis(s);
+    RGBColor(r, g, b)
 }
 
 fn error_panels<DB: DrawingBackend>(

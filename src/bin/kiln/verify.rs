@@ -404,18 +404,7 @@ fn run_furnace(args: &VerifyArgs, table: &Table) -> kiln::Result<bool> {
              colour from 1e-1)",
             table.spec.id()
         );
-        let (text, png) =
-            crate::plot::furnace_plot(&title, &maps).map_err(|message| kiln::Error::Format {
-                path: path.clone(),
-                message,
-            })?;
-        let bytes = if svg { text.into_bytes() } else { png };
-        let dir = path.parent().filter(|p| !p.as_os_str().is_empty());
-        let name = path
-            .file_name()
-            .and_then(|n| n.to_str())
-            .unwrap_or("furnace.png");
-        kiln::format::write_files(dir.unwrap_or(Path::new(".")), &[(name.to_string(), bytes)])?;
+        write_plot(path, svg, crate::plot::furnace_plot(&title, &maps))?;
     }
     let turquin_report = match forms.contains(&Form::Turquin) {
         true => {
@@ -790,17 +779,25 @@ fn write_error_maps(path: &Path, table: &Table, report: &kiln::verify::Report) -
         table.spec.id(),
         report.against
     );
-    let (text, png) =
-        crate::plot::error_map_plot(&title, &maps).map_err(|message| kiln::Error::Format {
-            path: path.to_path_buf(),
-            message,
-        })?;
+    write_plot(path, svg, crate::plot::error_map_plot(&title, &maps))
+}
+
+/// Writes a plot drawn as `(SVG text, PNG bytes)` to `path`, the SVG if `svg`.
+fn write_plot(
+    path: &Path,
+    svg: bool,
+    drawn: Result<(String, Vec<u8>), String>,
+) -> kiln::Result<()> {
+    let (text, png) = drawn.map_err(|message| kiln::Error::Format {
+        path: path.to_path_buf(),
+        message,
+    })?;
     let bytes = if svg { text.into_bytes() } else { png };
     let dir = path.parent().filter(|p| !p.as_os_str().is_empty());
     let name = path
         .file_name()
         .and_then(|n| n.to_str())
-        .unwrap_or("errors.svg");
+        .unwrap_or("plot.svg");
     kiln::format::write_files(dir.unwrap_or(Path::new(".")), &[(name.to_string(), bytes)])?;
     Ok(())
 }
