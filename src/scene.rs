@@ -27,11 +27,19 @@
 //! roughness = 0.1
 //! fresnel = { dielectric = { ior = 1.5 } }
 //! transmission = true           # glass: light refracts through (needs a dielectric fresnel)
+//! image_based_lighting = true   # the split-sum tables (default false)
+//! multiple_scattering = true    # Kulla-Conty's tables (the default)
 //! ```
 //!
-//! The plan ([`Scene::plan`]) lists each table once, with the materials that need it: `E`,
-//! `E_avg` and `f_ms_norm` for every NDF and masking combination in use (the Kulla-Conty lobe needs them, whatever
-//! the Fresnel model), for the combinations a transmissive material uses the dielectric tables
+//! `[output] preset = "filament"` writes that engine's own files instead ([`Preset`]): its
+//! tables in its layout, and a channel whose effect no material asks for (`sheen = true` for
+//! Filament's and Godot's cloth albedo) not computed.
+//!
+//! The plan ([`Scene::plan`]) lists each table once, with the materials and effects that need
+//! it: `E`, `E_avg` and `f_ms_norm` for every NDF and masking combination whose materials ask
+//! for multiple scattering (the Kulla-Conty lobe needs them, whatever the Fresnel model), the
+//! split-sum scale and bias for image-based lighting, for the combinations a transmissive
+//! material uses the dielectric tables
 //! `E_dielectric`, `E_dielectric_inside` and their averages over (eta, roughness[, mu]) (energy
 //! compensation of glass, [`crate::model::dielectric`]), and per material the scalars it needs:
 //! `F_avg` per channel ([`crate::Fresnel::average`]) for the lobe's colour term.
@@ -44,6 +52,8 @@ use crate::error::{Error, Result};
 use crate::format::{Format, Precision};
 use crate::model::fresnel::Rgb;
 use crate::model::{Fresnel, Masking, Model, Ndf};
+use crate::preset::Preset;
+pub use crate::preset::layout::Effect;
 use crate::table::Quantity;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -85,6 +95,10 @@ pub struct Output {
     pub precision: Option<Precision>,
     /// The max error to bake to (default [`crate::BakeOptions::DEFAULT_MAX_ERROR`]).
     pub max_error: Option<f64>,
+    /// An engine whose own files to write instead of kiln's ([`crate::preset::Preset`]): the
+    /// scene's tables are then the engine's, in its layout, and channels no material asks for
+    /// are not computed.
+    pub preset: Option<crate::preset::Preset>,
 }
 
 /// One material.
@@ -102,6 +116,21 @@ pub struct Material {
     /// dielectric tables. Needs a dielectric Fresnel.
     #[serde(default)]
     pub transmission: bool,
+    /// Whether the renderer compensates the energy single scattering loses (Kulla-Conty: `E`,
+    /// `E_avg`, `f_ms_norm`). On unless turned off.
+    #[serde(default = "on")]
+    pub multiple_scattering: bool,
+    /// Whether the material is lit by environment maps through the split sum (scale and bias).
+    #[serde(default, alias = "ibl")]
+    pub image_based_lighting: bool,
+    /// Whether the material has a cloth sheen (the Charlie/Ashikhmin albedo; an engine preset
+    /// whose texture holds it: filament, godot).
+    #[serde(default)]
+    pub sheen: bool,
+}
+
+fn on() -> bool {
+    true
 }
 
 impl Material {
@@ -112,6 +141,26 @@ impl Material {
             ndf: self.ndf,
             masking: self.masking,
         }
+    }
+
+    /// The effects the material asks for, in a fixed order.
+    #[must_use]
+    pub fn effects(&self) -> Vec<Effect> {
+        [
+            (self.multiple_scattering, Effect::MultipleScattering),
+            (self.image_based_lighting, Effect::ImageBasedLighting),
+            (self.sheen, Effect::Sheen),
+            (self.transmission, Effect::Transmission),
+        ]
+        .into_iter()
+        .filter_map(|(asked, effect)| asked.then_some(effect))
+        .collect()
+    }
+
+    /// Whether the material asks for `effect`.
+    #[must_use]
+    pub fn asks(&self, effect: Effect) -> bool {
+        self.effects().contains(&effect)
     }
 }
 
@@ -310,6 +359,16 @@ impl Scene {
                 )));
             }
         }
+        if let Some(preset) = self.preset() {
+            self.validate_for(preset).map_err(bad)?;
+        } else if let Some(m) = self.materials.iter().find(|m| m.sheen) {
+            return Err(bad(format!(
+                "material '{}': sheen = true needs an engine whose texture holds the cloth \
+                 albedo: name it in [output] (preset = \"filament\" or \"godot\"); kiln's own \
+                 layout has no sheen table",
+                m.name
+            )));
+        }
         if let Some(x) = self.output.as_ref().and_then(|o| o.max_error)
             && !(crate::BakeOptions::MIN_MAX_ERROR..=0.5).contains(&x)
         {
@@ -321,15 +380,88 @@ impl Scene {
         Ok(())
     }
 
+    /// The engine the scene writes for, if `[output]` names one.
+    #[must_use]
+    pub fn preset(&self) -> Option<Preset> {
+        self.output.as_ref().and_then(|o| o.preset)
+    }
+
+    /// What a scene that names `preset` may ask: the engine's own format (no `formats` or
+    /// `precision`), materials of the model the engine evaluates, and only effects its layout
+    /// serves.
+    fn validate_for(&self, preset: Preset) -> std::result::Result<(), String> {
+        let layout = preset.layout();
+        if let Some(output) = &self.output
+            && (output.formats.is_some() || output.precision.is_some())
+        {
+            return Err(format!(
+                "[output] names preset {}, which writes the engine's own files ({}): formats \
+                 and precision do not apply; remove them",
+                layout.name, layout.file_name
+            ));
+        }
+        let engine_model = Model {
+            ndf: Ndf::Ggx,
+            masking: layout.masking,
+        };
+        let sheen_in_layout = layout.extra.and_then(|e| e.effect()) == Some(Effect::Sheen);
+        for m in &self.materials {
+            if m.model() != engine_model {
+                return Err(format!(
+                    "material '{}' is {} {}, but {} evaluates {} {}: the engine's tables would \
+                     not be this material's; change its ndf and masking or the preset",
+                    m.name,
+                    m.ndf.name(),
+                    m.masking.name(),
+                    layout.name,
+                    engine_model.ndf.name(),
+                    engine_model.masking.name()
+                ));
+            }
+            if m.transmission {
+                return Err(format!(
+                    "material '{}': transmission = true, but kiln does not write {}'s glass \
+                     tables; bake the dielectric tables in kiln's own layout (a scene without \
+                     a preset)",
+                    m.name, layout.name
+                ));
+            }
+            if m.sheen && !sheen_in_layout {
+                return Err(format!(
+                    "material '{}': sheen = true, but {}'s layout has no cloth channel (filament \
+                     and godot have one)",
+                    m.name, layout.name
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The materials that ask for any of `effects`, by name.
+    fn asking(&self, model: Option<Model>, effects: &[Effect]) -> Vec<String> {
+        self.materials
+            .iter()
+            .filter(|m| model.is_none_or(|model| m.model() == model))
+            .filter(|m| effects.iter().any(|&e| m.asks(e)))
+            .map(|m| m.name.clone())
+            .collect()
+    }
+
     /// The NDF and masking combinations in use, in order of first appearance.
     #[must_use]
     pub fn models(&self) -> Vec<Model> {
+        self.models_asking(None)
+    }
+
+    /// The combinations whose materials ask for `effect` (any effect for `None`), in order of
+    /// first appearance.
+    fn models_asking(&self, effect: Option<Effect>) -> Vec<Model> {
         let mut models: Vec<Model> = Vec::new();
         for m in &self.materials {
-            let model = m.model();
-            if !models.contains(&model) {
-                models.push(model);
+            if effect.is_some_and(|e| !m.asks(e)) || models.contains(&m.model()) {
+                continue;
             }
+            models.push(m.model());
         }
         models
     }
@@ -337,13 +469,79 @@ impl Scene {
     /// The combinations a transmissive material uses, in order of first appearance.
     #[must_use]
     pub fn transmissive_models(&self) -> Vec<Model> {
-        let mut models: Vec<Model> = Vec::new();
-        for m in self.materials.iter().filter(|m| m.transmission) {
-            if !models.contains(&m.model()) {
-                models.push(m.model());
+        self.models_asking(Some(Effect::Transmission))
+    }
+
+    /// Each bake the scene needs with the effect it serves and its model (`None` for an
+    /// engine's tables, which serve the layout's effects): in kiln's layout, per NDF and
+    /// masking combination, `E`, `E_avg` and `f_ms_norm` for multiple scattering, the
+    /// split-sum scale and bias for image-based lighting, the dielectric tables for
+    /// transmission (each a bake of its own, so that one's options never change another's
+    /// cache keys); with a preset, the engine's tables.
+    fn needs(&self) -> Vec<(crate::BakeOptions, Option<Effect>, Model)> {
+        let max_error = self
+            .output
+            .as_ref()
+            .and_then(|o| o.max_error)
+            .unwrap_or(crate::BakeOptions::DEFAULT_MAX_ERROR);
+        if let Some(preset) = self.preset() {
+            if self.materials.is_empty() {
+                return Vec::new();
+            }
+            let options = crate::BakeOptions {
+                max_error: Some(max_error),
+                ..preset.options()
+            };
+            let model = Model {
+                ndf: Ndf::Ggx,
+                masking: preset.layout().masking,
+            };
+            return vec![(options, None, model)];
+        }
+        let ior_max = self.ior_max();
+        let mut needs = Vec::new();
+        for model in self.models() {
+            let base = crate::BakeOptions {
+                ndfs: vec![model.ndf],
+                maskings: vec![model.masking],
+                max_error: Some(max_error),
+                ..crate::BakeOptions::default()
+            };
+            let asked = |effect| self.models_asking(Some(effect)).contains(&model);
+            if asked(Effect::MultipleScattering) {
+                needs.push((base.clone(), Some(Effect::MultipleScattering), model));
+            }
+            if asked(Effect::ImageBasedLighting) {
+                let split_sum = crate::BakeOptions {
+                    quantities: vec![Quantity::EScale, Quantity::EBias],
+                    ..base.clone()
+                };
+                needs.push((split_sum, Some(Effect::ImageBasedLighting), model));
+            }
+            if asked(Effect::Transmission) {
+                let glass = crate::BakeOptions {
+                    quantities: DIELECTRIC_QUANTITIES.to_vec(),
+                    size: DIELECTRIC_SIZE,
+                    ior_size: DIELECTRIC_SIZE,
+                    ior_max,
+                    ..base.clone()
+                };
+                needs.push((glass, Some(Effect::Transmission), model));
             }
         }
-        models
+        needs
+    }
+
+    /// Whether the engine's extra channel is computed: always for one no effect gates (HDRP's
+    /// diffuse albedo), otherwise when a material asks for its effect (Filament's and Godot's
+    /// cloth albedo for sheen).
+    fn computes_extra(&self, preset: Preset) -> bool {
+        match preset.layout().extra {
+            Some(extra) => extra
+                .effect()
+                .is_none_or(|effect| self.materials.iter().any(|m| m.asks(effect))),
+            None => false,
+        }
     }
 
     /// The top of the dielectric tables' IOR axis: 3, or the scene's highest
@@ -360,49 +558,46 @@ impl Scene {
             .fold(crate::BakeOptions::DEFAULT_IOR_MAX, f64::max)
     }
 
-    /// The minimal set of tables the scene needs and the scalars of each material.
+    /// The minimal set of tables the scene needs and the scalars of each material: each table
+    /// once, with the materials and the effects that need it; with a preset, the engine's files
+    /// and what each of their channels holds, for which materials, and whether it is computed.
     #[must_use]
     pub fn plan(&self) -> Plan {
-        let specs: Vec<crate::TableSpec> = self
-            .bake_options()
-            .iter()
-            .flat_map(|options| options.resolved().specs())
-            .collect();
-        let spec_of = |model: Model, quantity: Quantity| {
-            specs
-                .iter()
-                .find(|spec| spec.model == model && spec.quantity == quantity)
-        };
-        let planned = |model: Model, quantity, glass_only: bool| PlannedTable {
-            ndf: model.ndf,
-            masking: model.masking,
-            quantity,
-            id: spec_of(model, quantity).map_or_else(String::new, crate::TableSpec::id),
-            estimated_core_seconds: spec_of(model, quantity)
-                .map_or(0.0, crate::bake::estimated_core_seconds),
-            materials: self
-                .materials
-                .iter()
-                .filter(|m| m.model() == model && (m.transmission || !glass_only))
-                .map(|m| m.name.clone())
-                .collect(),
-        };
-        let transmissive = self.transmissive_models();
-        let tables = self
-            .models()
-            .into_iter()
-            .flat_map(|model| {
-                let mut tables = vec![
-                    planned(model, Quantity::E, false),
-                    planned(model, Quantity::EAvg, false),
-                    planned(model, Quantity::FMsNorm, false),
-                ];
-                if transmissive.contains(&model) {
-                    tables.extend(DIELECTRIC_QUANTITIES.map(|q| planned(model, q, true)));
-                }
-                tables
-            })
-            .collect();
+        let mut tables = Vec::new();
+        for (options, effect, model) in self.needs() {
+            let effects: Vec<Effect> = match effect {
+                Some(effect) => vec![effect],
+                None => self
+                    .preset()
+                    .map(|p| p.layout().effects.to_vec())
+                    .unwrap_or_default()
+                    .into_iter()
+                    .filter(|&e| self.materials.iter().any(|m| m.asks(e)))
+                    .collect(),
+            };
+            let materials = match effect {
+                Some(effect) => self.asking(Some(model), &[effect]),
+                None => self.asking(
+                    Some(model),
+                    self.preset().map_or(&[][..], |p| p.layout().effects),
+                ),
+            };
+            for spec in options.resolved().specs() {
+                tables.push(PlannedTable {
+                    ndf: model.ndf,
+                    masking: model.masking,
+                    quantity: spec.quantity,
+                    materials: materials.clone(),
+                    effects: effects.clone(),
+                    id: spec.id(),
+                    estimated_core_seconds: crate::bake::estimated_core_seconds(&spec),
+                });
+            }
+        }
+        let engine = self
+            .preset()
+            .filter(|_| !self.materials.is_empty())
+            .map(|preset| self.planned_engine(preset, &tables));
         let materials = self
             .materials
             .iter()
@@ -415,11 +610,77 @@ impl Scene {
                     roughness: m.roughness.range(),
                     fresnel: fresnel.name().to_string(),
                     transmission: m.transmission,
+                    effects: m.effects(),
                     f_avg: fresnel.average(),
                 }
             })
             .collect();
-        Plan { tables, materials }
+        Plan {
+            tables,
+            materials,
+            engine,
+        }
+    }
+
+    /// The engine's files and channels for [`Scene::plan`].
+    fn planned_engine(&self, preset: Preset, tables: &[PlannedTable]) -> PlannedEngine {
+        use crate::preset::layout::{Channel, Container};
+        let layout = preset.layout();
+        let of_table = |name: String, q: Quantity| {
+            let planned = tables.iter().find(|t| t.quantity == q);
+            PlannedChannel {
+                name,
+                holds: q.symbol().to_string(),
+                effects: planned.map(|t| t.effects.clone()).unwrap_or_default(),
+                materials: planned.map(|t| t.materials.clone()).unwrap_or_default(),
+                computed: true,
+            }
+        };
+        let mut channels: Vec<PlannedChannel> = match layout.container {
+            Container::CycleTables(parts)
+            | Container::ExrPerTable(parts)
+            | Container::Png8(parts) => parts
+                .iter()
+                .map(|&(name, q)| of_table(name.to_string(), q))
+                .collect(),
+            _ => layout
+                .channels
+                .iter()
+                .zip(["R", "G", "B", "A"])
+                .map(|(channel, name)| match *channel {
+                    Channel::Table(q) => of_table(name.to_string(), q),
+                    Channel::Extra => {
+                        let extra = layout.extra.expect("a layout with an extra channel");
+                        let effects: Vec<Effect> = extra.effect().into_iter().collect();
+                        PlannedChannel {
+                            name: name.to_string(),
+                            holds: extra.description().to_string(),
+                            materials: match extra.effect() {
+                                Some(e) => self.asking(None, &[e]),
+                                None => self.asking(None, layout.effects),
+                            },
+                            effects,
+                            computed: self.computes_extra(preset),
+                        }
+                    }
+                    Channel::Constant(c) => PlannedChannel {
+                        name: name.to_string(),
+                        holds: format!("{c}"),
+                        effects: Vec::new(),
+                        materials: Vec::new(),
+                        computed: false,
+                    },
+                })
+                .collect(),
+        };
+        if let Some(form) = layout.normalisation {
+            channels.push(of_table(form.file().to_string(), Quantity::FMsNorm));
+        }
+        PlannedEngine {
+            preset: layout.name.to_string(),
+            file: layout.file_name.to_string(),
+            channels,
+        }
     }
 }
 
@@ -450,36 +711,12 @@ impl Scene {
         }
     }
 
-    /// The bake options of each NDF and masking combination in the plan, in plan order: its
-    /// `E` and `E_avg`, then (a bake of their own, so that their options never change the `E`
-    /// tables' cache keys) its dielectric tables if a transmissive material uses it.
+    /// The bakes the plan needs, in plan order ([`Scene::plan`]).
     #[must_use]
     pub fn bake_options(&self) -> Vec<crate::BakeOptions> {
-        let max_error = self
-            .output
-            .as_ref()
-            .and_then(|o| o.max_error)
-            .unwrap_or(crate::BakeOptions::DEFAULT_MAX_ERROR);
-        let transmissive = self.transmissive_models();
-        let ior_max = self.ior_max();
-        self.models()
+        self.needs()
             .into_iter()
-            .flat_map(|model| {
-                let base = crate::BakeOptions {
-                    ndfs: vec![model.ndf],
-                    maskings: vec![model.masking],
-                    max_error: Some(max_error),
-                    ..crate::BakeOptions::default()
-                };
-                let glass = transmissive.contains(&model).then(|| crate::BakeOptions {
-                    quantities: DIELECTRIC_QUANTITIES.to_vec(),
-                    size: DIELECTRIC_SIZE,
-                    ior_size: DIELECTRIC_SIZE,
-                    ior_max,
-                    ..base.clone()
-                });
-                std::iter::once(base).chain(glass)
-            })
+            .map(|(options, ..)| options)
             .collect()
     }
 
@@ -496,6 +733,9 @@ impl Scene {
         replace: crate::format::replace::Replace,
     ) -> Result<SceneBake> {
         crate::format::check_output_dir(dir)?;
+        if let Some(preset) = self.preset() {
+            return self.bake_for(preset, dir, progress);
+        }
         let output = self.output.clone().unwrap_or_default();
         let formats = output.formats.unwrap_or_else(|| Format::ALL.to_vec());
         let precision = output.precision.unwrap_or(Precision::F32);
@@ -506,6 +746,24 @@ impl Scene {
             .flat_map(|options| options.resolved().specs())
             .collect();
         crate::format::replace::precheck(dir, &specs, &formats, replace)?;
+        let report = self.bake_cached(dir, progress)?;
+        let mut files = crate::format::encode_all(&report.tables, &formats, precision)?;
+        if !self.materials.is_empty() {
+            files.push((
+                MATERIALS_FILE.to_string(),
+                self.materials_document(&report.tables),
+            ));
+        }
+        let written = crate::format::write_table_files(dir, &report.tables, &files, replace)?;
+        Ok(SceneBake { report, written })
+    }
+
+    /// Every bake of the plan through the cache in `dir/.kiln-cache`, in plan order.
+    fn bake_cached(
+        &self,
+        dir: &Path,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> Result<crate::bake::BakeReport> {
         let cache = crate::cache::Cache::new(&dir.join(".kiln-cache"));
         let mut report = crate::bake::BakeReport::default();
         for options in self.bake_options() {
@@ -515,14 +773,35 @@ impl Scene {
             report.reused.extend(part.reused);
             report.repaired.extend(part.repaired);
         }
-        let mut files = crate::format::encode_all(&report.tables, &formats, precision)?;
-        if !self.materials.is_empty() {
-            files.push((
-                MATERIALS_FILE.to_string(),
-                self.materials_document(&report.tables),
-            ));
+        Ok(report)
+    }
+
+    /// [`Scene::bake`] for a scene that names an engine: its tables through the cache, its own
+    /// files (the extra channel computed only if a material asks for it), kiln's sidecars and
+    /// the materials file.
+    fn bake_for(
+        &self,
+        preset: Preset,
+        dir: &Path,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> Result<SceneBake> {
+        let report = self.bake_cached(dir, progress)?;
+        if report.tables.is_empty() {
+            return Ok(SceneBake {
+                report,
+                written: Vec::new(),
+            });
         }
-        let written = crate::format::write_table_files(dir, &report.tables, &files, replace)?;
+        let extra = self
+            .computes_extra(preset)
+            .then(|| preset.extra_channel())
+            .flatten();
+        let mut files = preset.files_with_sidecars(&report.tables, extra.as_ref())?;
+        files.push((
+            MATERIALS_FILE.to_string(),
+            self.materials_document(&report.tables),
+        ));
+        let written = crate::format::write_files(dir, &files)?;
         Ok(SceneBake { report, written })
     }
 
@@ -586,6 +865,33 @@ impl Scene {
 pub struct Plan {
     pub tables: Vec<PlannedTable>,
     pub materials: Vec<PlannedMaterial>,
+    /// The engine's files and channels, for a scene that names a preset.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub engine: Option<PlannedEngine>,
+}
+
+/// The engine a scene writes for: its file and what each channel (or array, or file) holds.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct PlannedEngine {
+    pub preset: String,
+    /// The engine's (first) file.
+    pub file: String,
+    pub channels: Vec<PlannedChannel>,
+}
+
+/// One channel of an engine's texture (R, G, B, A), or one array or file of it.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct PlannedChannel {
+    pub name: String,
+    /// The quantity or value it holds.
+    pub holds: String,
+    /// The effects that need it.
+    pub effects: Vec<Effect>,
+    /// The materials that need it.
+    pub materials: Vec<String>,
+    /// Whether kiln computes it (a channel no material asks for is written as 0; a constant is
+    /// written as itself).
+    pub computed: bool,
 }
 
 /// One table of the plan and the materials that need it.
@@ -595,6 +901,8 @@ pub struct PlannedTable {
     pub masking: Masking,
     pub quantity: Quantity,
     pub materials: Vec<String>,
+    /// The effects the materials need it for.
+    pub effects: Vec<Effect>,
     /// The file-name stem the bake writes it under ([`crate::TableSpec::id`]).
     pub id: String,
     /// The estimated cost of baking it, in seconds of one core
@@ -623,6 +931,8 @@ pub struct PlannedMaterial {
     pub fresnel: String,
     /// Whether light refracts through it (it then uses the dielectric tables).
     pub transmission: bool,
+    /// The effects it asks for.
+    pub effects: Vec<Effect>,
     /// `F_avg` per channel, for the Kulla-Conty colour term
     /// ([`crate::model::kulla_conty::fresnel_colour`]).
     pub f_avg: Rgb,
@@ -744,6 +1054,127 @@ fresnel = { schlick = { f0 = 0.04 } }
         assert_eq!(plan.tables.len(), 3);
         assert_eq!(plan.tables[1].materials, ["a", "b"]);
         assert_eq!(plan.materials[0].f_avg, [1.0; 3]);
+    }
+
+    /// Each effect brings its tables and only those: multiple scattering E, E_avg and
+    /// f_ms_norm; image-based lighting the split-sum pair; a material that turns multiple
+    /// scattering off brings none of its tables.
+    #[test]
+    fn effects_decide_the_tables() {
+        let scene = Scene::parse(
+            "[[material]]\nname = \"env\"\nndf = \"ggx\"\nroughness = 0.3\n\
+             image_based_lighting = true\nmultiple_scattering = false\n\n\
+             [[material]]\nname = \"lobe\"\nndf = \"ggx\"\nroughness = 0.5\n\n\
+             [[material]]\nname = \"flat\"\nndf = \"beckmann\"\nroughness = 0.5\n\
+             multiple_scattering = false\n",
+            "effects.toml",
+        )
+        .unwrap();
+        let plan = scene.plan();
+        let rows: Vec<(Quantity, Vec<String>, Vec<Effect>)> = plan
+            .tables
+            .iter()
+            .map(|t| (t.quantity, t.materials.clone(), t.effects.clone()))
+            .collect();
+        let ms = vec![Effect::MultipleScattering];
+        let ibl = vec![Effect::ImageBasedLighting];
+        let lobe = vec!["lobe".to_string()];
+        let env = vec!["env".to_string()];
+        assert_eq!(
+            rows,
+            [
+                (Quantity::E, lobe.clone(), ms.clone()),
+                (Quantity::EAvg, lobe.clone(), ms.clone()),
+                (Quantity::FMsNorm, lobe, ms),
+                (Quantity::EScale, env.clone(), ibl.clone()),
+                (Quantity::EBias, env, ibl),
+            ]
+        );
+        assert!(plan.engine.is_none());
+        assert_eq!(plan.materials[2].effects, []);
+        // The bakes: one per effect, the split sum apart from E (its cache keys untouched).
+        let bakes = scene.bake_options();
+        assert_eq!(bakes.len(), 2);
+        assert_eq!(bakes[1].quantities, [Quantity::EScale, Quantity::EBias]);
+    }
+
+    /// A scene that names Filament plans Filament's texture: R and G for image-based lighting
+    /// and multiple scattering, B (the cloth albedo) computed only when a material asks for
+    /// sheen.
+    #[test]
+    fn a_scene_that_names_its_engine_plans_its_channels() {
+        let text = |sheen: bool| {
+            format!(
+                "[output]\npreset = \"filament\"\n\n[[material]]\nname = \"paint\"\n\
+                 ndf = \"ggx\"\nroughness = 0.3\nibl = true\n\n[[material]]\n\
+                 name = \"velvet\"\nndf = \"ggx\"\nroughness = 0.8\nsheen = {sheen}\n"
+            )
+        };
+        let plain = Scene::parse(&text(false), "filament.toml").unwrap().plan();
+        let quantities: Vec<Quantity> = plain.tables.iter().map(|t| t.quantity).collect();
+        assert_eq!(quantities, [Quantity::EBias, Quantity::E]);
+        assert_eq!(
+            plain.tables[0].effects,
+            [Effect::MultipleScattering, Effect::ImageBasedLighting]
+        );
+        let engine = plain.engine.expect("a preset scene plans its engine");
+        assert_eq!(
+            (engine.preset.as_str(), engine.file.as_str()),
+            ("filament", "dfg.inc")
+        );
+        let names: Vec<&str> = engine.channels.iter().map(|c| c.name.as_str()).collect();
+        assert_eq!(names, ["R", "G", "B"]);
+        let blue = &engine.channels[2];
+        assert!(!blue.computed && blue.materials.is_empty(), "{blue:?}");
+        assert_eq!(blue.effects, [Effect::Sheen]);
+        let sheen = Scene::parse(&text(true), "filament.toml").unwrap().plan();
+        let blue = &sheen.engine.expect("engine").channels[2];
+        assert!(blue.computed && blue.materials == ["velvet"], "{blue:?}");
+    }
+
+    /// What a scene cannot ask, each refused with the material, the reason and what to do.
+    #[test]
+    fn effects_an_engine_cannot_serve_are_refused() {
+        let material = "[[material]]\nname = \"m\"\nroughness = 0.3\n";
+        let cases = [
+            (
+                format!("{material}ndf = \"ggx\"\nsheen = true\n"),
+                "preset = \"filament\"",
+            ),
+            (
+                format!("[output]\npreset = \"bevy\"\n{material}ndf = \"beckmann\"\n"),
+                "bevy evaluates ggx height-correlated",
+            ),
+            (
+                format!("[output]\npreset = \"godot\"\n{material}ndf = \"ggx\"\n"),
+                "godot evaluates ggx schlick-ggx",
+            ),
+            (
+                format!("[output]\npreset = \"unreal\"\n{material}ndf = \"ggx\"\nsheen = true\n"),
+                "no cloth channel",
+            ),
+            (
+                format!(
+                    "[output]\npreset = \"cycles\"\n{material}ndf = \"ggx\"\n\
+                     fresnel = {{ dielectric = {{ ior = 1.5 }} }}\ntransmission = true\n"
+                ),
+                "glass",
+            ),
+            (
+                format!(
+                    "[output]\npreset = \"three\"\nformats = [\"exr\"]\n{material}ndf = \"ggx\"\n"
+                ),
+                "formats and precision do not apply",
+            ),
+            (
+                format!("[output]\npreset = \"ogre\"\n{material}ndf = \"ggx\"\n"),
+                "ogre",
+            ),
+        ];
+        for (text, needle) in cases {
+            let error = Scene::parse(&text, "bad.toml").unwrap_err().to_string();
+            assert!(error.contains(needle), "{needle}: {error}");
+        }
     }
 
     #[test]

@@ -179,3 +179,64 @@ fn an_edited_cache_entry_fails_its_digest_and_is_repaired() {
         assert!(third.report.baked.is_empty() && third.report.repaired.is_empty());
     }
 }
+
+/// A scene that names Godot writes Godot's own texture and kiln's sidecars: its blue channel
+/// (the cloth albedo) is computed only when a material asks for sheen, and is then kiln's value
+/// at every texel (as `kiln bake --preset godot` writes it); without sheen it is 0 and the file
+/// reads back with no cloth channel. Adding sheen re-integrates none of the tables.
+#[test]
+fn a_scene_that_names_its_engine_writes_only_what_its_materials_ask_for() {
+    use kiln::preset::Preset;
+    let godot = |sheen: bool| {
+        let text = format!(
+            "[output]\npreset = \"godot\"\nmax_error = 1e-3\n\n[[material]]\nname = \"wool\"\n\
+             ndf = \"ggx\"\nmasking = \"schlick-ggx\"\nroughness = 0.7\nsheen = {sheen}\n"
+        );
+        Scene::parse(&text, "godot.toml").unwrap()
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let plain = godot(false)
+        .bake(dir.path(), &|_| {}, Replace::Refuse)
+        .unwrap();
+    let names: Vec<String> = plain
+        .written
+        .iter()
+        .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(
+        names,
+        [
+            "dfg_lut.dds",
+            "godot-ggx-schlick-ggx-E_bias.json",
+            "godot-ggx-schlick-ggx-E.json",
+            "materials.json"
+        ]
+    );
+    let bytes = std::fs::read(dir.path().join("dfg_lut.dds")).unwrap();
+    assert_eq!(Preset::Godot.decode_extra(&bytes).unwrap(), None);
+    let tables = Preset::Godot.read_tables(&bytes, "dfg_lut.dds").unwrap();
+    assert_eq!(tables.len(), 2);
+
+    let calls = std::sync::atomic::AtomicU64::new(0);
+    let with_sheen = godot(true)
+        .bake(
+            dir.path(),
+            &|n| {
+                calls.fetch_add(n, std::sync::atomic::Ordering::Relaxed);
+            },
+            Replace::Refuse,
+        )
+        .unwrap();
+    assert!(with_sheen.report.baked.is_empty());
+    assert_eq!(calls.into_inner(), 0);
+    let bytes = std::fs::read(dir.path().join("dfg_lut.dds")).unwrap();
+    let cloth = Preset::Godot.decode_extra(&bytes).unwrap().expect("cloth");
+    let kiln_s = Preset::Godot.extra_channel().unwrap();
+    // As stored in half floats (the rounding is tested with the f16 writer).
+    let mismatch = cloth
+        .iter()
+        .zip(&kiln_s.value)
+        .position(|(&stored, &value)| stored != kiln::format::f16::stored(value));
+    assert_eq!(mismatch, None, "the blue channel holds kiln's cloth albedo");
+    assert!(cloth.iter().any(|&v| v > 0.1));
+}

@@ -72,12 +72,12 @@ fn planes(
                     q.symbol().to_string(),
                     orders.engine(&table_of(tables, q)?.value),
                 ),
+                // Not computed (no material asks for its effect): zeros.
                 Channel::Extra => {
-                    let extra = extra.ok_or_else(|| {
-                        Error::InvalidInput(format!("{} has an extra channel", layout.name))
-                    })?;
                     let name = layout.extra.map_or("extra", |e| e.channel_name());
-                    (name.to_string(), orders.engine(&extra.value))
+                    let values =
+                        extra.map_or_else(|| vec![0.0; n * n], |e| orders.engine(&e.value));
+                    (name.to_string(), values)
                 }
                 Channel::Constant(c) => ("A".to_string(), vec![c; n * n]),
             })
@@ -212,9 +212,9 @@ pub(super) fn encode(
         }
         Container::HalfBitsInclude => {
             let planes = planes(layout, n, tables, extra)?;
-            let max_error = extra.map_or(0.0, |e| e.max_error);
             Ok(main(
-                filament_include(n, &planes, max_error, &tables[0].command).into_bytes(),
+                filament_include(n, &planes, extra.map(|e| e.max_error), &tables[0].command)
+                    .into_bytes(),
             ))
         }
     }
@@ -269,7 +269,12 @@ pub(super) fn decode(
                         plane.ok_or_else(|| bad(format!("no channel for {}", q.symbol())))?;
                     tables.push((*q, orders.kiln(plane)));
                 }
-                Channel::Extra => extra = plane.map(|p| orders.kiln(p)),
+                // All zeros: not computed when the file was written (no material asked).
+                Channel::Extra => {
+                    extra = plane
+                        .filter(|p| p.iter().any(|&v| v != 0.0))
+                        .map(|p| orders.kiln(p));
+                }
                 Channel::Constant(_) => {}
             }
         }
@@ -537,20 +542,27 @@ fn half_bits(value: f64) -> u16 {
 }
 
 /// Filament's `dfg.inc` (included inside `DFG_LUT[]`): the planes' half-float bits interleaved
-/// per texel as C hex literals, four texels per line, after a comment saying what they hold.
+/// per texel as C hex literals, four texels per line, after a comment saying what they hold
+/// (`sheen_max_error`: the cloth channel's error estimate, `None` when it was not computed and
+/// holds 0).
 fn filament_include(
     n: usize,
     planes: &[(String, Vec<f64>)],
-    sheen_max_error: f64,
+    sheen_max_error: Option<f64>,
     command: &str,
 ) -> String {
+    let blue = match sheen_max_error {
+        Some(e) => format!(
+            "cloth albedo (Charlie NDF, Ashikhmin visibility), quadrature error estimate <= \
+             {e:.0e}"
+        ),
+        None => "0 (no material asks for sheen: the cloth albedo was not computed)".to_string(),
+    };
     let mut out = format!(
         "// kiln {}: Filament's DFG LUT (dfg.inc), {n} x {n} RGB16F half-float bits in GL \
          order,\n// x = NoV = (i + 0.5) / {n}, y = perceptual roughness = (j + 0.5) / {n} \
          (alpha = r^2), texel centres.\n// R = integral of Fc f mu_i, G = integral of f mu_i \
-         (GGX, height-correlated, F = 1);\n// B = cloth albedo (Charlie NDF, Ashikhmin \
-         visibility), quadrature error estimate <= {sheen_max_error:.0e}.\n// Regenerate: \
-         {command}\n",
+         (GGX, height-correlated, F = 1);\n// B = {blue}.\n// Regenerate: {command}\n",
         crate::format::metadata::KILN_VERSION,
     );
     for k in 0..n * n {

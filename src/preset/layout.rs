@@ -36,6 +36,34 @@ impl TexelOrder {
     }
 }
 
+/// What a material asks of the tables: the effects a renderer computes with them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Effect {
+    /// Kulla-Conty energy compensation of the specular lobe (`E`, `E_avg`, `f_ms_norm`; or an
+    /// engine's `1 / E` scaling from its DFG table).
+    MultipleScattering,
+    /// Image-based lighting by the split sum (scale and bias, an engine's DFG texture).
+    ImageBasedLighting,
+    /// Cloth sheen (the Charlie/Ashikhmin albedo in Filament's and Godot's DFG texture).
+    Sheen,
+    /// Light refracted through a dielectric (the dielectric tables).
+    Transmission,
+}
+
+impl Effect {
+    /// The name in scene files and plans.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Effect::MultipleScattering => "multiple-scattering",
+            Effect::ImageBasedLighting => "image-based-lighting",
+            Effect::Sheen => "sheen",
+            Effect::Transmission => "transmission",
+        }
+    }
+}
+
 /// What one channel of an engine's texture holds.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Channel {
@@ -64,6 +92,16 @@ impl Extra {
         match self {
             Extra::ClothAlbedo => "cloth albedo (Charlie NDF, Ashikhmin visibility)",
             Extra::DisneyDiffuseMinusHalf => "Disney diffuse albedo - 0.5",
+        }
+    }
+
+    /// The effect that needs the channel (`None`: always written, as HDRP's diffuse albedo,
+    /// which its engine uses for every material).
+    #[must_use]
+    pub fn effect(self) -> Option<Effect> {
+        match self {
+            Extra::ClothAlbedo => Some(Effect::Sheen),
+            Extra::DisneyDiffuseMinusHalf => None,
         }
     }
 
@@ -192,6 +230,9 @@ pub struct Layout {
     /// The smallest `mu` and roughness the engine itself computed its file at (its first row
     /// and column stand for this value), for a file kiln did not write: Cycles' 1e-4.
     pub engine_computed_from: f64,
+    /// The effects the engine computes with its tables (its [`Layout::extra`] channel serves
+    /// [`Extra::effect`]).
+    pub effects: &'static [Effect],
 }
 
 /// The file of `f_ms_norm` beside Cycles' `shader.tables`.
@@ -219,6 +260,7 @@ pub const CYCLES: Layout = Layout {
     extra: None,
     normalisation: Some(Normalisation::CycleTable(CYCLES_NORMALISATION_FILE)),
     engine_computed_from: 1e-4,
+    effects: &[Effect::MultipleScattering],
 };
 
 /// Bevy's `dfg.ktx2`.
@@ -237,6 +279,7 @@ pub const BEVY: Layout = Layout {
     extra: None,
     normalisation: None,
     engine_computed_from: 0.0,
+    effects: &[Effect::MultipleScattering, Effect::ImageBasedLighting],
 };
 
 /// three.js' `DFGLUTData.js` (16 x 16 since r182; r181 and before shipped 32 x 32, which
@@ -256,6 +299,7 @@ pub const THREE: Layout = Layout {
     extra: None,
     normalisation: None,
     engine_computed_from: 0.0,
+    effects: &[Effect::MultipleScattering, Effect::ImageBasedLighting],
 };
 
 /// Enterprise PBR's `res/GGX_E.exr` and `res/GGX_E_avg.exr`.
@@ -274,6 +318,7 @@ pub const ENTERPRISE_PBR: Layout = Layout {
     extra: None,
     normalisation: Some(Normalisation::ExrF32(ENTERPRISE_NORMALISATION_FILE)),
     engine_computed_from: 0.0,
+    effects: &[Effect::MultipleScattering],
 };
 
 /// Filament's `dfg.inc` (`cmgen --ibl-dfg-multiscatter --ibl-dfg-cloth`).
@@ -292,6 +337,7 @@ pub const FILAMENT: Layout = Layout {
     extra: Some(Extra::ClothAlbedo),
     normalisation: None,
     engine_computed_from: 0.0,
+    effects: &[Effect::MultipleScattering, Effect::ImageBasedLighting],
 };
 
 /// Godot 4's DFG texture (`integrate_dfg.glsl`), as a DDS to upload in its place.
@@ -310,6 +356,7 @@ pub const GODOT: Layout = Layout {
     extra: Some(Extra::ClothAlbedo),
     normalisation: None,
     engine_computed_from: 0.0,
+    effects: &[Effect::MultipleScattering, Effect::ImageBasedLighting],
 };
 
 /// Unity HDRP's `_PreIntegratedFGD_GGXDisneyDiffuse`, as an EXR to import in its place.
@@ -328,6 +375,7 @@ pub const UNITY_HDRP: Layout = Layout {
     extra: Some(Extra::DisneyDiffuseMinusHalf),
     normalisation: None,
     engine_computed_from: 0.0,
+    effects: &[Effect::MultipleScattering, Effect::ImageBasedLighting],
 };
 
 /// Unreal Engine 5's `ShadingEnergyGGXSpecTexture`, as an EXR to import in its place.
@@ -346,6 +394,7 @@ pub const UNREAL: Layout = Layout {
     extra: None,
     normalisation: None,
     engine_computed_from: 0.0,
+    effects: &[Effect::MultipleScattering, Effect::ImageBasedLighting],
 };
 
 /// The Kulla-Conty homework of the GAMES202 course (assignment 4): `GGX_E_LUT.png` and
@@ -368,4 +417,5 @@ pub const GAMES202: Layout = Layout {
     extra: None,
     normalisation: None,
     engine_computed_from: 0.0,
+    effects: &[Effect::MultipleScattering],
 };

@@ -59,8 +59,9 @@ use crate::table::{Quantity, Table, TableSpec};
 pub use layout::{CYCLES_NORMALISATION_FILE, ENTERPRISE_NORMALISATION_FILE};
 use layout::{Container, Extra, Layout};
 
-/// An engine layout.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// An engine layout (named in scene files as on the command line).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
 #[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum Preset {
     /// Blender Cycles: E and E_avg, 32 x 32 mu-major, nodes, C float arrays.
@@ -84,6 +85,7 @@ pub enum Preset {
     /// The GAMES202 Kulla-Conty homework: GGX_E_LUT.png and GGX_Eavg_LUT.png, 128 x 128 8-bit
     /// grey, roughest row on top, Schlick-GGX k = alpha/2.
     #[cfg_attr(feature = "cli", value(name = "games202"))]
+    #[serde(rename = "games202")]
     Games202,
 }
 
@@ -166,11 +168,40 @@ impl Preset {
     /// caller that reports it.
     pub fn files_and_extra(self, tables: &[Table]) -> Result<(Files, Option<ExtraChannel>)> {
         let extra = self.extra_channel();
-        let mut files = container::encode(self.layout(), tables, extra.as_ref())?;
+        Ok((self.files_with(tables, extra.as_ref())?, extra))
+    }
+
+    /// The preset's files with the given extra channel (`None`: not computed, written as 0).
+    pub fn files_with(self, tables: &[Table], extra: Option<&ExtraChannel>) -> Result<Files> {
+        let mut files = container::encode(self.layout(), tables, extra)?;
         if let Some(file) = self.normalisation_file(tables)? {
             files.push(file);
         }
-        Ok((files, extra))
+        Ok(files)
+    }
+
+    /// What `kiln bake --preset` writes: the engine's files from [`Preset::engine_tables`]
+    /// (with `extra`, see [`Preset::files_with`]) and kiln's JSON sidecar of each table beside
+    /// them ([`Preset::sidecar_name`]), each naming the engine's files it describes.
+    pub fn files_with_sidecars(
+        self,
+        tables: &[Table],
+        extra: Option<&ExtraChannel>,
+    ) -> Result<Files> {
+        let tables = self.engine_tables(tables)?;
+        let mut files = self.files_with(&tables, extra)?;
+        let engine_files: Vec<String> = files.iter().map(|(name, _)| name.clone()).collect();
+        for table in &tables {
+            let described = [(self.name().to_string(), engine_files.join(", "))]
+                .into_iter()
+                .collect();
+            let sidecar = crate::format::json::sidecar(table, "f32", described);
+            let bytes = crate::format::json::encode(&sidecar).map_err(|message| {
+                Error::InvalidInput(format!("{}: {message}", self.sidecar_name(table)))
+            })?;
+            files.push((self.sidecar_name(table), bytes));
+        }
+        Ok(files)
     }
 
     /// The smallest `mu` and roughness the engine computed the file `bytes` at, where its

@@ -387,23 +387,10 @@ fn bake_preset(preset: kiln::preset::Preset, args: &BakeArgs) -> kiln::Result<()
     let start = Instant::now();
     let tables = options.bake(&|samples| bar.inc(samples))?;
     bar.finish_and_clear();
-    // The tables as the engine's files hold them, for the files and the sidecars alike.
-    let tables = preset.engine_tables(&tables)?;
-    let (mut files, extra) = preset.files_and_extra(&tables)?;
-    let engine_files: Vec<String> = files.iter().map(|(name, _)| name.clone()).collect();
-    // kiln's sidecars of the tables the engine file holds, named after the preset (the layout
-    // is the preset's), listing the engine's file(s) they describe.
-    for table in &tables {
-        let described = [(preset.name().to_string(), engine_files.join(", "))]
-            .into_iter()
-            .collect();
-        let sidecar = format::json::sidecar(table, "f32", described);
-        let bytes = format::json::encode(&sidecar).map_err(|message| kiln::Error::Format {
-            path: out.join(preset.sidecar_name(table)),
-            message,
-        })?;
-        files.push((preset.sidecar_name(table), bytes));
-    }
+    // The engine's files and kiln's sidecars of the tables they hold, named after the preset
+    // (the layout is the preset's), listing the engine's file(s) they describe.
+    let extra = preset.extra_channel();
+    let files = preset.files_with_sidecars(&tables, extra.as_ref())?;
     let written = format::write_files(&out, &files)?;
     if !args.quiet {
         for table in &tables {

@@ -8,9 +8,16 @@ use std::path::PathBuf;
 #[derive(Args, Debug)]
 #[command(
     long_about = "Read a scene file (TOML: [output] and [[material]] entries with name, ndf, \
-                  masking, roughness and fresnel; see the README) and print the minimal set of \
-                  tables its materials need, each once with the materials that need it: E and \
-                  E_avg for every NDF and masking combination in use. Per material, the scalars \
+                  masking, roughness and fresnel, and the effects each asks for: \
+                  multiple_scattering (on unless false), image_based_lighting, sheen, \
+                  transmission; see docs/scenes.md) and print the minimal set of tables its \
+                  materials need, each once with the materials and effects that need it: E, \
+                  E_avg and f_ms_norm for multiple scattering, the split-sum scale and bias for \
+                  image-based lighting, the dielectric tables for transmission, per NDF and \
+                  masking combination. With [output] preset = NAME, the engine's own tables in \
+                  its layout instead, and for each channel of its file what it holds, for which \
+                  materials, and whether it is computed (Filament's cloth channel only for a \
+                  sheen material). Per material, the scalars \
                   it needs: F_avg per channel for its Fresnel model (the Kulla-Conty colour \
                   term), which `kiln bake --scene` writes to materials.json. Each table with its \
                   estimated bake time on this machine's threads (a rough figure: seconds or \
@@ -59,28 +66,56 @@ pub fn run(args: PlanArgs) -> kiln::Result<()> {
         crate::human_seconds(total / threads as f64),
         scene.output_dir().join(".kiln-cache").display()
     );
+    let effects = |effects: &[kiln::scene::Effect]| -> String {
+        let names: Vec<&str> = effects.iter().map(|e| e.name()).collect();
+        names.join(", ")
+    };
     for t in &plan.tables {
+        let why = if t.effects.is_empty() {
+            " (the engine's file holds it)".to_string()
+        } else {
+            format!(" ({})", effects(&t.effects))
+        };
         println!(
-            "  {:<46} ~{:>8}  for {}",
+            "  {:<46} ~{:>8}  for {}{why}",
             t.id,
             crate::human_seconds(t.estimated_core_seconds / threads as f64),
             t.materials.join(", ")
         );
     }
+    if let Some(engine) = &plan.engine {
+        println!("  {} layout, {}:", engine.preset, engine.file);
+        for c in &engine.channels {
+            let what = match (c.computed, c.effects.is_empty(), c.materials.is_empty()) {
+                (false, false, _) => format!(
+                    "not computed (written as 0): no material asks for {}",
+                    effects(&c.effects)
+                ),
+                (false, true, _) => "a constant".to_string(),
+                (true, _, true) => "for the engine's file".to_string(),
+                (true, true, false) => format!("for {}", c.materials.join(", ")),
+                (true, false, false) => {
+                    format!("for {} ({})", c.materials.join(", "), effects(&c.effects))
+                }
+            };
+            println!("    {:<4} {}: {what}", c.name, c.holds);
+        }
+    }
     for m in &plan.materials {
         let [r, g, b] = m.f_avg;
         println!(
-            "  material {}: {} {}, roughness {}..{}, fresnel {}{}, F_avg [{r:.6}, {g:.6}, {b:.6}]",
+            "  material {}: {} {}, roughness {}..{}, fresnel {}, asks for {}, F_avg [{r:.6}, \
+             {g:.6}, {b:.6}]",
             m.name,
             m.ndf,
             m.masking,
             m.roughness[0],
             m.roughness[1],
             m.fresnel,
-            if m.transmission {
-                " (transmission)"
+            if m.effects.is_empty() {
+                "nothing".to_string()
             } else {
-                ""
+                effects(&m.effects)
             }
         );
     }
