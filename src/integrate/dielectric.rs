@@ -31,7 +31,7 @@ use super::albedo::{
 use super::estimate::Estimate;
 use super::gauss_kronrod::{integrate, integrate_pieces};
 use super::reference::{ReferenceSettings, ReferenceValue, phi_breaks, x_range};
-use crate::model::dielectric::{refract, scattering};
+use crate::model::dielectric::{TransmissionConvention, refract, scattering_with};
 use crate::model::fresnel::dielectric;
 use crate::model::{
     Beckmann, Ggx, Masking, MicrofacetDistribution, Model, Ndf, SMOOTH_ALPHA, Vec3,
@@ -59,8 +59,31 @@ pub fn dielectric_albedo(
     eta: f64,
     settings: &QmcSettings,
 ) -> Estimate {
+    dielectric_albedo_with(
+        model,
+        alpha,
+        mu,
+        eta,
+        TransmissionConvention::SingleScattering,
+        settings,
+    )
+}
+
+/// [`dielectric_albedo`] in the given convention ([`TransmissionConvention`]).
+///
+/// # Panics
+/// As [`dielectric_albedo`].
+#[must_use]
+pub fn dielectric_albedo_with(
+    model: Model,
+    alpha: f64,
+    mu: f64,
+    eta: f64,
+    convention: TransmissionConvention,
+    settings: &QmcSettings,
+) -> Estimate {
     check(alpha, mu, eta);
-    if alpha == 0.0 && mu > 0.0 {
+    if (alpha == 0.0 && mu > 0.0) || convention.smooth_at(eta) {
         return Estimate::exact(0.0);
     }
     let alpha = alpha.max(SMOOTH_ALPHA);
@@ -76,6 +99,7 @@ pub fn dielectric_albedo(
         masking: Masking,
         mu: f64,
         eta: f64,
+        convention: TransmissionConvention,
         settings: &QmcSettings,
         key: &[u64],
     ) -> Estimate {
@@ -88,14 +112,23 @@ pub fn dielectric_albedo(
                 #[inline(always)]
                 |u: [f64; 2]| {
                     let m = ndf.sample_visible_normal(o, u);
-                    scattering(ndf, masking, o, lambda_o, m, eta).loss
+                    scattering_with(ndf, masking, o, lambda_o, m, eta, convention).loss
                 },
             )
         })
     }
+    let masking = model.masking;
     match model.ndf {
-        Ndf::Ggx => kernel(Ggx { alpha }, model.masking, mu, eta, settings, &key),
-        Ndf::Beckmann => kernel(Beckmann { alpha }, model.masking, mu, eta, settings, &key),
+        Ndf::Ggx => kernel(Ggx { alpha }, masking, mu, eta, convention, settings, &key),
+        Ndf::Beckmann => kernel(
+            Beckmann { alpha },
+            masking,
+            mu,
+            eta,
+            convention,
+            settings,
+            &key,
+        ),
     }
 }
 
@@ -136,7 +169,17 @@ pub fn dielectric_average_albedo(
                 |[u0, u1, s]: [f64; 3]| {
                     let o = Vec3::new((1.0 - s).sqrt(), 0.0, s.sqrt());
                     let m = ndf.sample_visible_normal(o, [u0, u1]);
-                    scattering(ndf, masking, o, ndf.lambda(o), m, eta).loss
+                    let lambda_o = ndf.lambda(o);
+                    scattering_with(
+                        ndf,
+                        masking,
+                        o,
+                        lambda_o,
+                        m,
+                        eta,
+                        TransmissionConvention::SingleScattering,
+                    )
+                    .loss
                 },
             )
         })
@@ -212,14 +255,41 @@ pub fn reference_dielectric_albedo(
     eta: f64,
     settings: &ReferenceSettings,
 ) -> DielectricReference {
+    reference_dielectric_albedo_with(
+        model,
+        alpha,
+        mu,
+        eta,
+        TransmissionConvention::SingleScattering,
+        settings,
+    )
+}
+
+/// [`reference_dielectric_albedo`] in the given convention ([`TransmissionConvention`]).
+#[must_use]
+pub fn reference_dielectric_albedo_with(
+    model: Model,
+    alpha: f64,
+    mu: f64,
+    eta: f64,
+    convention: TransmissionConvention,
+    settings: &ReferenceSettings,
+) -> DielectricReference {
     check(alpha, mu, eta);
-    if alpha == 0.0 && mu > 0.0 {
+    if (alpha == 0.0 && mu > 0.0) || convention.smooth_at(eta) {
         return DielectricReference::exact(mu, eta);
     }
     let alpha = alpha.max(SMOOTH_ALPHA);
     match model.ndf {
-        Ndf::Ggx => quadrature(Ggx { alpha }, model.masking, mu, eta, settings),
-        Ndf::Beckmann => quadrature(Beckmann { alpha }, model.masking, mu, eta, settings),
+        Ndf::Ggx => quadrature(Ggx { alpha }, model.masking, mu, eta, convention, settings),
+        Ndf::Beckmann => quadrature(
+            Beckmann { alpha },
+            model.masking,
+            mu,
+            eta,
+            convention,
+            settings,
+        ),
     }
 }
 
@@ -235,8 +305,26 @@ pub fn reference_dielectric_average_albedo(
     eta: f64,
     settings: &ReferenceSettings,
 ) -> DielectricReference {
+    reference_dielectric_average_albedo_with(
+        model,
+        alpha,
+        eta,
+        TransmissionConvention::SingleScattering,
+        settings,
+    )
+}
+
+/// [`reference_dielectric_average_albedo`] in the given convention ([`TransmissionConvention`]).
+#[must_use]
+pub fn reference_dielectric_average_albedo_with(
+    model: Model,
+    alpha: f64,
+    eta: f64,
+    convention: TransmissionConvention,
+    settings: &ReferenceSettings,
+) -> DielectricReference {
     check(alpha, 0.5, eta);
-    if alpha == 0.0 {
+    if alpha == 0.0 || convention.smooth_at(eta) {
         // Smooth: R_avg = F_avg(eta), T_avg = 1 - F_avg(eta).
         let f_avg = crate::model::Fresnel::Dielectric { eta }.average_report();
         return DielectricReference {
@@ -255,7 +343,7 @@ pub fn reference_dielectric_average_albedo(
     let mut evaluations = 0;
     let mut converged = true;
     let mut integrand = |mu: f64| {
-        let r = reference_dielectric_albedo(model, alpha, mu, eta, &inner);
+        let r = reference_dielectric_albedo_with(model, alpha, mu, eta, convention, &inner);
         evaluations += r.evaluations;
         converged &= r.converged;
         let w = 2.0 * mu;
@@ -302,6 +390,7 @@ fn quadrature<N: MicrofacetDistribution>(
     masking: Masking,
     mu: f64,
     eta: f64,
+    convention: TransmissionConvention,
     settings: &ReferenceSettings,
 ) -> DielectricReference {
     let alpha = ndf.alpha();
@@ -332,7 +421,7 @@ fn quadrature<N: MicrofacetDistribution>(
         // dω_m = sin^2 cos dx dphi in these variables; G1(o) (o.m) D / mu is the visible density.
         let sin_t = t * m.z;
         let density = ndf.d_from_tan2(t * t) * sin_t * sin_t * m.z * om * inverse_area;
-        let s = scattering(ndf, masking, o, lambda_o, m, eta);
+        let s = scattering_with(ndf, masking, o, lambda_o, m, eta, convention);
         [
             density * s.reflection,
             density * s.transmission,

@@ -54,6 +54,49 @@ pub struct Scattering {
     pub loss: f64,
 }
 
+/// Whose dielectric albedo a table holds: single scattering as a BSDF evaluates it (kiln's), or
+/// what Cycles' sampler made of it when it computed Blender's glass tables
+/// (`table_ggx_glass_*` in `shader.tables`), which a table that replaces Blender's must match.
+/// They differ in two places:
+///
+/// - a refracted direction that ends on the incident side of the macrosurface: single
+///   scattering cannot send light through the interface and back to the side it came from, and
+///   the BSDF's evaluation gives it nothing, so kiln counts it as lost; Cycles' sampler (its
+///   hemisphere check commented out) kept it with the weight of any refraction,
+///   `(1 - F) G2(o, i_t) / G1(o)` (`Lambda` of `|cos|`). Blender's `glass_inv_E` differs from
+///   kiln's by up to 0.61 there (grazing views from inside, high roughness);
+/// - an index within 1e-4 of 1 (`|eta - 1| < 1e-4`, Cycles' first IOR node): Cycles treats the
+///   interface as smooth, `E = F + (1 - F) = 1`, where a rough index-matched interface loses
+///   `1 - G2 / G1` (0.3 at `r = 1`, `mu = 0.4`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
+pub enum TransmissionConvention {
+    /// Single scattering as the BSDF evaluates it (kiln's default).
+    #[default]
+    SingleScattering,
+    /// Cycles' sampler, as it computed Blender's glass tables.
+    Cycles,
+}
+
+impl TransmissionConvention {
+    /// Whether a refraction that ends on the incident side is kept.
+    #[must_use]
+    pub fn keeps_refraction_above(self) -> bool {
+        self == TransmissionConvention::Cycles
+    }
+
+    /// Whether the interface is treated as smooth at this relative index whatever the
+    /// roughness (Cycles: `|eta - 1| < 1e-4`).
+    #[must_use]
+    pub fn smooth_at(self, eta: f64) -> bool {
+        self == TransmissionConvention::Cycles && (eta - 1.0).abs() < CYCLES_SINGULAR_ETA
+    }
+}
+
+/// Cycles treats an interface within this of index 1 as smooth (`bsdf_microfacet_sample`).
+pub const CYCLES_SINGULAR_ETA: f64 = 1e-4;
+
 /// Refracts the unit view direction `o` through the unit microfacet normal `m` with
 /// `c = o.m > 0`, into the medium of relative index `eta = n_other / n_view` (Walter 2007,
 /// eq. 40): `i_t = -o / eta + (c / eta - cos_t) m`, `cos_t = sqrt(1 - (1 - c^2) / eta^2)`, so
@@ -75,7 +118,7 @@ pub fn refract(o: Vec3, m: Vec3, c: f64, eta: f64) -> Option<Vec3> {
 }
 
 /// The contributions of the visible microfacet normal `m` for the view `o` (see the module
-/// docs); `lambda_o = Lambda(o)`.
+/// docs); `lambda_o = Lambda(o)`, single scattering ([`TransmissionConvention`]).
 #[must_use]
 #[inline]
 pub fn scattering<N: MicrofacetDistribution>(
@@ -86,6 +129,30 @@ pub fn scattering<N: MicrofacetDistribution>(
     m: Vec3,
     eta: f64,
 ) -> Scattering {
+    scattering_with(
+        ndf,
+        masking,
+        o,
+        lambda_o,
+        m,
+        eta,
+        TransmissionConvention::SingleScattering,
+    )
+}
+
+/// [`scattering`] in the given convention (a refraction that ends on the incident side kept for
+/// Cycles').
+#[must_use]
+#[inline]
+pub fn scattering_with<N: MicrofacetDistribution>(
+    ndf: N,
+    masking: Masking,
+    o: Vec3,
+    lambda_o: f64,
+    m: Vec3,
+    eta: f64,
+    convention: TransmissionConvention,
+) -> Scattering {
     let c = o.dot(m).clamp(0.0, 1.0);
     let fresnel = super::fresnel::dielectric(eta, c);
     let reflection_loss = crate::integrate::albedo::reflection_loss(ndf, masking, o, lambda_o, m);
@@ -94,7 +161,7 @@ pub fn scattering<N: MicrofacetDistribution>(
         // its limit along the view (1/2 height-correlated, 1 separable), not the value at
         // Lambda(o) = infinity with Lambda(i) finite that `Masking::loss` gives.
         _ if eta == 1.0 => masking.loss_index_matched(ndf.alpha(), o.z, lambda_o),
-        Some(i_t) if i_t.z < 0.0 => {
+        Some(i_t) if i_t.z < 0.0 || (convention.keeps_refraction_above() && i_t.z > 0.0) => {
             masking.loss_at(ndf.alpha(), o.z, i_t.z, lambda_o, ndf.lambda(i_t))
         }
         _ => 1.0,

@@ -72,6 +72,12 @@ pub struct EvalArgs {
     /// How to evaluate it.
     #[arg(long, value_enum, default_value = "qmc")]
     method: Method,
+    /// For --quantity e-dielectric|e-avg-dielectric: whose albedo. single-scattering: a
+    /// refraction that ends on the incident side is lost (what the BSDF evaluates; kiln's
+    /// tables); cycles: as Cycles' sampler computed Blender's glass tables (such a refraction
+    /// kept, an index within 1e-4 of 1 treated as smooth).
+    #[arg(long, value_enum, default_value = "single-scattering")]
+    transmission: kiln::model::dielectric::TransmissionConvention,
     /// QMC samples, a power of two (split over the scrambles) [default: 2^19 for e, 2^23 for
     /// e-avg, as `kiln bake` uses].
     #[arg(long, value_parser = parse_samples, allow_negative_numbers = true)]
@@ -396,9 +402,20 @@ fn dielectric(
     mu: Option<f64>,
 ) -> kiln::Result<()> {
     use kiln::integrate::dielectric::{
-        dielectric_albedo, dielectric_average_albedo, reference_dielectric_albedo,
-        reference_dielectric_average_albedo,
+        dielectric_albedo_with, dielectric_average_albedo, reference_dielectric_albedo_with,
+        reference_dielectric_average_albedo_with,
     };
+    use kiln::model::dielectric::TransmissionConvention;
+    let convention = args.transmission;
+    if mu.is_none()
+        && args.method == Method::Qmc
+        && convention != TransmissionConvention::SingleScattering
+    {
+        return Err(kiln::Error::InvalidInput(
+            "--transmission cycles with --quantity e-avg-dielectric needs --method reference"
+                .to_string(),
+        ));
+    }
     let start = Instant::now();
     let (value, one_minus_value, error, samples, converged, parts) = match args.method {
         Method::Qmc => {
@@ -413,7 +430,7 @@ fn dielectric(
             };
             settings.validate().map_err(kiln::Error::InvalidInput)?;
             let e = match mu {
-                Some(mu) => dielectric_albedo(model, alpha, mu, eta, &settings),
+                Some(mu) => dielectric_albedo_with(model, alpha, mu, eta, convention, &settings),
                 None => dielectric_average_albedo(model, alpha, eta, &settings),
             };
             (
@@ -429,11 +446,14 @@ fn dielectric(
             args.no_samples_for_reference()?;
             let settings = ReferenceSettings::default();
             let r = match mu {
-                Some(mu) => reference_dielectric_albedo(model, alpha, mu, eta, &settings),
-                None => reference_dielectric_average_albedo(
+                Some(mu) => {
+                    reference_dielectric_albedo_with(model, alpha, mu, eta, convention, &settings)
+                }
+                None => reference_dielectric_average_albedo_with(
                     model,
                     alpha,
                     eta,
+                    convention,
                     &ReferenceSettings {
                         tolerance: 1e-9,
                         ..settings
@@ -473,6 +493,7 @@ fn dielectric(
             "value": value,
             "one_minus_value": one_minus_value,
             "convention": "energy albedo R + T (sample weight)",
+            "transmission": convention,
             "std_error": error,
             "method": method,
             "samples": samples,
