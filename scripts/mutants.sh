@@ -29,7 +29,9 @@ done
 if [ -n "${SHARD:-}" ]; then
     args+=(--shard "$SHARD")
 fi
-test_args=(--cargo-test-arg=--release)
+# --release for the build and the test alike (a test-only flag builds each mutant twice, in
+# debug and then in release).
+test_args=(--cargo-arg=--release)
 for t in ${TESTS:-}; do
     test_args+=("--cargo-test-arg=$t")
 done
