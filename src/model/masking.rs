@@ -150,6 +150,18 @@ impl std::fmt::Display for Masking {
 mod tests {
     use super::*;
 
+    /// Schlick's `G1` at the horizon: 0 for any rough surface (`mu / (mu (1 - k) + k)` at
+    /// `mu = 0`), 1 for a mirror at every `mu` including the horizon (its limit), and the closed
+    /// form between.
+    #[test]
+    fn schlick_g1_at_the_horizon_and_on_a_mirror() {
+        assert_eq!(Masking::schlick_g1(0.0, 0.5), 0.0);
+        assert_eq!(Masking::schlick_g1(0.0, 0.0), 1.0);
+        assert_eq!(Masking::schlick_g1(0.3, 0.0), 1.0);
+        let (mu, k) = (0.3, 0.25);
+        assert!((Masking::schlick_g1(-mu, 2.0 * k) - mu / (mu * (1.0 - k) + k)).abs() < 1e-16);
+    }
+
     /// At `alpha = 1`, `k = 1/2`: Schlick's `G1 = mu / (mu / 2 + 1/2) = 2 mu / (1 + mu)`, Smith's
     /// GGX `G1 = 1 / (1 + (1 / mu - 1) / 2)`: the same; so the losses agree with separable.
     #[test]

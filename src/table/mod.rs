@@ -677,6 +677,30 @@ mod tests {
     use crate::model::{Masking, Ndf};
     use axis::{Grid, MuMapping};
 
+    /// The fixed E_avg rules' bounds were measured for the Smith forms: a Schlick-GGX table at a
+    /// chosen tolerance takes the adaptive rule, a height-correlated one a fixed rule.
+    #[test]
+    fn fixed_average_rules_serve_the_smith_forms_only() {
+        let spec = |masking| {
+            crate::BakeOptions {
+                quantities: vec![Quantity::EAvg],
+                maskings: vec![masking],
+                max_error: Some(1e-6),
+                ..crate::BakeOptions::default()
+            }
+            .resolved()
+            .specs()
+            .remove(0)
+        };
+        assert!(
+            spec(Masking::HeightCorrelated)
+                .average_rule_order()
+                .is_some()
+        );
+        assert!(spec(Masking::Separable).average_rule_order().is_some());
+        assert_eq!(spec(Masking::SchlickGgx).average_rule_order(), None);
+    }
+
     fn synthetic(grid: Grid, mapping: MuMapping) -> Table {
         let spec = TableSpec {
             reference_digits: None,
