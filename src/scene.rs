@@ -147,20 +147,25 @@ impl Material {
     #[must_use]
     pub fn effects(&self) -> Vec<Effect> {
         [
-            (self.multiple_scattering, Effect::MultipleScattering),
-            (self.image_based_lighting, Effect::ImageBasedLighting),
-            (self.sheen, Effect::Sheen),
-            (self.transmission, Effect::Transmission),
+            Effect::MultipleScattering,
+            Effect::ImageBasedLighting,
+            Effect::Sheen,
+            Effect::Transmission,
         ]
         .into_iter()
-        .filter_map(|(asked, effect)| asked.then_some(effect))
+        .filter(|&effect| self.asks(effect))
         .collect()
     }
 
     /// Whether the material asks for `effect`.
     #[must_use]
     pub fn asks(&self, effect: Effect) -> bool {
-        self.effects().contains(&effect)
+        match effect {
+            Effect::MultipleScattering => self.multiple_scattering,
+            Effect::ImageBasedLighting => self.image_based_lighting,
+            Effect::Sheen => self.sheen,
+            Effect::Transmission => self.transmission,
+        }
     }
 }
 

@@ -130,10 +130,16 @@ impl Stored {
     /// A value as the engine's file holds it, widened back.
     #[must_use]
     pub fn round(self, value: f64) -> f64 {
+        self.rounding()(value)
+    }
+
+    /// [`Stored::round`] as a function.
+    #[must_use]
+    pub fn rounding(self) -> fn(f64) -> f64 {
         match self {
-            Stored::F32 => f64::from(value as f32),
-            Stored::F16 => crate::format::f16::stored(value),
-            Stored::Unorm8 => f64::from(crate::format::png::unorm8(value)) / 255.0,
+            Stored::F32 => |v| f64::from(v as f32),
+            Stored::F16 => crate::format::f16::stored,
+            Stored::Unorm8 => |v| f64::from(crate::format::png::unorm8(v)) / 255.0,
         }
     }
 

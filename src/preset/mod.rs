@@ -128,14 +128,9 @@ impl Preset {
     #[must_use]
     pub fn storage(self) -> Option<crate::verify::Storage> {
         let stored = self.layout().stored;
-        let round: fn(f64) -> f64 = match stored {
-            layout::Stored::F32 => return None,
-            layout::Stored::F16 => crate::format::f16::stored,
-            layout::Stored::Unorm8 => |v| f64::from(crate::format::png::unorm8(v)) / 255.0,
-        };
-        Some(crate::verify::Storage {
+        (stored != layout::Stored::F32).then(|| crate::verify::Storage {
             name: stored.name(),
-            round,
+            round: stored.rounding(),
         })
     }
 
