@@ -28,7 +28,12 @@ fn main() -> kiln::Result<()> {
             .map(|k| {
                 let r = (((k / n) as f64 + 1.5) / n as f64).min(1.0);
                 let mu = ((k % n) as f64 + 0.5) / n as f64;
-                kiln::verify::reference_value(&spec, r * r, Some(mu), None, &settings).value
+                let at = kiln::integrate::value::Point {
+                    alpha: r * r,
+                    mu: Some(mu),
+                    eta: None,
+                };
+                spec.integral().reference(at, &settings).value
             })
             .collect();
     }

@@ -6,15 +6,15 @@
 
 use crate::cache::{Cache, CacheKey};
 use crate::error::{Error, Result};
-use crate::integrate::albedo::weighted_albedo;
 use crate::integrate::average_quadrature::rule_average_albedo;
-use crate::integrate::dielectric::{dielectric_albedo, dielectric_average_albedo};
 use crate::integrate::reference::ReferenceSettings;
-use crate::integrate::{Estimate, QmcSettings, albedo, average_albedo};
+use crate::integrate::value::Point;
+use crate::integrate::{Estimate, QmcSettings};
+use crate::model::dielectric::TransmissionConvention;
 use crate::model::{Masking, Model, Ndf, RoughnessConvention};
 use crate::table::axis::{Axis, Grid, IorBound, IorMapping, MuMapping};
 use crate::table::{Method, Quantity, Table, TableSpec};
-use crate::verify::{MAX_AVERAGE_ENTRIES_CHECKED, reference_value, spread_indices};
+use crate::verify::{MAX_AVERAGE_ENTRIES_CHECKED, spread_indices};
 use rayon::prelude::*;
 
 /// What `kiln bake` bakes: for each model, an `E` table and an `E_avg` table.
@@ -50,6 +50,10 @@ pub struct BakeOptions {
     pub ior_max: f64,
     /// The Fresnel model of the `E_F` tables (a grey one; required with [`Quantity::EF`]).
     pub fresnel: Option<crate::model::Fresnel>,
+    /// How the dielectric tables count a refraction that ends on the incident side
+    /// ([`TransmissionConvention`]; the other tables ignore it).
+    #[serde(default)]
+    pub transmission: TransmissionConvention,
     /// Measure each table's node error against the deterministic reference after baking (only
     /// meaningful for [`Method::Qmc`]).
     pub check_against_reference: bool,
@@ -80,6 +84,7 @@ impl Default for BakeOptions {
             ior_mapping: IorMapping::Cycles,
             ior_max: Self::DEFAULT_IOR_MAX,
             fresnel: None,
+            transmission: TransmissionConvention::SingleScattering,
             check_against_reference: true,
             method: Method::Qmc,
             max_error: Some(Self::DEFAULT_MAX_ERROR),
@@ -126,6 +131,19 @@ impl BakeOptions {
                 "ior-max must be above 1 and at most 100 (got {}): the IOR axis runs over \
                  [1, ior-max], and inside tables use 1 / eta",
                 crate::error::shown(self.ior_max)
+            )));
+        }
+        if !self.transmission.is_default()
+            && !self
+                .quantities()
+                .iter()
+                .any(|q| q.has_ior() && *q != Quantity::FAvg)
+        {
+            return Err(Error::InvalidInput(format!(
+                "transmission {} applies to the dielectric tables only (e-dielectric, \
+                 e-dielectric-inside, e-avg-dielectric, e-avg-dielectric-inside): add one with \
+                 --quantity, or drop --transmission",
+                self.transmission.name()
             )));
         }
         if let Some(x) = self.max_error
@@ -270,7 +288,11 @@ impl BakeOptions {
         let ior = Axis::Ior {
             size: self.ior_size,
             mapping: self.ior_mapping,
-            max: IorBound(self.ior_max),
+            // Blender's axis ends where its clamp puts it, whatever ior_max.
+            max: IorBound(match self.ior_mapping {
+                IorMapping::Blender => IorMapping::Blender.eta(1.0, self.ior_max),
+                _ => self.ior_max,
+            }),
             grid: self.grid,
         };
         let roughness = Axis::Roughness {
@@ -304,6 +326,11 @@ impl BakeOptions {
                         let spec = |quantity: Quantity| TableSpec {
                             reference_digits,
                             lookup_of: None,
+                            transmission: if quantity.has_ior() && quantity != Quantity::FAvg {
+                                self.transmission
+                            } else {
+                                TransmissionConvention::SingleScattering
+                            },
                             model,
                             quantity,
                             ior: quantity.has_ior().then_some(ior),
@@ -649,47 +676,26 @@ pub fn bake_table(spec: TableSpec, command: String, progress: &(dyn Fn(u64) + Sy
     }
 }
 
-/// The estimate of one texel (row-major index, slowest axis first).
+/// The estimate of one texel (row-major index, slowest axis first): the spec's integral
+/// ([`TableSpec::integral`]) at the texel's point by the spec's method
+/// ([`crate::integrate::value`]); with [`Method::Reference`] at a chosen tolerance, `E_avg`
+/// by a fixed rule whose measured error bound is within it ([`TableSpec::average_rule_order`]).
 #[must_use]
 pub fn estimate_texel(spec: &TableSpec, index: usize) -> Estimate {
     let (alpha, mu) = spec.texel_coordinates(index);
-    let eta = spec.texel_eta(index);
-    // F_avg is a 1-D integral: always the quadrature, whatever the method.
-    let method = if spec.quantity == Quantity::FAvg {
-        Method::Reference
-    } else {
-        spec.method
+    let at = Point {
+        alpha,
+        mu,
+        eta: spec.texel_eta(index),
     };
-    match (method, eta) {
-        (Method::Qmc, Some(eta)) => match mu {
-            Some(mu) => dielectric_albedo(spec.model, alpha, mu, eta, &spec.qmc),
-            None => dielectric_average_albedo(spec.model, alpha, eta, &spec.qmc),
-        },
-        (Method::Qmc, None) if spec.fresnel.is_some() => {
-            let fresnel = spec.fresnel.expect("checked");
-            let mu = mu.expect("E_F has a mu axis");
-            weighted_albedo(
-                spec.model,
-                alpha,
-                mu,
-                move |c| fresnel.reflectance(c)[0],
-                &spec.qmc,
-            )
-        }
-        (Method::Qmc, None) => match (mu, spec.quantity.weight()) {
-            (Some(mu), None) => albedo(spec.model, alpha, mu, &spec.qmc),
-            (Some(mu), Some(h)) => weighted_albedo(spec.model, alpha, mu, h, &spec.qmc),
-            (None, _) => average_albedo(spec.model, alpha, &spec.qmc),
-        },
-        (Method::Reference, eta) => {
+    let integral = spec.integral();
+    match spec.method {
+        Method::Qmc => integral.qmc(at, &spec.qmc),
+        Method::Reference => {
             let settings = spec.reference_settings();
             let r = match (mu, spec.average_rule_order()) {
-                // A fixed rule whose measured error bound is within the tolerance.
                 (None, Some(order)) => rule_average_albedo(spec.model, alpha, order, &settings),
-                // What the audit compares with, at the spec's tolerance: `E` and the split-sum
-                // channels by the reference, `E_avg` by the composite rule in smooth variables,
-                // the dielectric tables by their own quadrature.
-                _ => reference_value(spec, alpha, mu, eta, &settings),
+                _ => integral.reference(at, &settings),
             };
             Estimate {
                 value: r.value,

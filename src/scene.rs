@@ -423,11 +423,11 @@ impl Scene {
                     engine_model.masking.name()
                 ));
             }
-            if m.transmission {
+            if m.transmission && layout.glass.is_none() {
                 return Err(format!(
-                    "material '{}': transmission = true, but kiln does not write {}'s glass \
-                     tables; bake the dielectric tables in kiln's own layout (a scene without \
-                     a preset)",
+                    "material '{}': transmission = true, but {}'s layout has no glass tables \
+                     (cycles has them); bake the dielectric tables in kiln's own layout (a \
+                     scene without a preset)",
                     m.name, layout.name
                 ));
             }
@@ -484,11 +484,8 @@ impl Scene {
     /// transmission (each a bake of its own, so that one's options never change another's
     /// cache keys); with a preset, the engine's tables.
     fn needs(&self) -> Vec<(crate::BakeOptions, Option<Effect>, Model)> {
-        let max_error = self
-            .output
-            .as_ref()
-            .and_then(|o| o.max_error)
-            .unwrap_or(crate::BakeOptions::DEFAULT_MAX_ERROR);
+        let asked_max_error = self.output.as_ref().and_then(|o| o.max_error);
+        let max_error = asked_max_error.unwrap_or(crate::BakeOptions::DEFAULT_MAX_ERROR);
         if let Some(preset) = self.preset() {
             if self.materials.is_empty() {
                 return Vec::new();
@@ -501,7 +498,14 @@ impl Scene {
                 ndf: Ndf::Ggx,
                 masking: preset.layout().masking,
             };
-            return vec![(options, None, model)];
+            let mut needs = vec![(options, None, model)];
+            // The engine's glass tables when a material refracts.
+            if self.materials.iter().any(|m| m.transmission)
+                && let Some(glass) = preset.glass_options(asked_max_error)
+            {
+                needs.push((glass, Some(Effect::Transmission), model));
+            }
+            return needs;
         }
         let ior_max = self.ior_max();
         let mut needs = Vec::new();
@@ -570,22 +574,26 @@ impl Scene {
     pub fn plan(&self) -> Plan {
         let mut tables = Vec::new();
         for (options, effect, model) in self.needs() {
+            // An engine's main tables serve its effects but transmission, which its glass
+            // tables (a need of their own) serve.
+            let engine_effects: Vec<Effect> = self
+                .preset()
+                .map(|p| p.layout().effects.to_vec())
+                .unwrap_or_default()
+                .into_iter()
+                .filter(|&e| e != Effect::Transmission)
+                .collect();
             let effects: Vec<Effect> = match effect {
                 Some(effect) => vec![effect],
-                None => self
-                    .preset()
-                    .map(|p| p.layout().effects.to_vec())
-                    .unwrap_or_default()
-                    .into_iter()
+                None => engine_effects
+                    .iter()
+                    .copied()
                     .filter(|&e| self.materials.iter().any(|m| m.asks(e)))
                     .collect(),
             };
             let materials = match effect {
                 Some(effect) => self.asking(Some(model), &[effect]),
-                None => self.asking(
-                    Some(model),
-                    self.preset().map_or(&[][..], |p| p.layout().effects),
-                ),
+                None => self.asking(Some(model), &engine_effects),
             };
             for spec in options.resolved().specs() {
                 tables.push(PlannedTable {
@@ -638,7 +646,8 @@ impl Scene {
                 holds: q.symbol().to_string(),
                 effects: planned.map(|t| t.effects.clone()).unwrap_or_default(),
                 materials: planned.map(|t| t.materials.clone()).unwrap_or_default(),
-                computed: true,
+                // Cycles' glass arrays when no material refracts: not baked, not written.
+                computed: planned.is_some(),
             }
         };
         let mut channels: Vec<PlannedChannel> = match layout.container {
@@ -801,7 +810,7 @@ impl Scene {
             .computes_extra(preset)
             .then(|| preset.extra_channel())
             .flatten();
-        let mut files = preset.files_with_sidecars(&report.tables, extra.as_ref())?;
+        let mut files = preset.files_with_sidecars(&report.tables, extra.as_ref(), None)?;
         files.push((
             MATERIALS_FILE.to_string(),
             self.materials_document(&report.tables),
@@ -1137,6 +1146,65 @@ fresnel = { schlick = { f0 = 0.04 } }
         assert!(blue.computed && blue.materials == ["velvet"], "{blue:?}");
     }
 
+    /// A Cycles scene bakes Cycles' glass tables only when a material refracts, and the plan
+    /// says which materials need them for transmission; the E tables serve the others.
+    #[test]
+    fn a_cycles_scene_plans_its_glass_tables_only_for_glass() {
+        let text = |glass: bool| {
+            let mut text = "[output]\npreset = \"cycles\"\n\n[[material]]\nname = \"paint\"\n\
+                            ndf = \"ggx\"\nroughness = 0.4\n"
+                .to_string();
+            if glass {
+                text.push_str(
+                    "\n[[material]]\nname = \"bottle\"\nndf = \"ggx\"\nroughness = 0.1\n\
+                     fresnel = { dielectric = { ior = 1.5 } }\ntransmission = true\n",
+                );
+            }
+            Scene::parse(&text, "cycles.toml").unwrap().plan()
+        };
+        let plain = text(false);
+        assert!(plain.tables.iter().all(|t| !t.quantity.has_ior()));
+        let engine = plain.engine.expect("engine");
+        let glass = engine
+            .channels
+            .iter()
+            .find(|c| c.name == "table_ggx_glass_inv_E")
+            .expect("the array is planned");
+        assert!(!glass.computed && glass.materials.is_empty(), "{glass:?}");
+
+        let plan = text(true);
+        let glass: Vec<_> = plan
+            .tables
+            .iter()
+            .filter(|t| t.quantity.has_ior())
+            .collect();
+        assert_eq!(glass.len(), 4);
+        for t in &glass {
+            assert_eq!(
+                (t.materials.clone(), t.effects.clone()),
+                (vec!["bottle".to_string()], vec![Effect::Transmission])
+            );
+            assert!(t.id.contains("transmission-cycles"), "{}", t.id);
+        }
+        let e = plan
+            .tables
+            .iter()
+            .find(|t| t.quantity == Quantity::E)
+            .unwrap();
+        assert_eq!(e.effects, [Effect::MultipleScattering]);
+        let channel = plan
+            .engine
+            .expect("engine")
+            .channels
+            .into_iter()
+            .find(|c| c.name == "table_ggx_glass_inv_E")
+            .unwrap();
+        assert!(
+            channel.computed && channel.materials == ["bottle"],
+            "{channel:?}"
+        );
+    }
+
     /// What a scene cannot ask, each refused with the material, the reason and what to do.
     #[test]
     fn effects_an_engine_cannot_serve_are_refused() {
@@ -1160,10 +1228,10 @@ fresnel = { schlick = { f0 = 0.04 } }
             ),
             (
                 format!(
-                    "[output]\npreset = \"cycles\"\n{material}ndf = \"ggx\"\n\
+                    "[output]\npreset = \"bevy\"\n{material}ndf = \"ggx\"\n\
                      fresnel = {{ dielectric = {{ ior = 1.5 }} }}\ntransmission = true\n"
                 ),
-                "glass",
+                "no glass tables (cycles has them)",
             ),
             (
                 format!(

@@ -104,6 +104,7 @@ fn axis_descriptor(axis: Option<&Axis>) -> [u32; 4] {
             let m = match mapping {
                 IorMapping::Linear => 0,
                 IorMapping::Cycles => 1,
+                IorMapping::Blender => 2,
             };
             [4, m, grid(g), (max.0 as f32).to_bits()]
         }

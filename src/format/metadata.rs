@@ -56,6 +56,10 @@ pub struct Metadata {
     /// `height-correlated` or `separable`.
     pub masking: String,
     pub fresnel: String,
+    /// The dielectric tables' transmission convention
+    /// ([`crate::model::dielectric::TransmissionConvention`]); absent for the other tables.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub transmission: Option<String>,
     /// `r` (perceptual, alpha = r^2) or `alpha`.
     pub roughness_convention: String,
     /// The shape, slowest-varying axis first.
@@ -162,6 +166,8 @@ impl Metadata {
                     }
                 ),
             },
+            transmission: (spec.quantity.has_ior() && spec.quantity != Quantity::FAvg)
+                .then(|| spec.transmission.describe().to_string()),
             roughness_convention: match spec.roughness {
                 Some(_) => spec.roughness_convention().name().to_string(),
                 None => "none (no roughness axis)".to_string(),

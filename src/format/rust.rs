@@ -105,6 +105,7 @@ fn coordinate_code(axis: &Axis) -> String {
                     z_max as f32
                 )
             }
+            IorMapping::Blender => "((eta - 1.0) / (eta + 1.0)).max(0.0).sqrt()".to_string(),
         },
     }
 }

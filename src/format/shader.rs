@@ -111,6 +111,7 @@ fn coordinate(language: Language, axis: &Axis) -> String {
                     literal(z_max)
                 )
             }
+            IorMapping::Blender => "sqrt(max((eta_up - 1.0) / (eta_up + 1.0), 0.0))".to_string(),
         },
     }
 }

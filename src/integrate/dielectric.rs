@@ -143,8 +143,29 @@ pub fn dielectric_average_albedo(
     eta: f64,
     settings: &QmcSettings,
 ) -> Estimate {
+    dielectric_average_albedo_with(
+        model,
+        alpha,
+        eta,
+        TransmissionConvention::SingleScattering,
+        settings,
+    )
+}
+
+/// [`dielectric_average_albedo`] in the given convention ([`TransmissionConvention`]).
+///
+/// # Panics
+/// As [`dielectric_albedo`].
+#[must_use]
+pub fn dielectric_average_albedo_with(
+    model: Model,
+    alpha: f64,
+    eta: f64,
+    convention: TransmissionConvention,
+    settings: &QmcSettings,
+) -> Estimate {
     check(alpha, 0.5, eta);
-    if alpha == 0.0 {
+    if alpha == 0.0 || convention.smooth_at(eta) {
         return Estimate::exact(0.0);
     }
     let alpha = alpha.max(SMOOTH_ALPHA);
@@ -158,6 +179,7 @@ pub fn dielectric_average_albedo(
         ndf: N,
         masking: Masking,
         eta: f64,
+        convention: TransmissionConvention,
         settings: &QmcSettings,
         key: &[u64],
     ) -> Estimate {
@@ -170,23 +192,15 @@ pub fn dielectric_average_albedo(
                     let o = Vec3::new((1.0 - s).sqrt(), 0.0, s.sqrt());
                     let m = ndf.sample_visible_normal(o, [u0, u1]);
                     let lambda_o = ndf.lambda(o);
-                    scattering_with(
-                        ndf,
-                        masking,
-                        o,
-                        lambda_o,
-                        m,
-                        eta,
-                        TransmissionConvention::SingleScattering,
-                    )
-                    .loss
+                    scattering_with(ndf, masking, o, lambda_o, m, eta, convention).loss
                 },
             )
         })
     }
+    let masking = model.masking;
     match model.ndf {
-        Ndf::Ggx => kernel(Ggx { alpha }, model.masking, eta, settings, &key),
-        Ndf::Beckmann => kernel(Beckmann { alpha }, model.masking, eta, settings, &key),
+        Ndf::Ggx => kernel(Ggx { alpha }, masking, eta, convention, settings, &key),
+        Ndf::Beckmann => kernel(Beckmann { alpha }, masking, eta, convention, settings, &key),
     }
 }
 

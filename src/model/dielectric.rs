@@ -68,7 +68,9 @@ pub struct Scattering {
 /// - an index within 1e-4 of 1 (`|eta - 1| < 1e-4`, Cycles' first IOR node): Cycles treats the
 ///   interface as smooth, `E = F + (1 - F) = 1`, where a rough index-matched interface loses
 ///   `1 - G2 / G1` (0.3 at `r = 1`, `mu = 0.4`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize,
+)]
 #[serde(rename_all = "kebab-case")]
 #[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum TransmissionConvention {
@@ -80,6 +82,37 @@ pub enum TransmissionConvention {
 }
 
 impl TransmissionConvention {
+    /// The name on the command line, in files and in table names.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            TransmissionConvention::SingleScattering => "single-scattering",
+            TransmissionConvention::Cycles => "cycles",
+        }
+    }
+
+    /// Whether it is kiln's default (single scattering), which files leave out.
+    #[must_use]
+    pub fn is_default(&self) -> bool {
+        *self == TransmissionConvention::SingleScattering
+    }
+
+    /// A sentence for metadata.
+    #[must_use]
+    pub fn describe(self) -> &'static str {
+        match self {
+            TransmissionConvention::SingleScattering => {
+                "single scattering: a refraction that ends on the incident side of the surface \
+                 is lost, as the BSDF evaluates it"
+            }
+            TransmissionConvention::Cycles => {
+                "Cycles' sampler (bsdf_microfacet_sample): a refraction that ends on the \
+                 incident side of the surface is kept, and an index within 1e-4 of 1 is smooth \
+                 (E = 1), as Blender computed its glass tables"
+            }
+        }
+    }
+
     /// Whether a refraction that ends on the incident side is kept.
     #[must_use]
     pub fn keeps_refraction_above(self) -> bool {

@@ -7,6 +7,7 @@ use super::{ExtraChannel, Files};
 use crate::error::{Error, Result};
 use crate::format::Precision;
 use crate::format::texture::Texture;
+use crate::model::dielectric::TransmissionConvention;
 use crate::table::{Quantity, Table};
 use std::fmt::Write as _;
 
@@ -103,33 +104,13 @@ pub(super) fn encode(
     layout: &Layout,
     tables: &[Table],
     extra: Option<&ExtraChannel>,
+    carried: Option<&Carried>,
 ) -> Result<Files> {
     let n = layout.size;
     let invalid = Error::InvalidInput;
     let main = |bytes: Vec<u8>| -> Files { vec![(layout.file_name.to_string(), bytes)] };
     match layout.container {
-        Container::CycleTables(arrays) => {
-            let orders = Orders { layout, n };
-            let mut out = format!(
-                "/* kiln {}: Cycles' GGX energy-compensation tables (GGX, height-correlated, F = \
-                 1).\n * table_ggx_E: index = mu_index * {n} + r_index, mu = j / {}, r = i / {} \
-                 (alpha = r^2), exact nodes.\n * Regenerate: {}\n */\n",
-                crate::format::metadata::KILN_VERSION,
-                n - 1,
-                n - 1,
-                tables[0].command
-            );
-            for &(name, quantity) in arrays {
-                let table = table_of(tables, quantity)?;
-                let values = if quantity.has_mu() {
-                    orders.engine(&table.value)
-                } else {
-                    table.value.clone()
-                };
-                crate::format::c_header::float_array(&mut out, name, &values);
-            }
-            Ok(main(out.into_bytes()))
-        }
+        Container::CycleTables(arrays) => Ok(main(cycle_tables(layout, arrays, tables, carried)?)),
         Container::Ktx2 => {
             let mut texture =
                 Texture::of_values(&channel_tables(layout, tables)?).map_err(invalid)?;
@@ -325,17 +306,29 @@ pub(super) fn decode(
                 }
                 return Ok((vec![(Quantity::FMsNorm, norm)], None));
             }
-            let found: Vec<(Quantity, &str, Vec<f64>)> = arrays
+            // Every array that must be there first, then each one's size.
+            if let Some((name, _)) = arrays
                 .iter()
-                .map(|&(name, quantity)| {
-                    c_array(&text, name)
-                        .map(|values| (quantity, name, values))
-                        .ok_or_else(|| bad(format!("no {name}")))
-                })
-                .collect::<Result<_>>()?;
+                .find(|(name, q)| !q.has_ior() && c_array(&text, name).is_none())
+            {
+                return Err(bad(format!("no {name}")));
+            }
             let mut tables = Vec::new();
-            for (quantity, name, values) in found {
-                let expected = if quantity.has_mu() { n * n } else { n };
+            for &(name, quantity) in arrays {
+                let glass = quantity.has_ior().then_some(layout.glass).flatten();
+                let Some(values) = c_array(&text, name) else {
+                    // A file from before Cycles' glass tables (or without them) is read
+                    // without them; the other arrays are required.
+                    if glass.is_some() {
+                        continue;
+                    }
+                    return Err(bad(format!("no {name}")));
+                };
+                let (side, slices) = match glass {
+                    Some(g) => (g.size, g.size),
+                    None => (n, 1),
+                };
+                let expected = slices * if quantity.has_mu() { side * side } else { side };
                 if values.len() != expected {
                     return Err(bad(format!(
                         "{name} has {} values (expected {expected})",
@@ -343,7 +336,11 @@ pub(super) fn decode(
                     )));
                 }
                 let values = if quantity.has_mu() {
-                    orders.kiln(&values)
+                    let orders = Orders { layout, n: side };
+                    values
+                        .chunks(side * side)
+                        .flat_map(|slice| orders.kiln(slice))
+                        .collect()
                 } else {
                     values
                 };
@@ -500,6 +497,162 @@ pub(super) fn decode(
     }
 }
 
+/// The engine's arrays that kiln does not compute ([`Layout::carried`]), taken from the engine's
+/// own file to be written back verbatim.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Carried {
+    /// Where they come from, for the file's header.
+    pub origin: String,
+    /// Each array's declaration, `static const float name[N] = { ... };`, as the file has it.
+    pub declarations: Vec<String>,
+}
+
+impl Carried {
+    /// The layout's carried arrays from the engine's file `bytes` (named `origin`).
+    ///
+    /// # Errors
+    /// If the file lacks one of them.
+    pub fn from_file(layout: &Layout, bytes: &[u8], origin: &str) -> Result<Self> {
+        let text = String::from_utf8_lossy(bytes);
+        let declarations = layout
+            .carried
+            .iter()
+            .map(|name| {
+                c_declaration(&text, name).ok_or_else(|| {
+                    Error::InvalidInput(format!(
+                        "{origin} has no array {name} to carry over (expected `static const \
+                         float {name}[N] = {{ ... }};`, as in Blender's shader.tables)"
+                    ))
+                })
+            })
+            .collect::<Result<_>>()?;
+        Ok(Self {
+            origin: origin.to_string(),
+            declarations,
+        })
+    }
+}
+
+/// The whole declaration of the C array `name`, from `static` (or the name, without it) to its
+/// closing `};`.
+fn c_declaration(text: &str, name: &str) -> Option<String> {
+    let mut from = 0;
+    loop {
+        let at = from + text[from..].find(name)?;
+        let after = &text[at + name.len()..];
+        if after.starts_with(|c: char| c.is_alphanumeric() || c == '_') || !after.starts_with('[') {
+            from = at + name.len();
+            continue;
+        }
+        let line_start = text[..at].rfind('\n').map_or(0, |k| k + 1);
+        let end = at + after.find("};")? + name.len() + 2;
+        return Some(text[line_start..end].to_string());
+    }
+}
+
+/// Cycles' `shader.tables`: each array of the layout under its name (2-D tables in the layout's
+/// texel order, the glass tables one such slice per IOR node, averages by roughness), inside
+/// Cycles' namespace as Blender's file is; the glass arrays only when baked (a scene without
+/// transmission), the carried ones when given.
+fn cycle_tables(
+    layout: &Layout,
+    arrays: &[(&str, Quantity)],
+    tables: &[Table],
+    carried: Option<&Carried>,
+) -> Result<Vec<u8>> {
+    let n = layout.size;
+    let has = |q: Quantity| tables.iter().any(|t| t.spec.quantity == q);
+    let mut header = format!(
+        "/* kiln {}: Cycles' albedo tables (shader.tables), GGX, height-correlated.\n * \
+         table_ggx_E, table_ggx_Eavg: F = 1; index = mu_index * {n} + r_index, mu = j / {}, r = \
+         i / {} (alpha = r^2), exact nodes.\n",
+        crate::format::metadata::KILN_VERSION,
+        n - 1,
+        n - 1,
+    );
+    if let Some(glass) = layout.glass {
+        let g = glass.size;
+        if glass.tables.iter().all(|&q| has(q)) {
+            let _ = write!(
+                header,
+                " * table_ggx_glass_*: energy albedo R + T of a rough dielectric, {}\n *   \
+                 index = z_index * {} + mu_index * {g} + r_index (E),\n *   \
+                 z_index * {g} + r_index (Eavg); z = clamp(k / {}, 1e-4, 0.99), ior = (1 + z^2) \
+                 / (1 - z^2), _inv_ at 1 / ior;\n *   mu, r = k / {} (alpha = r^2), exact nodes.\n",
+                match glass.transmission {
+                    TransmissionConvention::Cycles => {
+                        "in Cycles' convention (a refraction ending on the incident side kept; \
+                         |ior - 1| < 1e-4 smooth);"
+                    }
+                    TransmissionConvention::SingleScattering => "single scattering;",
+                },
+                g * g,
+                g - 1,
+                g - 1
+            );
+        } else {
+            header.push_str(
+                " * table_ggx_glass_*: not baked (no material asks for transmission): keep \
+                 Blender's.\n",
+            );
+        }
+    }
+    for name in layout.carried {
+        match carried {
+            Some(c) => {
+                let _ = writeln!(
+                    header,
+                    " * {name}: not made by kiln (an LTC fit), carried over from {}.",
+                    c.origin
+                );
+            }
+            None => {
+                let _ = writeln!(
+                    header,
+                    " * {name}: not made by kiln (an LTC fit) and not in this file: Cycles \
+                     needs it, so keep Blender's\n *   (kiln bake --preset {} --carry-over \
+                     path/to/blender/shader.tables writes it in).",
+                    layout.name
+                );
+            }
+        }
+    }
+    let mut out = header;
+    let _ = write!(
+        out,
+        " * Regenerate: {}\n */\n\nCCL_NAMESPACE_BEGIN\n\n",
+        tables[0].command
+    );
+    for &(name, quantity) in arrays {
+        let glass = quantity.has_ior().then_some(layout.glass).flatten();
+        let values = match glass {
+            Some(_) if !has(quantity) => continue,
+            Some(g) if quantity.has_mu() => {
+                let orders = Orders { layout, n: g.size };
+                table_of(tables, quantity)?
+                    .value
+                    .chunks(g.size * g.size)
+                    .flat_map(|slice| orders.engine(slice))
+                    .collect()
+            }
+            None if quantity.has_mu() => {
+                Orders { layout, n }.engine(&table_of(tables, quantity)?.value)
+            }
+            _ => table_of(tables, quantity)?.value.clone(),
+        };
+        crate::format::c_header::float_array(&mut out, name, &values);
+        out.push('\n');
+    }
+    if let Some(c) = carried {
+        for declaration in &c.declarations {
+            out.push_str(declaration);
+            out.push_str("\n\n");
+        }
+    }
+    out.push_str("CCL_NAMESPACE_END\n");
+    Ok(out.into_bytes())
+}
+
 /// Little-endian 16-bit words (a container's half floats).
 #[cfg(feature = "containers")]
 fn little_endian(data: &[u8]) -> Vec<u16> {
@@ -515,8 +668,9 @@ fn c_array(text: &str, name: &str) -> Option<Vec<f64>> {
     loop {
         let at = rest.find(name)?;
         let after = &rest[at + name.len()..];
-        // The whole identifier: not table_ggx_E inside table_ggx_Eavg.
-        if after.starts_with(|c: char| c.is_alphanumeric() || c == '_') {
+        // The declaration of the whole identifier: not table_ggx_E inside table_ggx_Eavg, nor
+        // the name in a comment.
+        if !after.trim_start().starts_with('[') {
             rest = after;
             continue;
         }

@@ -7,8 +7,9 @@
 //! The sources of each layout (engines' files and commits) are in `docs/engines.md`.
 
 use crate::model::Masking;
+use crate::model::dielectric::TransmissionConvention;
 use crate::table::Quantity;
-use crate::table::axis::{Grid, MuMapping};
+use crate::table::axis::{Grid, IorMapping, MuMapping};
 
 /// Where the engine's flat array puts the texel at roughness index `r` and `mu` index `m` of an
 /// `n x n` table (in texels; channels interleave within one).
@@ -239,6 +240,26 @@ pub struct Layout {
     /// The effects the engine computes with its tables (its [`Layout::extra`] channel serves
     /// [`Extra::effect`]).
     pub effects: &'static [Effect],
+    /// The engine's dielectric (glass) tables, on axes of their own, if it has any.
+    pub glass: Option<GlassLayout>,
+    /// The engine's arrays kiln does not compute (Cycles' `table_sheen_ltc`, an LTC fit): a
+    /// preset's file carries them over verbatim from the engine's own file when given one.
+    pub carried: &'static [&'static str],
+}
+
+/// The dielectric tables of a layout: same grid, `mu` mapping and masking as its other tables,
+/// `size` samples on each of the IOR, roughness and `mu` axes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GlassLayout {
+    pub size: usize,
+    pub ior_mapping: IorMapping,
+    /// The tables, in order (`E` over (eta, roughness, mu), `E_avg` over (eta, roughness)).
+    pub tables: &'static [Quantity],
+    /// How the engine's tables count a refraction that ends on the incident side.
+    pub transmission: TransmissionConvention,
+    /// The max error they are baked to unless the user names one: they cost ten to a hundred
+    /// times the other tables per digit.
+    pub default_max_error: f64,
 }
 
 /// The file of `f_ms_norm` beside Cycles' `shader.tables`.
@@ -248,7 +269,10 @@ pub const CYCLES_NORMALISATION_FILE: &str = "ggx_f_ms_norm.tables";
 pub const ENTERPRISE_NORMALISATION_FILE: &str = "GGX_f_ms_norm.exr";
 
 use Channel::{Constant, Table};
-use Quantity::{E, EAvg, EBias, EScale, FMsNorm};
+use Quantity::{
+    E, EAvg, EAvgDielectric, EAvgDielectricInside, EBias, EDielectric, EDielectricInside, EScale,
+    FMsNorm,
+};
 
 /// Blender Cycles' `table_ggx_E[1024]` and `table_ggx_Eavg[32]` (`shader.tables`).
 pub const CYCLES: Layout = Layout {
@@ -262,12 +286,37 @@ pub const CYCLES: Layout = Layout {
     order: TexelOrder::MuRows,
     channels: &[Table(E)],
     stored: Stored::F32,
-    container: Container::CycleTables(&[("table_ggx_E", E), ("table_ggx_Eavg", EAvg)]),
+    container: Container::CycleTables(&[
+        ("table_ggx_E", E),
+        ("table_ggx_Eavg", EAvg),
+        ("table_ggx_glass_E", EDielectric),
+        ("table_ggx_glass_Eavg", EAvgDielectric),
+        ("table_ggx_glass_inv_E", EDielectricInside),
+        ("table_ggx_glass_inv_Eavg", EAvgDielectricInside),
+    ]),
     extra: None,
     normalisation: Some(Normalisation::CycleTable(CYCLES_NORMALISATION_FILE)),
     engine_computed_from: 1e-4,
-    effects: &[Effect::MultipleScattering],
+    effects: &[Effect::MultipleScattering, Effect::Transmission],
+    glass: Some(GlassLayout {
+        size: 16,
+        ior_mapping: IorMapping::Blender,
+        tables: &[
+            EDielectric,
+            EDielectricInside,
+            EAvgDielectric,
+            EAvgDielectricInside,
+        ],
+        transmission: TransmissionConvention::Cycles,
+        default_max_error: CYCLES_GLASS_MAX_ERROR,
+    }),
+    carried: &["table_sheen_ltc"],
 };
+
+/// The default max error of Cycles' glass tables: Blender's own are within 1.5e-5 of the truth
+/// in Cycles' convention (`docs/engines.md`), and each digit below costs the inside average
+/// about twice the time.
+pub const CYCLES_GLASS_MAX_ERROR: f64 = 1e-5;
 
 /// Bevy's `dfg.ktx2`.
 pub const BEVY: Layout = Layout {
@@ -286,6 +335,8 @@ pub const BEVY: Layout = Layout {
     normalisation: None,
     engine_computed_from: 0.0,
     effects: &[Effect::MultipleScattering, Effect::ImageBasedLighting],
+    glass: None,
+    carried: &[],
 };
 
 /// three.js' `DFGLUTData.js` (16 x 16 since r182; r181 and before shipped 32 x 32, which
@@ -306,6 +357,8 @@ pub const THREE: Layout = Layout {
     normalisation: None,
     engine_computed_from: 0.0,
     effects: &[Effect::MultipleScattering, Effect::ImageBasedLighting],
+    glass: None,
+    carried: &[],
 };
 
 /// Enterprise PBR's `res/GGX_E.exr` and `res/GGX_E_avg.exr`.
@@ -325,6 +378,8 @@ pub const ENTERPRISE_PBR: Layout = Layout {
     normalisation: Some(Normalisation::ExrF32(ENTERPRISE_NORMALISATION_FILE)),
     engine_computed_from: 0.0,
     effects: &[Effect::MultipleScattering],
+    glass: None,
+    carried: &[],
 };
 
 /// Filament's `dfg.inc` (`cmgen --ibl-dfg-multiscatter --ibl-dfg-cloth`).
@@ -344,6 +399,8 @@ pub const FILAMENT: Layout = Layout {
     normalisation: None,
     engine_computed_from: 0.0,
     effects: &[Effect::MultipleScattering, Effect::ImageBasedLighting],
+    glass: None,
+    carried: &[],
 };
 
 /// Godot 4's DFG texture (`integrate_dfg.glsl`), as a DDS to upload in its place.
@@ -363,6 +420,8 @@ pub const GODOT: Layout = Layout {
     normalisation: None,
     engine_computed_from: 0.0,
     effects: &[Effect::MultipleScattering, Effect::ImageBasedLighting],
+    glass: None,
+    carried: &[],
 };
 
 /// Unity HDRP's `_PreIntegratedFGD_GGXDisneyDiffuse`, as an EXR to import in its place.
@@ -382,6 +441,8 @@ pub const UNITY_HDRP: Layout = Layout {
     normalisation: None,
     engine_computed_from: 0.0,
     effects: &[Effect::MultipleScattering, Effect::ImageBasedLighting],
+    glass: None,
+    carried: &[],
 };
 
 /// Unreal Engine 5's `ShadingEnergyGGXSpecTexture`, as an EXR to import in its place.
@@ -401,6 +462,8 @@ pub const UNREAL: Layout = Layout {
     normalisation: None,
     engine_computed_from: 0.0,
     effects: &[Effect::MultipleScattering, Effect::ImageBasedLighting],
+    glass: None,
+    carried: &[],
 };
 
 /// The Kulla-Conty homework of the GAMES202 course (assignment 4): `GGX_E_LUT.png` and
@@ -424,4 +487,6 @@ pub const GAMES202: Layout = Layout {
     normalisation: None,
     engine_computed_from: 0.0,
     effects: &[Effect::MultipleScattering],
+    glass: None,
+    carried: &[],
 };

@@ -52,6 +52,8 @@
 mod container;
 pub mod layout;
 
+pub use container::Carried;
+
 use crate::bake::BakeOptions;
 use crate::error::{Error, Result};
 use crate::model::{Ndf, RoughnessConvention};
@@ -64,7 +66,8 @@ use layout::{Container, Extra, Layout};
 #[serde(rename_all = "kebab-case")]
 #[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum Preset {
-    /// Blender Cycles: E and E_avg, 32 x 32 mu-major, nodes, C float arrays.
+    /// Blender Cycles: E and E_avg, 32 x 32 mu-major, nodes, and the 16^3 glass arrays, C float
+    /// arrays.
     Cycles,
     /// Bevy: scale/bias, 64 x 64, centres, RG16F KTX2.
     Bevy,
@@ -168,7 +171,18 @@ impl Preset {
 
     /// The preset's files with the given extra channel (`None`: not computed, written as 0).
     pub fn files_with(self, tables: &[Table], extra: Option<&ExtraChannel>) -> Result<Files> {
-        let mut files = container::encode(self.layout(), tables, extra)?;
+        self.files_carrying(tables, extra, None)
+    }
+
+    /// [`Preset::files_with`], with the engine's arrays kiln does not compute carried over from
+    /// its own file ([`Carried::from_file`]; Cycles' `table_sheen_ltc`).
+    pub fn files_carrying(
+        self,
+        tables: &[Table],
+        extra: Option<&ExtraChannel>,
+        carried: Option<&Carried>,
+    ) -> Result<Files> {
+        let mut files = container::encode(self.layout(), tables, extra, carried)?;
         if let Some(file) = self.normalisation_file(tables)? {
             files.push(file);
         }
@@ -182,9 +196,10 @@ impl Preset {
         self,
         tables: &[Table],
         extra: Option<&ExtraChannel>,
+        carried: Option<&Carried>,
     ) -> Result<Files> {
         let tables = self.engine_tables(tables)?;
-        let mut files = self.files_with(&tables, extra)?;
+        let mut files = self.files_carrying(&tables, extra, carried)?;
         let engine_files: Vec<String> = files.iter().map(|(name, _)| name.clone()).collect();
         for table in &tables {
             let described = [(self.name().to_string(), engine_files.join(", "))]
@@ -291,6 +306,48 @@ impl Preset {
         }
     }
 
+    /// The bake of the preset's glass tables ([`layout::GlassLayout`]; `None` for an engine
+    /// without): to `max_error`, or the layout's default for them.
+    #[must_use]
+    pub fn glass_options(self, max_error: Option<f64>) -> Option<BakeOptions> {
+        let glass = self.layout().glass?;
+        Some(BakeOptions {
+            quantities: glass.tables.to_vec(),
+            size: glass.size,
+            ior_size: glass.size,
+            ior_mapping: glass.ior_mapping,
+            transmission: glass.transmission,
+            max_error: Some(max_error.unwrap_or(glass.default_max_error)),
+            ..self.options()
+        })
+    }
+
+    /// Every bake the preset's files hold: [`Preset::options`] and [`Preset::glass_options`],
+    /// to `max_error` (`None`: the defaults, 1e-7 and the glass tables' own).
+    #[must_use]
+    pub fn bakes(self, max_error: Option<f64>) -> Vec<BakeOptions> {
+        let main = BakeOptions {
+            max_error: Some(max_error.unwrap_or(BakeOptions::DEFAULT_MAX_ERROR)),
+            ..self.options()
+        };
+        std::iter::once(main)
+            .chain(self.glass_options(max_error))
+            .collect()
+    }
+
+    /// The engine's arrays kiln does not compute, from the engine's file `bytes` (`origin` names
+    /// it), for [`Preset::files_carrying`]; `None` for a preset without such arrays.
+    ///
+    /// # Errors
+    /// If the file lacks one of them.
+    pub fn carried_from(self, bytes: &[u8], origin: &str) -> Result<Option<Carried>> {
+        let layout = self.layout();
+        if layout.carried.is_empty() {
+            return Ok(None);
+        }
+        Carried::from_file(layout, bytes, origin).map(Some)
+    }
+
     /// The engine's value of `tables[channel]` at roughness index `r` and `mu` index `m`:
     /// where in the engine's flat array it sits (in texels; channels interleave within one).
     #[must_use]
@@ -337,7 +394,7 @@ impl Preset {
     /// [`Preset::file_name`] (see [`Preset::files`] for all of them).
     pub fn encode(self, tables: &[Table]) -> Result<Vec<u8>> {
         let extra = self.extra_channel();
-        let mut files = container::encode(self.layout(), tables, extra.as_ref())?;
+        let mut files = container::encode(self.layout(), tables, extra.as_ref(), None)?;
         Ok(files.swap_remove(0).1)
     }
 
@@ -494,7 +551,10 @@ impl Preset {
             size: self.size_in(bytes)?,
             ..self.options()
         };
-        let specs = options.resolved().specs();
+        let specs: Vec<TableSpec> = std::iter::once(options)
+            .chain(self.glass_options(None))
+            .flat_map(|o| o.resolved().specs())
+            .collect();
         let tables: Vec<Table> = self
             .decode(bytes)?
             .into_iter()

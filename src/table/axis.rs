@@ -180,7 +180,15 @@ pub enum IorMapping {
     Linear,
     /// Linear in `z = sqrt((eta - 1) / (eta + 1))` (Cycles' glass tables); kiln's default.
     Cycles,
+    /// Blender's own glass tables (`shader.tables`): `z = t` clamped to `[1e-4, 0.99]` at the
+    /// nodes, so the axis runs from `eta = 1 + 2e-8` to `eta = 99.5` whatever `eta_max`, and
+    /// the lookup reads `t = z` unclamped (`microfacet_ggx_glass_E`).
+    Blender,
 }
+
+/// The ends of [`IorMapping::Blender`]'s `z` (`ior_parameterization` in Cycles'
+/// `precompute.cpp`: `z = clamp(k / 15, 1e-4, 0.99)`).
+pub const BLENDER_Z_RANGE: (f64, f64) = (1e-4, 0.99);
 
 impl IorMapping {
     /// The name used on the command line and in files.
@@ -189,6 +197,7 @@ impl IorMapping {
         match self {
             IorMapping::Linear => "linear",
             IorMapping::Cycles => "cycles",
+            IorMapping::Blender => "blender",
         }
     }
 
@@ -205,6 +214,10 @@ impl IorMapping {
                 let z = t * Self::z(max);
                 (1.0 + z * z) / (1.0 - z * z)
             }
+            IorMapping::Blender => {
+                let z = t.clamp(BLENDER_Z_RANGE.0, BLENDER_Z_RANGE.1);
+                (1.0 + z * z) / (1.0 - z * z)
+            }
         }
     }
 
@@ -216,6 +229,7 @@ impl IorMapping {
         match self {
             IorMapping::Linear => (eta - 1.0) / (max - 1.0),
             IorMapping::Cycles => Self::z(eta) / Self::z(max),
+            IorMapping::Blender => Self::z(eta),
         }
     }
 
@@ -227,6 +241,10 @@ impl IorMapping {
             IorMapping::Cycles => {
                 "z = t z_max with z = sqrt((eta - 1) / (eta + 1)), z_max = z(eta_max); \
                  eta = (1 + z^2) / (1 - z^2)"
+            }
+            IorMapping::Blender => {
+                "z = clamp(t, 1e-4, 0.99), eta = (1 + z^2) / (1 - z^2) (Blender's glass tables; \
+                 a lookup reads t = sqrt((eta - 1) / (eta + 1)))"
             }
         }
     }

@@ -64,6 +64,12 @@ impl TableSpec {
                 crate::format::MAX_TEXELS
             ));
         }
+        if !self.transmission.is_default() && (!q.has_ior() || q == Quantity::FAvg) {
+            return Err(format!(
+                "a transmission convention belongs to the dielectric tables, not {}",
+                q.symbol()
+            ));
+        }
         if (q == Quantity::EF) != self.fresnel.is_some() {
             return Err("a Fresnel model belongs to E_F tables, and only to them".into());
         }

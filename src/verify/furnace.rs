@@ -109,7 +109,12 @@ fn turquin_deviation(
     reference: &crate::integrate::reference::ReferenceSettings,
 ) -> f64 {
     let roughness = e.spec.roughness_convention().from_alpha(alpha);
-    let truth = super::reference_value(&e.spec, alpha, Some(mu), eta, reference).value;
+    let at = super::Coordinates {
+        alpha,
+        mu: Some(mu),
+        eta,
+    };
+    let truth = e.spec.integral().reference(at, reference).value;
     let lookup = e.lookup_eta(mu, roughness, eta.unwrap_or(1.0));
     if lookup > 0.0 {
         truth / lookup - 1.0

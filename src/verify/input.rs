@@ -514,6 +514,7 @@ fn spec_and_values(
     let spec = |roughness, mu| TableSpec {
         reference_digits: None,
         lookup_of: None,
+        transmission: crate::model::dielectric::TransmissionConvention::SingleScattering,
         model: layout.model,
         quantity: layout.quantity,
         fresnel: layout.fresnel,

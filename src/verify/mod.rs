@@ -8,16 +8,9 @@ pub mod input;
 
 pub use error_map::{ErrorMap, MAX_MAP_CELLS, error_maps};
 
-use crate::integrate::average_quadrature::quadrature_average_albedo;
-use crate::integrate::dielectric::{
-    reference_dielectric_albedo, reference_dielectric_average_albedo,
-};
-use crate::integrate::reference::{
-    ReferenceSettings, ReferenceValue, reference_albedo, reference_weighted_albedo,
-};
-use crate::model::Fresnel;
+use crate::integrate::reference::ReferenceSettings;
 use crate::table::axis::Axis;
-use crate::table::{Quantity, Table, TableSpec};
+use crate::table::{Table, TableSpec};
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -142,83 +135,9 @@ pub struct Report {
     pub lookup_points_compared: Vec<Point>,
 }
 
-/// The reference value of `spec`'s quantity at `(alpha, mu)` and, for the tables with an IOR
-/// axis, the relative index `eta` ([`TableSpec::texel_eta`]): `E` by the reference, `E_avg` by
-/// the composite rule ([`quadrature_average_albedo`], within 1e-10 of the nested reference), the
-/// split-sum channels by the reference with their weight, the dielectric tables by their own
-/// quadrature ([`crate::integrate::dielectric`]), `F_avg` by Gauss-Kronrod to 1e-14.
-///
-/// # Panics
-/// If a table with an IOR axis is given no `eta`.
-#[must_use]
-pub fn reference_value(
-    spec: &TableSpec,
-    alpha: f64,
-    mu: Option<f64>,
-    eta: Option<f64>,
-    settings: &ReferenceSettings,
-) -> ReferenceValue {
-    if spec.quantity.has_ior() {
-        let eta = eta.expect("a table with an IOR axis needs eta");
-        return match (spec.quantity, mu) {
-            (Quantity::FAvg, _) => {
-                let f = Fresnel::Dielectric { eta }.average_report();
-                ReferenceValue {
-                    value: f.value[0],
-                    one_minus_value: 1.0 - f.value[0],
-                    error: f.error,
-                    evaluations: f.evaluations,
-                    converged: true,
-                }
-            }
-            (_, Some(mu)) => reference_dielectric_albedo(spec.model, alpha, mu, eta, settings)
-                .as_reference_value(),
-            (_, None) => reference_dielectric_average_albedo(spec.model, alpha, eta, settings)
-                .as_reference_value(),
-        };
-    }
-    if let (Some(fresnel), Some(mu)) = (spec.fresnel, mu) {
-        return fresnel_weighted_reference(spec.model, fresnel, alpha, mu, settings);
-    }
-    match (mu, spec.quantity.weight()) {
-        (Some(mu), None) => reference_albedo(spec.model, alpha, mu, settings),
-        (Some(mu), Some(h)) => reference_weighted_albedo(spec.model, alpha, mu, h, settings),
-        (None, _) => quadrature_average_albedo(spec.model, alpha, settings),
-    }
-}
-
-/// The reference Fresnel-weighted albedo `E_F(mu)` of channel 0 of `fresnel`: for a dielectric
-/// the reflected part of [`reference_dielectric_albedo`] (its quadrature splits at the critical
-/// angle, where `F` has a square-root kink that misleads the generic rule's error estimate),
-/// otherwise the reference with the weight `F(o.h)`. `one_minus_value` is `1 - E_F`.
-#[must_use]
-pub fn fresnel_weighted_reference(
-    model: crate::model::Model,
-    fresnel: Fresnel,
-    alpha: f64,
-    mu: f64,
-    settings: &ReferenceSettings,
-) -> ReferenceValue {
-    if let Fresnel::Dielectric { eta } = fresnel {
-        let r = reference_dielectric_albedo(model, alpha, mu, eta, settings);
-        return ReferenceValue {
-            value: r.reflection,
-            one_minus_value: 1.0 - r.reflection,
-            error: r.error,
-            evaluations: r.evaluations,
-            converged: r.converged,
-        };
-    }
-    reference_weighted_albedo(model, alpha, mu, |c| fresnel.reflectance(c)[0], settings)
-}
-
-/// Where a value is compared: `alpha`, and `mu` and the relative `eta` where the table has them.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Coordinates {
-    pub alpha: f64,
-    pub mu: Option<f64>,
-    pub eta: Option<f64>,
-}
+/// Where a value is compared: `alpha`, and `mu` and the relative `eta` where the table has them
+/// (the integration layer's [`crate::integrate::value::Point`]).
+pub use crate::integrate::value::Point as Coordinates;
 
 /// The audit's reference aims at this fraction of the smallest figure it reports for a group
 /// of points (the nodes; the lookups), and settles anywhere between it and twice it: a lookup
@@ -316,6 +235,7 @@ pub fn audit(
     progress: &(dyn Fn(Progress) + Sync),
 ) -> Report {
     let spec = &table.spec;
+    let integral = spec.integral();
     let convention = spec.roughness_convention();
     let clamp = |x: f64| x.max(settings.clamp_min);
 
@@ -357,7 +277,7 @@ pub fn audit(
                             tolerance,
                             ..*finest
                         };
-                        let r = reference_value(spec, at.alpha, at.mu, at.eta, &settings);
+                        let r = integral.reference(at, &settings);
                         (r.value, r.error, r.converged)
                     }
                     Against::Table(other) => {
@@ -654,7 +574,12 @@ pub fn node_error_terms(
         .par_iter()
         .map(|&k| {
             let (alpha, mu) = spec.texel_coordinates(k);
-            let reference = reference_value(spec, alpha, mu, spec.texel_eta(k), settings);
+            let at = Coordinates {
+                alpha,
+                mu,
+                eta: spec.texel_eta(k),
+            };
+            let reference = spec.integral().reference(at, settings);
             let (value, one_minus_value) = stored(k);
             // `1 - E` where both carry it directly; the split-sum channels and `E_F` by value.
             let difference = if spec.quantity.varies_on_a_mirror() {

@@ -70,6 +70,17 @@ pub struct BakeArgs {
     /// The top of the IOR axis, above 1 (Unreal's glass table goes to 3; diamond is 2.42).
     #[arg(long, default_value_t = BakeOptions::DEFAULT_IOR_MAX, allow_negative_numbers = true)]
     ior_max: f64,
+    /// How the dielectric tables count a refraction that ends on the incident side of the
+    /// surface: single-scattering (lost, as the BSDF evaluates it; kiln's default) or cycles
+    /// (kept, and an index within 1e-4 of 1 smooth, as Cycles' sampler computed Blender's glass
+    /// tables). Recorded in the tables' metadata and names.
+    #[arg(
+        long,
+        value_enum,
+        default_value = "single-scattering",
+        hide_possible_values = true
+    )]
+    transmission: kiln::model::dielectric::TransmissionConvention,
     /// QMC samples per E texel, a power of two from --scrambles to 2^32 x --scrambles (split
     /// over the scrambles); implies --method qmc [default: 2^19].
     #[arg(long, value_parser = parse_samples, allow_negative_numbers = true)]
@@ -95,12 +106,13 @@ pub struct BakeArgs {
         long,
         conflicts_with_all = ["ndf", "masking", "quantity", "size", "samples", "avg_samples",
             "scrambles", "seed", "format", "precision", "roughness_axis", "mu_axis", "grid",
-            "ior_size", "ior_axis", "ior_max", "fresnel", "f0", "f90", "ior", "eta", "k",
+            "ior_size", "ior_axis", "ior_max", "transmission", "fresnel", "f0", "f90", "ior", "eta", "k",
             "method", "no_reference_check", "max_error"]
     )]
     scene: Option<PathBuf>,
     /// Bake an engine's table in that engine's own layout, to drop in for its file: cycles
-    /// (shader.tables: table_ggx_E, table_ggx_Eavg), bevy (dfg.ktx2, RG16F scale/bias, 64 x 64,
+    /// (shader.tables: table_ggx_E, table_ggx_Eavg and the four glass arrays, in Cycles'
+    /// transmission convention, to 1e-5 unless --max-error is given), bevy (dfg.ktx2, RG16F scale/bias, 64 x 64,
     /// zstd), three (DFGLUTData.js as three ships it, 16 x 16 transposed half bits),
     /// enterprise-pbr (GGX_E.exr and GGX_E_avg.exr, half channel Y), filament (dfg.inc, 128 x
     /// 128 RGB16F half bits, cloth in B), godot (dfg_lut.dds, RGBA16F, rows at 1 - r,
@@ -111,12 +123,18 @@ pub struct BakeArgs {
     #[arg(
         long,
         value_enum,
+        hide_possible_values = true,
         conflicts_with_all = ["scene", "ndf", "masking", "quantity", "size", "samples",
             "avg_samples", "scrambles", "seed", "format", "precision", "roughness_axis", "mu_axis",
-            "grid", "method", "no_reference_check", "ior_size", "ior_axis", "ior_max", "fresnel",
+            "grid", "method", "no_reference_check", "ior_size", "ior_axis", "ior_max", "transmission", "fresnel",
             "f0", "f90", "ior", "eta", "k"]
     )]
     preset: Option<kiln::preset::Preset>,
+    /// With --preset cycles: copy the arrays kiln does not compute (table_sheen_ltc, an LTC
+    /// fit) from this shader.tables (Blender's own, say) into the one written, so that it
+    /// replaces Blender's whole. Without it the file says that Blender's must be kept.
+    #[arg(long, requires = "preset", value_name = "FILE")]
+    carry_over: Option<PathBuf>,
     /// Output formats, comma-separated.
     #[arg(
         long,
@@ -243,6 +261,7 @@ pub fn run(args: BakeArgs) -> kiln::Result<()> {
         ior_size: args.ior_size,
         ior_mapping: args.ior_axis,
         ior_max: args.ior_max,
+        transmission: args.transmission,
         check_against_reference: !args.no_reference_check,
         method: args.method.unwrap_or(Method::Qmc),
         max_error,
@@ -376,21 +395,44 @@ fn check_method_flags(args: &BakeArgs) -> kiln::Result<()> {
 /// `kiln bake --preset NAME`.
 fn bake_preset(preset: kiln::preset::Preset, args: &BakeArgs) -> kiln::Result<()> {
     let out = args.out.clone().unwrap_or_else(|| PathBuf::from("tables"));
-    let options = BakeOptions {
-        max_error: Some(args.max_error.unwrap_or(BakeOptions::DEFAULT_MAX_ERROR)),
-        ..preset.options()
+    // The engine's tables, and its glass tables to their own default max error unless one is
+    // named.
+    let bakes = preset.bakes(args.max_error);
+    for options in &bakes {
+        options.validate()?;
+    }
+    let carried = match &args.carry_over {
+        Some(path) => {
+            let bytes = format::read_file(path)?;
+            let carried = preset.carried_from(&bytes, &path.display().to_string())?;
+            if carried.is_none() {
+                return Err(kiln::Error::InvalidInput(format!(
+                    "--carry-over: the {} layout holds nothing kiln does not compute (only \
+                     cycles carries arrays over: table_sheen_ltc)",
+                    preset.name()
+                )));
+            }
+            carried
+        }
+        None => None,
     };
-    options.validate()?;
     format::check_output_dir(&out)?;
-    crate::announce_cost(options.estimated_core_seconds(), args.quiet);
-    let bar = crate::progress_bar(args.quiet, options.total_samples(), "integrating");
+    crate::announce_cost(
+        bakes.iter().map(BakeOptions::estimated_core_seconds).sum(),
+        args.quiet,
+    );
+    let total = bakes.iter().map(BakeOptions::total_samples).sum();
+    let bar = crate::progress_bar(args.quiet, total, "integrating");
     let start = Instant::now();
-    let tables = options.bake(&|samples| bar.inc(samples))?;
+    let mut tables = Vec::new();
+    for options in &bakes {
+        tables.extend(options.bake(&|samples| bar.inc(samples))?);
+    }
     bar.finish_and_clear();
     // The engine's files and kiln's sidecars of the tables they hold, named after the preset
     // (the layout is the preset's), listing the engine's file(s) they describe.
     let extra = preset.extra_channel();
-    let files = preset.files_with_sidecars(&tables, extra.as_ref())?;
+    let files = preset.files_with_sidecars(&tables, extra.as_ref(), carried.as_ref())?;
     let written = format::write_files(&out, &files)?;
     if !args.quiet {
         for table in &tables {
@@ -407,6 +449,15 @@ fn bake_preset(preset: kiln::preset::Preset, args: &BakeArgs) -> kiln::Result<()
             println!(
                 "blue channel: {}, error estimate {:.1e}",
                 extra.name, extra.max_error
+            );
+        }
+        let layout = preset.layout();
+        if !layout.carried.is_empty() && carried.is_none() {
+            println!(
+                "note: {} is not made by kiln and is not in {}: Cycles needs it, so keep \
+                 Blender's, or give --carry-over path/to/blender/shader.tables",
+                layout.carried.join(", "),
+                preset.file_name()
             );
         }
         println!(

@@ -402,20 +402,10 @@ fn dielectric(
     mu: Option<f64>,
 ) -> kiln::Result<()> {
     use kiln::integrate::dielectric::{
-        dielectric_albedo_with, dielectric_average_albedo, reference_dielectric_albedo_with,
+        dielectric_albedo_with, dielectric_average_albedo_with, reference_dielectric_albedo_with,
         reference_dielectric_average_albedo_with,
     };
-    use kiln::model::dielectric::TransmissionConvention;
     let convention = args.transmission;
-    if mu.is_none()
-        && args.method == Method::Qmc
-        && convention != TransmissionConvention::SingleScattering
-    {
-        return Err(kiln::Error::InvalidInput(
-            "--transmission cycles with --quantity e-avg-dielectric needs --method reference"
-                .to_string(),
-        ));
-    }
     let start = Instant::now();
     let (value, one_minus_value, error, samples, converged, parts) = match args.method {
         Method::Qmc => {
@@ -431,7 +421,7 @@ fn dielectric(
             settings.validate().map_err(kiln::Error::InvalidInput)?;
             let e = match mu {
                 Some(mu) => dielectric_albedo_with(model, alpha, mu, eta, convention, &settings),
-                None => dielectric_average_albedo(model, alpha, eta, &settings),
+                None => dielectric_average_albedo_with(model, alpha, eta, convention, &settings),
             };
             (
                 e.value,

@@ -58,7 +58,7 @@ pub struct VerifyArgs {
     #[arg(long)]
     json: bool,
     /// FILE is an engine's own table in that engine's layout (cycles: shader.tables with
-    /// table_ggx_E and table_ggx_Eavg; bevy: dfg.ktx2, zstd or not; three: the DFG LUT's
+    /// table_ggx_E, table_ggx_Eavg and the glass arrays, those in Cycles' convention; bevy: dfg.ktx2, zstd or not; three: the DFG LUT's
     /// Uint16Array; enterprise-pbr: GGX_E.exr or GGX_E_avg.exr; filament: dfg.inc, RGB or RG
     /// half bits; godot: dfg_lut.dds; unity-hdrp and unreal: their EXR; games202:
     /// GGX_E_LUT.png or GGX_Eavg_LUT.png, told apart by their rows): audit each of its tables
@@ -69,6 +69,10 @@ pub struct VerifyArgs {
     #[arg(long, value_enum, conflicts_with_all = ["furnace", "shape", "channel", "dtype",
         "order", "grid", "roughness_axis", "mu_axis", "ndf", "masking", "quantity"])]
     preset: Option<kiln::preset::Preset>,
+    /// With --preset: audit only these of the file's tables, comma-separated (e,e-avg of a
+    /// Cycles shader.tables skips its four glass arrays, whose audit takes minutes).
+    #[arg(long, value_enum, value_delimiter = ',', requires = "preset")]
+    only: Option<Vec<Quantity>>,
     /// Exit with status 1 when node_max_error exceeds this.
     #[arg(long, value_parser = parse_error_bound, allow_negative_numbers = true)]
     max_error: Option<f64>,
@@ -571,9 +575,25 @@ pub fn run(args: VerifyArgs) -> kiln::Result<bool> {
             }
             other => other,
         };
-        let tables = preset
+        let mut tables = preset
             .read_tables(&bytes, &args.file.display().to_string())
             .map_err(in_file)?;
+        if let Some(only) = &args.only {
+            let held: Vec<&str> = tables.iter().map(|t| t.spec.quantity.cli_name()).collect();
+            if let Some(missing) = only
+                .iter()
+                .find(|q| !tables.iter().any(|t| t.spec.quantity == **q))
+            {
+                return Err(kiln::Error::InvalidInput(format!(
+                    "{}: --only names {}, but the file holds {} in the {} layout",
+                    args.file.display(),
+                    missing.cli_name(),
+                    held.join(", "),
+                    preset.name()
+                )));
+            }
+            tables.retain(|t| only.contains(&t.spec.quantity));
+        }
         let args = &VerifyArgs {
             clamp_min: args.clamp_min.or(Some(preset.computed_from(&bytes))),
             ..args.clone()
