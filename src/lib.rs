@@ -45,6 +45,7 @@ pub mod error;
 pub mod format;
 pub mod integrate;
 pub mod model;
+pub mod numerics;
 pub mod preset;
 pub mod scene;
 pub mod shard;

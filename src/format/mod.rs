@@ -223,10 +223,8 @@ pub fn as_stored(tables: &[Table], precision: Precision) -> Vec<Table> {
         .collect()
 }
 
-/// The most texels kiln reads from any file or accepts in any metadata: 2^26, a 4096 x 4096
-/// table (the largest 2-D table kiln bakes, [`crate::BakeOptions::MAX_SIZE`]). A header that
-/// claims more is refused before anything is allocated or decompressed.
-pub const MAX_TEXELS: usize = 1 << 26;
+/// The most texels kiln reads from any file or accepts in any metadata ([`crate::table::MAX_TEXELS`]).
+pub use crate::table::MAX_TEXELS;
 
 /// The largest file kiln reads: 2 GiB (a 4096 x 4096 table with its three channels in JSON is
 /// about 1 GiB). Larger files, and anything that is not a regular file (`/dev/zero`, a pipe,

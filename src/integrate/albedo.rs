@@ -23,6 +23,7 @@
 
 use super::estimate::Estimate;
 use super::sobol::{OwenSobol, mix_seed};
+pub use crate::model::masking::reflection_loss;
 use crate::model::ndf::BeckmannVisibleNormals;
 use crate::model::{
     Beckmann, Ggx, Masking, MicrofacetDistribution, Model, Ndf, SMOOTH_ALPHA, Vec3,
@@ -431,25 +432,6 @@ pub fn generic_loss<N: MicrofacetDistribution>(
     u: [f64; 2],
 ) -> f64 {
     reflection_loss(ndf, masking, o, lambda_o, ndf.sample_visible_normal(o, u))
-}
-
-/// The loss `1 - w` for the microfacet normal `m`: reflect `o` about it; below the horizon all
-/// is lost, above it [`Masking::loss`].
-#[inline]
-#[must_use]
-pub fn reflection_loss<N: MicrofacetDistribution>(
-    ndf: N,
-    masking: Masking,
-    o: Vec3,
-    lambda_o: f64,
-    m: Vec3,
-) -> f64 {
-    let i = o.reflect(m);
-    if i.z > 0.0 {
-        masking.loss_at(ndf.alpha(), o.z, i.z, lambda_o, ndf.lambda(i))
-    } else {
-        1.0
-    }
 }
 
 /// What the GGX kernel needs of the view: `o = (so, 0, mu)` and its stretched direction.

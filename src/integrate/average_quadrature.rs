@@ -3,7 +3,7 @@
 //! against it (tests, `kiln verify`).
 //!
 //! `E_avg = 2 ∫_0^1 E(mu) mu dmu` (`docs/physics.md`). In the adaptive table coordinate
-//! `t = (mu (1 + c alpha) / (mu + c alpha))^p` ([`MuMapping::Adaptive`]) the grazing boundary
+//! `t = (mu (1 + c alpha) / (mu + c alpha))^p` ([`crate::table::axis::MuMapping::Adaptive`]) the grazing boundary
 //! layer `mu ~ alpha` is smooth at every `alpha`, so the integral over `mu in [0, mu_c]`,
 //! `mu_c = min(8 alpha, 1)`, is taken in `t`, with `2 mu dmu = 2 mu (dmu/dt) dt`,
 //! `dmu/dt = k (1 + k) / (1 + k - s)^2 * s / (p t)`, `s = t^(1/p)`, `k = c alpha`. Beyond
@@ -16,9 +16,9 @@
 
 use super::gauss_kronrod::integrate_pieces;
 use super::gauss_legendre;
+use super::grazing::{ADAPTIVE_POWER, ADAPTIVE_SCALE, mu_of_t, t_of_mu};
 use super::reference::{MIRROR, ReferenceSettings, ReferenceValue, reference_albedo};
 use crate::model::{Model, Ndf, SMOOTH_ALPHA};
-use crate::table::axis::{ADAPTIVE_POWER, ADAPTIVE_SCALE, MuMapping};
 
 /// Panels each part starts with.
 pub const PANELS: usize = 3;
@@ -38,7 +38,7 @@ impl Split {
         Split {
             alpha,
             mu_c,
-            t_c: MuMapping::Adaptive.coordinate(mu_c, alpha),
+            t_c: t_of_mu(mu_c, alpha),
         }
     }
 
@@ -46,7 +46,7 @@ impl Split {
     fn head(&self, t: f64) -> (f64, f64) {
         let (p, k) = (ADAPTIVE_POWER, ADAPTIVE_SCALE * self.alpha);
         let s = t.powf(1.0 / p);
-        let mu = MuMapping::Adaptive.mu(t, self.alpha);
+        let mu = mu_of_t(t, self.alpha);
         let dmu_dt = k * (1.0 + k) / (1.0 + k - s).powi(2) * s / (p * t);
         (mu, 2.0 * mu * dmu_dt)
     }

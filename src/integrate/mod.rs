@@ -4,13 +4,15 @@ pub mod albedo;
 pub mod average_quadrature;
 pub mod dielectric;
 pub mod estimate;
-pub mod gauss_kronrod;
-pub mod gauss_legendre;
+pub mod grazing;
 pub mod quantity;
 pub mod reference;
 pub mod sheen;
 pub mod sobol;
 pub mod value;
+
+/// The quadrature rules, at home in [`crate::numerics`].
+pub use crate::numerics::{gauss_kronrod, gauss_legendre};
 
 pub use albedo::{QmcSettings, albedo, average_albedo};
 pub use estimate::Estimate;

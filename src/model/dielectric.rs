@@ -188,7 +188,7 @@ pub fn scattering_with<N: MicrofacetDistribution>(
 ) -> Scattering {
     let c = o.dot(m).clamp(0.0, 1.0);
     let fresnel = super::fresnel::dielectric(eta, c);
-    let reflection_loss = crate::integrate::albedo::reflection_loss(ndf, masking, o, lambda_o, m);
+    let reflection_loss = crate::model::masking::reflection_loss(ndf, masking, o, lambda_o, m);
     let transmission_loss = match refract(o, m, c, eta) {
         // Index-matched, i_t = -o: Lambda(i_t) = Lambda(o), and at a grazing view the loss takes
         // its limit along the view (1/2 height-correlated, 1 separable), not the value at

@@ -31,14 +31,14 @@ pub fn disney_diffuse_no_pi(mu_o: f64, mu_i: f64, cos_io: f64, r: f64) -> f64 {
 pub fn disney_diffuse_albedo(r: f64, mu_o: f64) -> f64 {
     let p_o = (1.0 - mu_o).powi(5);
     let s_o2 = 1.0 - mu_o * mu_o;
-    let rule = crate::integrate::gauss_legendre::rule(5);
+    let rule = crate::numerics::gauss_legendre::rule(5);
     let mut f = |mu_i: f64| -> [f64; 1] {
         let a = r * (1.0 + mu_o * mu_i) - 0.5;
         let b2 = r * r * s_o2 * (1.0 - mu_i * mu_i);
         let p_i = (1.0 - mu_i).powi(5);
         [2.0 * mu_i * (1.0 + a * (p_i + p_o) + (a * a + 0.5 * b2) * p_i * p_o)]
     };
-    crate::integrate::gauss_legendre::integrate(&rule, &mut f, 0.0, 1.0)[0] / UNITY_NORMALISATION
+    crate::numerics::gauss_legendre::integrate(&rule, &mut f, 0.0, 1.0)[0] / UNITY_NORMALISATION
 }
 
 #[cfg(test)]
@@ -49,7 +49,7 @@ mod tests {
     /// The albedo by brute force: a 64 x 64 Gauss-Legendre product rule over `(mu_i, phi)` of
     /// the BRDF itself, with the directions as vectors (no averaging over `phi` by hand).
     fn brute_force(r: f64, mu_o: f64) -> f64 {
-        let rule = crate::integrate::gauss_legendre::rule(64);
+        let rule = crate::numerics::gauss_legendre::rule(64);
         let o = crate::model::Vec3::from_mu(mu_o);
         let mut outer = |mu_i: f64| -> [f64; 1] {
             let s_i = (1.0 - mu_i * mu_i).sqrt();
@@ -57,9 +57,9 @@ mod tests {
                 let i = crate::model::Vec3::new(s_i * phi.cos(), s_i * phi.sin(), mu_i);
                 [disney_diffuse_no_pi(mu_o, mu_i, o.dot(i), r) * mu_i / PI]
             };
-            crate::integrate::gauss_legendre::integrate(&rule, &mut inner, 0.0, 2.0 * PI)
+            crate::numerics::gauss_legendre::integrate(&rule, &mut inner, 0.0, 2.0 * PI)
         };
-        crate::integrate::gauss_legendre::integrate(&rule, &mut outer, 0.0, 1.0)[0]
+        crate::numerics::gauss_legendre::integrate(&rule, &mut outer, 0.0, 1.0)[0]
     }
 
     #[test]

@@ -17,7 +17,7 @@
 //!
 //! `c` is the cosine between the incident direction and the (micro)surface normal, in `[0, 1]`.
 
-use crate::integrate::gauss_kronrod::integrate_pieces;
+use crate::numerics::gauss_kronrod::integrate_pieces;
 use serde::{Deserialize, Serialize};
 
 /// RGB values, one per channel.

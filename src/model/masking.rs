@@ -9,6 +9,7 @@
 //! The estimators sample Smith's visible normals whatever the form, so every form is expressed
 //! as the loss `1 - G2 / G1_Smith(o)` of a sample ([`Masking::loss_at`]).
 
+use super::{MicrofacetDistribution, Vec3};
 use serde::{Deserialize, Serialize};
 
 /// Which Smith `G2` a table is computed for. Part of a table's identity: a table is only right for
@@ -143,6 +144,25 @@ impl Masking {
 impl std::fmt::Display for Masking {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(self.name())
+    }
+}
+
+/// The loss `1 - w` for the microfacet normal `m`: reflect `o` about it; below the horizon all
+/// is lost, above it [`Masking::loss_at`].
+#[inline]
+#[must_use]
+pub fn reflection_loss<N: MicrofacetDistribution>(
+    ndf: N,
+    masking: Masking,
+    o: Vec3,
+    lambda_o: f64,
+    m: Vec3,
+) -> f64 {
+    let i = o.reflect(m);
+    if i.z > 0.0 {
+        masking.loss_at(ndf.alpha(), o.z, i.z, lambda_o, ndf.lambda(i))
+    } else {
+        1.0
     }
 }
 

@@ -78,11 +78,9 @@ impl Grid {
     }
 }
 
-/// The scale `c` of [`MuMapping::Adaptive`]: the boundary layer's `mu ~ alpha` maps near
-/// `t = (1 / (1 + c))^p`, about the middle of the axis.
-pub const ADAPTIVE_SCALE: f64 = 4.0;
-/// The power `p` of [`MuMapping::Adaptive`]: below 1 it spreads the samples near `mu = 0`.
-pub const ADAPTIVE_POWER: f64 = 0.4;
+/// The constants of [`MuMapping::Adaptive`], at home with the change of variable they define.
+pub use crate::integrate::grazing::{ADAPTIVE_POWER, ADAPTIVE_SCALE};
+
 /// The `alpha` at which a row at `alpha = 0` of an [`MuMapping::Adaptive`] table is computed:
 /// that row holds the limit `alpha -> 0+` at fixed `t`, which `E` approaches as `O(alpha^2)`, so
 /// the difference at 1e-7 is about 1e-14 (equal to [`crate::model::SMOOTH_ALPHA`]).
@@ -126,16 +124,7 @@ impl MuMapping {
         match self {
             MuMapping::Linear => t,
             MuMapping::Sqrt => t * t,
-            MuMapping::Adaptive => {
-                // s (mu + k) = mu (1 + k)  =>  mu = s k / (1 + k - s), with k = c alpha.
-                let s = t.powf(1.0 / ADAPTIVE_POWER);
-                let k = ADAPTIVE_SCALE * alpha;
-                if s >= 1.0 {
-                    1.0
-                } else {
-                    (s * k / (1.0 + k - s)).min(1.0)
-                }
-            }
+            MuMapping::Adaptive => crate::integrate::grazing::mu_of_t(t, alpha),
         }
     }
 
@@ -146,13 +135,7 @@ impl MuMapping {
         match self {
             MuMapping::Linear => mu,
             MuMapping::Sqrt => mu.sqrt(),
-            MuMapping::Adaptive => {
-                if mu <= 0.0 {
-                    return 0.0;
-                }
-                let k = ADAPTIVE_SCALE * alpha;
-                (mu * (1.0 + k) / (mu + k)).min(1.0).powf(ADAPTIVE_POWER)
-            }
+            MuMapping::Adaptive => crate::integrate::grazing::t_of_mu(mu, alpha),
         }
     }
 

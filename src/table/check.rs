@@ -1,5 +1,5 @@
 //! Whether a table read from a file (or a cache) is one kiln can use: a spec whose axes fit its
-//! quantity and whose size is within [`crate::format::MAX_TEXELS`], and channels of that length
+//! quantity and whose size is within [`super::MAX_TEXELS`], and channels of that length
 //! holding finite numbers in the quantity's range. Every reader runs these before a table is
 //! audited, looked up or written, so that a hostile or damaged file is an error naming the
 //! value, never a panic, a huge allocation or a NaN audit that passes.
@@ -14,7 +14,7 @@ pub const RANGE_TOLERANCE: f64 = 1e-3;
 
 impl TableSpec {
     /// Checks that the axes are those of the quantity, each in its place, that every axis has
-    /// between 1 and [`crate::format::MAX_TEXELS`] samples and the table at most that many
+    /// between 1 and [`super::MAX_TEXELS`] samples and the table at most that many
     /// texels, and that `fresnel` and `lookup_of` are set exactly where they belong.
     ///
     /// # Errors
@@ -43,25 +43,25 @@ impl TableSpec {
         let mut texels: usize = 1;
         for axis in self.axes() {
             let size = axis.size();
-            if size == 0 || size > crate::format::MAX_TEXELS {
+            if size == 0 || size > super::MAX_TEXELS {
                 return Err(format!("its {} axis has {size} samples", axis.name()));
             }
             if let Axis::Ior { max, .. } = axis
-                && !(max.0.is_finite() && max.0 > 1.0 && max.0 <= crate::bake::MAX_IOR)
+                && !(max.0.is_finite() && max.0 > 1.0 && max.0 <= crate::model::fresnel::MAX_INDEX)
             {
                 return Err(format!(
                     "its eta axis ends at {}, outside (1, {}]",
                     max.0,
-                    crate::bake::MAX_IOR
+                    crate::model::fresnel::MAX_INDEX
                 ));
             }
             texels = texels.saturating_mul(size);
         }
-        if texels > crate::format::MAX_TEXELS {
+        if texels > super::MAX_TEXELS {
             return Err(format!(
                 "shape {:?}: {texels} texels, more than the {} kiln reads",
                 self.shape(),
-                crate::format::MAX_TEXELS
+                super::MAX_TEXELS
             ));
         }
         if !self.transmission.is_default() && (!q.has_ior() || q == Quantity::FAvg) {

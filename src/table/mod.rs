@@ -12,6 +12,11 @@ use serde::{Deserialize, Serialize};
 
 pub use crate::integrate::quantity::{Quantity, schlick_weight};
 
+/// The most texels kiln reads from any file or accepts in any metadata (checked by [`TableSpec::check`]): 2^26, a 4096 x 4096
+/// table (the largest 2-D table kiln bakes, [`crate::BakeOptions::MAX_SIZE`]). A header that
+/// claims more is refused before anything is allocated or decompressed.
+pub const MAX_TEXELS: usize = 1 << 26;
+
 /// How a table's values are computed.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
@@ -350,7 +355,7 @@ pub struct Table {
     /// The command that reproduces this table.
     pub command: String,
     /// The error of the stored values against the deterministic reference, where measured.
-    pub node_errors: Option<crate::verify::NodeErrors>,
+    pub node_errors: Option<NodeErrors>,
     /// The `--max-error` the table was baked to meet, if any.
     pub requested_max_error: Option<f64>,
 }
@@ -462,6 +467,21 @@ fn blend(channel: &[f64], corners: &[Corner], base: usize) -> f64 {
             a * (1.0 - c.weight) + b * c.weight
         }
     }
+}
+
+/// The node errors `kiln bake` measures against the reference and records with a table
+/// ([`crate::verify::node_errors`]).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct NodeErrors {
+    /// The largest error (NaN if any texel is NaN).
+    pub max: f64,
+    pub rms: f64,
+    /// How many texels were checked.
+    pub texels: usize,
+    /// How many of them had a reference that did not converge within its evaluation budget
+    /// (their error is the difference plus the reference's own error estimate).
+    #[serde(default)]
+    pub unconverged: usize,
 }
 
 #[cfg(test)]

@@ -35,7 +35,7 @@
 
 use super::axis::{Axis, Grid};
 use super::{Quantity, Table, TableSpec};
-use crate::integrate::gauss_kronrod::integrate_pieces;
+use crate::numerics::gauss_kronrod::integrate_pieces;
 
 /// Nodes of the normalisation table per cell of the E table's roughness axis.
 pub const SUBDIVISIONS: usize = 16;

@@ -610,16 +610,5 @@ pub fn summarise_node_errors(measured: &[(f64, bool)]) -> NodeErrors {
     }
 }
 
-/// The node errors `kiln bake` measures and records.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, serde::Deserialize)]
-pub struct NodeErrors {
-    /// The largest error (NaN if any texel is NaN).
-    pub max: f64,
-    pub rms: f64,
-    /// How many texels were checked.
-    pub texels: usize,
-    /// How many of them had a reference that did not converge within its evaluation budget
-    /// (their error is the difference plus the reference's own error estimate).
-    #[serde(default)]
-    pub unconverged: usize,
-}
+/// The node errors `kiln bake` measures and records (a table's own record).
+pub use crate::table::NodeErrors;
