@@ -791,6 +791,51 @@ fn reference_method_bakes_tables_within_1e_10_that_qmc_agrees_with() {
     }
 }
 
+/// `kiln study --scaling --quick`: its four files, the CSV rows the JSON's runs, one fit per
+/// case in the plot's legend, a PNG. Its timings are not asserted.
+#[test]
+fn study_scaling_writes_consistent_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("scaling");
+    let output = kiln(&[
+        "study",
+        "--scaling",
+        "--quick",
+        "-q",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    assert_eq!(
+        files_in(&out),
+        ["scaling.csv", "scaling.json", "scaling.png", "scaling.svg"]
+    );
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("scaling.json")).unwrap()).unwrap();
+    let runs = json["runs"].as_array().unwrap();
+    let csv = std::fs::read_to_string(out.join("scaling.csv")).unwrap();
+    assert_eq!(csv.lines().count(), runs.len() + 1);
+    for (line, run) in csv.lines().skip(1).zip(runs) {
+        assert!(line.starts_with(&format!(
+            "{},{},{},",
+            run["case"].as_str().unwrap(),
+            run["size"],
+            run["texels"]
+        )));
+    }
+    let svg = std::fs::read_to_string(out.join("scaling.svg")).unwrap();
+    let fits = json["fits"].as_array().unwrap();
+    assert_eq!(fits.len(), 4);
+    for fit in fits {
+        let case = fit["case"].as_str().unwrap();
+        assert!(svg.contains(&format!("{case} (time ~ texels^")), "{case}");
+    }
+    let png = std::fs::read(out.join("scaling.png")).unwrap();
+    assert!(png.starts_with(b"\x89PNG"));
+    let text = String::from_utf8(output.stdout).unwrap();
+    assert!(text.contains("time ~ texels^"), "{text}");
+}
+
 /// `kiln study --quick`: every file, consistent with each other (CSV rows are the JSON's runs),
 /// plots that are an SVG with the legend's entries and a PNG of the stated size, and a summary
 /// line per method. Its timings are not asserted.

@@ -121,3 +121,90 @@ fn csv_files_follow_their_schema() {
     );
     assert_eq!(lines.count(), report.lookup.len());
 }
+
+/// `kiln study --scaling`'s measurements: the lookup error it reports is the one this test
+/// computes on its own (the same fixed points, kiln's reference by its direct entry point), a
+/// larger table's lookup is closer to the truth, every bake met its max error at the nodes,
+/// and the CSV holds the runs.
+#[test]
+fn scaling_study_measures_what_it_reports() {
+    use kiln::integrate::reference::reference_albedo;
+    use kiln::study::scaling::{Case, ScalingSettings, run, scaling_csv};
+    use kiln::{BakeOptions, Quantity};
+    let settings = ScalingSettings {
+        model: model(),
+        max_error: 1e-4,
+        cases: vec![
+            Case {
+                name: "E".into(),
+                quantities: vec![Quantity::E],
+                sizes: vec![4, 8],
+                mu_mapping: MuMapping::Adaptive,
+            },
+            Case {
+                name: "E_dielectric".into(),
+                quantities: vec![Quantity::EDielectric],
+                sizes: vec![3],
+                mu_mapping: MuMapping::Adaptive,
+            },
+        ],
+        lookup_points_per_axis: 5,
+    };
+    let done = std::sync::atomic::AtomicU64::new(0);
+    let report = run(&settings, &|n| {
+        done.fetch_add(n, std::sync::atomic::Ordering::Relaxed);
+    })
+    .unwrap();
+    assert_eq!(done.into_inner(), settings.work());
+    assert_eq!(report.runs.len(), 3);
+    assert_eq!(
+        report.runs.iter().map(|r| r.texels).collect::<Vec<_>>(),
+        [16, 64, 27]
+    );
+    for r in &report.runs {
+        assert!(r.node_max_error <= 1e-4 && r.seconds > 0.0, "{r:?}");
+    }
+    // The E lookup error at size 4, recomputed: the table as the study bakes it, looked up at
+    // (j + 0.37) / 5 of r and mu, against the reference.
+    let table = BakeOptions {
+        quantities: vec![Quantity::E],
+        size: 4,
+        ior_size: 4,
+        max_error: Some(1e-4),
+        ..BakeOptions::default()
+    }
+    .bake(&|_| {})
+    .unwrap()
+    .remove(0);
+    let mut max = 0.0f64;
+    for i in 0..5 {
+        for j in 0..5 {
+            let (r, mu) = ((i as f64 + 0.37) / 5.0, (j as f64 + 0.37) / 5.0);
+            let settings = ReferenceSettings {
+                tolerance: 1e-9,
+                ..ReferenceSettings::default()
+            };
+            let truth = reference_albedo(model(), r * r, mu, &settings).value;
+            max = max.max((table.lookup(mu, r) - truth).abs());
+        }
+    }
+    let reported = report.runs[0].lookup_max_error;
+    assert!((reported - max).abs() <= 1e-7, "{reported:e} vs {max:e}");
+    assert!(report.runs[1].lookup_max_error < reported);
+    // One fit per case, over its sizes.
+    assert_eq!(report.fits.len(), 2);
+    assert_eq!(report.fits[0].sizes, [4, 8]);
+    assert!(report.fits[0].exponent.is_finite() && report.fits[1].exponent.is_nan());
+    let csv = scaling_csv(&report);
+    let mut lines = csv.lines();
+    assert_eq!(
+        lines.next(),
+        Some("case,size,texels,seconds,node_max_error,lookup_max_error,lookup_rms_error")
+    );
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), 3);
+    assert_eq!(
+        (rows[2][0], rows[2][1], rows[2][2]),
+        ("E_dielectric", "3", "27")
+    );
+}

@@ -8,6 +8,7 @@
 
 pub mod estimators;
 pub mod hard_grid;
+pub mod scaling;
 pub mod yardstick;
 
 use crate::bake::{BakeOptions, bake_table};

@@ -192,6 +192,36 @@ pub fn cost_plot(report: &StudyReport) -> Result<(String, Vec<u8>), String> {
     )
 }
 
+/// Bake time against texel count (log-log), one line per case, its fitted exponent in the
+/// legend.
+pub fn scaling_plot(
+    report: &kiln::study::scaling::ScalingReport,
+) -> Result<(String, Vec<u8>), String> {
+    let series: Vec<Series> = report
+        .fits
+        .iter()
+        .map(|fit| Series {
+            name: format!("{} (time ~ texels^{:.2})", fit.case, fit.exponent),
+            points: report
+                .runs
+                .iter()
+                .filter(|r| r.case == fit.case)
+                .map(|r| (r.texels as f64, r.seconds.max(1e-6)))
+                .collect(),
+        })
+        .collect();
+    render(
+        &format!(
+            "How bake time grows with table size: {} {}, to {:.0e}",
+            report.ndf, report.masking, report.max_error
+        ),
+        "texels (all of the case's tables)",
+        &format!("wall time of the bake, {} threads (s)", report.threads),
+        &series,
+        None,
+    )
+}
+
 /// Lookup error against table size, one line per mu mapping.
 pub fn lookup_plot(report: &StudyReport) -> Result<(String, Vec<u8>), String> {
     let mut mappings: Vec<&str> = Vec::new();

@@ -40,9 +40,71 @@ pub struct StudyArgs {
     /// Smith G2 form.
     #[arg(long, value_enum, default_value = "height-correlated")]
     masking: Masking,
+    /// Instead: how cost grows with the work. E, E_avg and the split-sum pair baked at 16 to
+    /// 256 per axis, a dielectric E table at 8 to 32 per axis (--quick: smaller), all to 1e-6
+    /// (--quick: 1e-5); each bake's wall time, node error and lookup error at fixed points go
+    /// to DIR/scaling.csv and scaling.json, time against texel count (log-log, with the fitted
+    /// exponent) to scaling.svg and scaling.png. A few minutes on 2 cores.
+    #[arg(long)]
+    scaling: bool,
     /// No progress bar.
     #[arg(long, short)]
     quiet: bool,
+}
+
+/// `kiln study --scaling`.
+fn run_scaling(args: &StudyArgs, model: Model) -> kiln::Result<()> {
+    use kiln::study::scaling::{self, ScalingSettings};
+    let settings = if args.quick {
+        ScalingSettings::quick(model)
+    } else {
+        ScalingSettings::full(model)
+    };
+    format::check_output_dir(&args.out)?;
+    let bar = crate::progress_bar(args.quiet, settings.work(), "baking");
+    let report = scaling::run(&settings, &|units| bar.inc(units))?;
+    bar.finish_and_clear();
+    let (svg, png) = plot::scaling_plot(&report).map_err(|e| kiln::Error::Format {
+        path: args.out.clone(),
+        message: format!("plotting: {e}"),
+    })?;
+    let json = serde_json::to_string_pretty(&report).expect("a report serialises");
+    let files = vec![
+        (
+            "scaling.csv".to_string(),
+            scaling::scaling_csv(&report).into_bytes(),
+        ),
+        ("scaling.json".to_string(), json.into_bytes()),
+        ("scaling.svg".to_string(), svg.into_bytes()),
+        ("scaling.png".to_string(), png),
+    ];
+    let written = format::write_files(&args.out, &files)?;
+    println!(
+        "{} {}, every table to {:.0e}, {} threads",
+        report.ndf, report.masking, report.max_error, report.threads
+    );
+    println!(
+        "{:<14} {:>5} {:>8} {:>9} {:>10} {:>10}",
+        "case", "size", "texels", "seconds", "node max", "lookup max"
+    );
+    for r in &report.runs {
+        println!(
+            "{:<14} {:>5} {:>8} {:>9.3} {:>10.2e} {:>10.2e}",
+            r.case, r.size, r.texels, r.seconds, r.node_max_error, r.lookup_max_error
+        );
+    }
+    for fit in &report.fits {
+        println!(
+            "{:<14} time ~ texels^{:.2} (sizes {:?})",
+            fit.case, fit.exponent, fit.sizes
+        );
+    }
+    if !args.quiet {
+        for path in written {
+            eprintln!("wrote {}", path.display());
+        }
+    }
+    Ok(())
 }
 
 fn reach_text(reach: &Reach) -> String {
@@ -86,6 +148,9 @@ pub fn run(args: StudyArgs) -> kiln::Result<()> {
         ndf: args.ndf,
         masking: args.masking,
     };
+    if args.scaling {
+        return run_scaling(&args, model);
+    }
     let settings = if args.quick {
         StudySettings::quick(model)
     } else {
