@@ -170,6 +170,17 @@ fn kiln_s_shader_tables_compiles_as_cycles_includes_it() {
         t[at..at + t[at..].find("};").unwrap()].to_string()
     };
     assert_eq!(ltc(&text), ltc(&blender));
+    // A file whose array is not numbers of its declared size is refused, not copied.
+    for bad in [
+        "static const float table_sheen_ltc[3] = { 1.0f, 2.0f };",
+        "static const float table_sheen_ltc[2] = { 1.0f, 2.0f\n#include <x>\n };",
+    ] {
+        let message = Preset::Cycles
+            .carried_from(bad.as_bytes(), "bad")
+            .unwrap_err()
+            .to_string();
+        assert!(message.contains("declared size"), "{message}");
+    }
     // Without it, the file says what to keep.
     let plain =
         String::from_utf8(Preset::Cycles.encode(&numbered_cycles_tables()).unwrap()).unwrap();

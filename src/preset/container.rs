@@ -518,12 +518,27 @@ impl Carried {
             .carried
             .iter()
             .map(|name| {
-                c_declaration(&text, name).ok_or_else(|| {
+                let declaration = c_declaration(&text, name).ok_or_else(|| {
                     Error::InvalidInput(format!(
                         "{origin} has no array {name} to carry over (expected `static const \
                          float {name}[N] = {{ ... }};`, as in Blender's shader.tables)"
                     ))
-                })
+                })?;
+                // Copied verbatim, so it must be nothing but N numbers.
+                let declared = declaration
+                    .split_once('[')
+                    .and_then(|(_, rest)| rest.split_once(']'))
+                    .and_then(|(n, _)| n.trim().parse::<usize>().ok());
+                let values = c_array(&declaration, name);
+                match (declared, values) {
+                    (Some(n), Some(values)) if values.len() == n => Ok(declaration),
+                    (declared, values) => Err(Error::InvalidInput(format!(
+                        "{origin}: {name} is not an array of numbers of its declared size \
+                         ({} declared, {} numbers read): not carried over",
+                        declared.map_or("no size".to_string(), |n| n.to_string()),
+                        values.map_or("no".to_string(), |v| v.len().to_string())
+                    ))),
+                }
             })
             .collect::<Result<_>>()?;
         Ok(Self {
@@ -540,7 +555,7 @@ fn c_declaration(text: &str, name: &str) -> Option<String> {
     loop {
         let at = from + text[from..].find(name)?;
         let after = &text[at + name.len()..];
-        if after.starts_with(|c: char| c.is_alphanumeric() || c == '_') || !after.starts_with('[') {
+        if !after.starts_with('[') {
             from = at + name.len();
             continue;
         }
