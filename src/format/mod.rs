@@ -223,7 +223,8 @@ pub fn as_stored(tables: &[Table], precision: Precision) -> Vec<Table> {
         .collect()
 }
 
-/// The most texels kiln reads from any file or accepts in any metadata ([`crate::table::MAX_TEXELS`]).
+/// The most texels kiln reads from any file or accepts in any metadata
+/// ([`crate::table::MAX_TEXELS`]).
 pub use crate::table::MAX_TEXELS;
 
 /// The largest file kiln reads: 2 GiB (a 4096 x 4096 table with its three channels in JSON is

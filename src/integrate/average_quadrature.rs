@@ -3,7 +3,8 @@
 //! against it (tests, `kiln verify`).
 //!
 //! `E_avg = 2 ∫_0^1 E(mu) mu dmu` (`docs/physics.md`). In the adaptive table coordinate
-//! `t = (mu (1 + c alpha) / (mu + c alpha))^p` ([`crate::table::axis::MuMapping::Adaptive`]) the grazing boundary
+//! `t = (mu (1 + c alpha) / (mu + c alpha))^p` ([`crate::table::axis::MuMapping::Adaptive`],
+//! [`super::grazing`]) the grazing boundary
 //! layer `mu ~ alpha` is smooth at every `alpha`, so the integral over `mu in [0, mu_c]`,
 //! `mu_c = min(8 alpha, 1)`, is taken in `t`, with `2 mu dmu = 2 mu (dmu/dt) dt`,
 //! `dmu/dt = k (1 + k) / (1 + k - s)^2 * s / (p t)`, `s = t^(1/p)`, `k = c alpha`. Beyond

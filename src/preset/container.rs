@@ -306,24 +306,23 @@ pub(super) fn decode(
                 }
                 return Ok((vec![(Quantity::FMsNorm, norm)], None));
             }
-            // Every array that must be there first, then each one's size.
-            if let Some((name, _)) = arrays
+            // Each array read once; every required one must be there before any size is
+            // checked (a file from before Cycles' glass tables, or without them, is read
+            // without them).
+            let found: Vec<(&str, Quantity, Option<Vec<f64>>)> = arrays
                 .iter()
-                .find(|(name, q)| !q.has_ior() && c_array(&text, name).is_none())
+                .map(|&(name, quantity)| (name, quantity, c_array(&text, name)))
+                .collect();
+            if let Some((name, _, _)) = found
+                .iter()
+                .find(|(_, q, values)| !q.has_ior() && values.is_none())
             {
                 return Err(bad(format!("no {name}")));
             }
             let mut tables = Vec::new();
-            for &(name, quantity) in arrays {
+            for (name, quantity, values) in found {
+                let Some(values) = values else { continue };
                 let glass = quantity.has_ior().then_some(layout.glass).flatten();
-                let Some(values) = c_array(&text, name) else {
-                    // A file from before Cycles' glass tables (or without them) is read
-                    // without them; the other arrays are required.
-                    if glass.is_some() {
-                        continue;
-                    }
-                    return Err(bad(format!("no {name}")));
-                };
                 let (side, slices) = match glass {
                     Some(g) => (g.size, g.size),
                     None => (n, 1),

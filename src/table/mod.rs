@@ -12,7 +12,8 @@ use serde::{Deserialize, Serialize};
 
 pub use crate::integrate::quantity::{Quantity, schlick_weight};
 
-/// The most texels kiln reads from any file or accepts in any metadata (checked by [`TableSpec::check`]): 2^26, a 4096 x 4096
+/// The most texels kiln reads from any file or accepts in any metadata (checked by
+/// [`TableSpec::check`]): 2^26, a 4096 x 4096
 /// table (the largest 2-D table kiln bakes, [`crate::BakeOptions::MAX_SIZE`]). A header that
 /// claims more is refused before anything is allocated or decompressed.
 pub const MAX_TEXELS: usize = 1 << 26;

@@ -58,8 +58,9 @@ pub struct VerifyArgs {
     #[arg(long)]
     json: bool,
     /// FILE is an engine's own table in that engine's layout (cycles: shader.tables with
-    /// table_ggx_E, table_ggx_Eavg and the glass arrays, those in Cycles' convention; bevy: dfg.ktx2, zstd or not; three: the DFG LUT's
-    /// Uint16Array; enterprise-pbr: GGX_E.exr or GGX_E_avg.exr; filament: dfg.inc, RGB or RG
+    /// table_ggx_E, table_ggx_Eavg and the glass arrays, those in Cycles' convention; bevy:
+    /// dfg.ktx2, zstd or not; three: the DFG LUT's Uint16Array; enterprise-pbr: GGX_E.exr or
+    /// GGX_E_avg.exr; filament: dfg.inc, RGB or RG
     /// half bits; godot: dfg_lut.dds; unity-hdrp and unreal: their EXR; games202:
     /// GGX_E_LUT.png or GGX_Eavg_LUT.png, told apart by their rows): audit each of its tables
     /// against the reference for the model the engine evaluates (GGX, height-correlated; Godot
@@ -579,11 +580,11 @@ pub fn run(args: VerifyArgs) -> kiln::Result<bool> {
             .read_tables(&bytes, &args.file.display().to_string())
             .map_err(in_file)?;
         if let Some(only) = &args.only {
-            let held: Vec<&str> = tables.iter().map(|t| t.spec.quantity.cli_name()).collect();
             if let Some(missing) = only
                 .iter()
                 .find(|q| !tables.iter().any(|t| t.spec.quantity == **q))
             {
+                let held: Vec<&str> = tables.iter().map(|t| t.spec.quantity.cli_name()).collect();
                 return Err(kiln::Error::InvalidInput(format!(
                     "{}: --only names {}, but the file holds {} in the {} layout",
                     args.file.display(),
