@@ -14,7 +14,11 @@
 //! has a kink: the peak (`x = 0`), the reflected direction's horizon (closed form), the critical
 //! angle of total internal reflection (`o.m = sqrt(1 - eta^2)` for `eta < 1`, closed form: `o.m =
 //! rho cos(theta - delta)` along the `phi` slice), the refracted direction's horizon (found by
-//! bisection between sign changes on a scan) and the edge of visibility.
+//! bisection between sign changes on a scan uniform in `theta_m`) and the edge of visibility.
+//! Geometric ladders of breaks close in on the two horizons, whose masking layers are ~`alpha`
+//! wide (as `E`'s horizon ladder). The piece below the peak is integrated from `x = -infinity` in
+//! `s = t / (alpha + t)`, as in `E`'s reference; above, `x` is cut where GGX's tail holds a
+//! hundredth of the tolerance ([`super::reference::x_range`]).
 //!
 //! Limits: `alpha = 0` with `mu > 0` is the smooth interface, `R = F(mu)`, `T = 1 - F(mu)`,
 //! `E = 1` exactly. Unlike `E`, `E_eta(0)` is not 1 in general (for `eta < 1` refracted directions
@@ -398,6 +402,20 @@ pub fn reference_dielectric_average_albedo_with(
     }
 }
 
+/// Distances of a geometric ladder of breaks closing in on a masking layer of width `layer`
+/// (in `x`): from a sixteenth of it, four times further each rung, up to 8 (as the `E`
+/// reference's horizon ladder, [`super::reference::horizon_breaks`]), so every scale between the
+/// layer and the piece has intervals of its own.
+fn ladder(layer: f64) -> Vec<f64> {
+    let mut rungs = Vec::new();
+    let mut distance = layer.abs() / 16.0;
+    while distance > 0.0 && distance < 8.0 {
+        rungs.push(distance);
+        distance *= 4.0;
+    }
+    rungs
+}
+
 /// `[R, T, 1 - E]` for one distribution (see the module docs).
 fn quadrature<N: MicrofacetDistribution>(
     ndf: N,
@@ -419,22 +437,30 @@ fn quadrature<N: MicrofacetDistribution>(
     let inverse_area = 1.0 / ndf.projected_area(mu);
     let (x_min, x_max) = x_range(alpha, settings.tolerance);
     let x_of_theta = |theta: f64| (theta.tan() / alpha).ln().clamp(x_min, x_max);
-    let normal = |x: f64, cos_phi: f64, sin_phi: f64| {
-        let t = alpha * x.exp();
+    let normal_at = |t: f64, cos_phi: f64, sin_phi: f64| {
         let cos_t = 1.0 / (1.0 + t * t).sqrt();
         let sin_t = t * cos_t;
-        (Vec3::new(sin_t * cos_phi, sin_t * sin_phi, cos_t), t)
+        Vec3::new(sin_t * cos_phi, sin_t * sin_phi, cos_t)
     };
-    // [R, T, 1 - E] per unit x and phi.
-    let point = |x: f64, cos_phi: f64, sin_phi: f64| -> [f64; 3] {
-        let (m, t) = normal(x, cos_phi, sin_phi);
+    let normal = |x: f64, cos_phi: f64, sin_phi: f64| {
+        let t = alpha * x.exp();
+        (normal_at(t, cos_phi, sin_phi), t)
+    };
+    // [R, T, 1 - E] per unit x and phi at `t = tan(theta_m)`, times `jacobian` (`dx/dv` for
+    // another variable `v`).
+    let point_at = |t: f64, jacobian: f64, cos_phi: f64, sin_phi: f64| -> [f64; 3] {
+        // A node rounded onto `s = 0` (see below), where the integrand vanishes.
+        if !(t > 0.0 && t < f64::INFINITY) {
+            return [0.0; 3];
+        }
+        let m = normal_at(t, cos_phi, sin_phi);
         let om = o.dot(m);
         if om <= 0.0 {
             return [0.0; 3];
         }
         // dω_m = sin^2 cos dx dphi in these variables; G1(o) (o.m) D / mu is the visible density.
         let sin_t = t * m.z;
-        let density = ndf.d_from_tan2(t * t) * sin_t * sin_t * m.z * om * inverse_area;
+        let density = ndf.d_from_tan2(t * t) * sin_t * sin_t * m.z * om * inverse_area * jacobian;
         let s = scattering_with(ndf, masking, o, lambda_o, m, eta, convention);
         [
             density * s.reflection,
@@ -442,6 +468,8 @@ fn quadrature<N: MicrofacetDistribution>(
             density * s.loss,
         ]
     };
+    let point =
+        |x: f64, cos_phi: f64, sin_phi: f64| point_at(alpha * x.exp(), 1.0, cos_phi, sin_phi);
     // The z of the refracted direction, where there is one.
     let refracted_z = |x: f64, cos_phi: f64, sin_phi: f64| -> Option<f64> {
         let (m, _) = normal(x, cos_phi, sin_phi);
@@ -480,12 +508,14 @@ fn quadrature<N: MicrofacetDistribution>(
                 }
             }
         }
-        // Sign changes of the refracted direction's z: a scan, then bisection.
-        const SCAN: usize = 16;
-        let step = (x_visible - x_min) / SCAN as f64;
+        // Sign changes of the refracted direction's z: a scan, then bisection. The scan is
+        // uniform in theta_m (a scan uniform in x, over the range a tight tolerance needs,
+        // stepped over pairs of sign changes near the peak: 6e-10 lost at 1e-12).
+        const SCAN: usize = 32;
+        let theta_visible = (x_visible.exp() * alpha).atan();
         let mut previous: Option<(f64, f64)> = None;
         for k in 0..=SCAN {
-            let x = x_min + step * k as f64;
+            let x = x_of_theta(theta_visible * k as f64 / SCAN as f64);
             let z = refracted_z(x, cos_phi, sin_phi);
             if let (Some((x0, z0)), Some(z1)) = (previous, z)
                 && (z0 < 0.0) != (z1 < 0.0)
@@ -498,22 +528,58 @@ fn quadrature<N: MicrofacetDistribution>(
                         _ => hi = mid,
                     }
                 }
-                breaks.push(0.5 * (lo + hi));
+                let root = 0.5 * (lo + hi);
+                breaks.push(root);
+                // The refracted direction grazes the horizon here: its masking layer, on both
+                // sides.
+                let layer = 2.0 * alpha / (2.0 * (alpha * root.exp()).atan()).sin();
+                for rung in ladder(layer) {
+                    breaks.extend([root - rung, root + rung]);
+                }
             }
             previous = z.map(|z| (x, z));
         }
         evaluations += (SCAN as u64 + 1) * 2;
+        // The reflected direction's masking layer below its horizon curve (as in `E`'s
+        // reference: a layer of width ~alpha / sin(2 theta*) in x, which a piece much wider
+        // than it can step over unseen).
+        let x_star = x_of_theta(theta_star);
+        for rung in ladder(alpha / (2.0 * theta_star).sin()) {
+            breaks.push(x_star - rung);
+        }
         breaks.extend(&critical);
         breaks.retain(|&b| b >= x_min && b <= x_visible);
         breaks.sort_by(f64::total_cmp);
         breaks.dedup();
+        // The piece from x_min is integrated from x = -infinity in s (below); when it ends at a
+        // critical angle, a break a unit before it keeps the square-root piece finite.
+        if let Some(&first) = breaks.get(1)
+            && first <= 0.0
+            && critical.contains(&first)
+            && first - 1.0 > x_min
+        {
+            breaks.insert(1, first - 1.0);
+        }
         // Beside the critical angle 1 - F and the refracted direction go as sqrt(distance):
         // integrate those pieces in s with x = edge +- s^2, which makes them smooth.
         let pieces = breaks.len().saturating_sub(1).max(1) as f64;
         let mut total = [0.0; 4];
         for pair in breaks.windows(2) {
             let (a, b) = (pair[0], pair[1]);
-            let q = if critical.contains(&a) {
+            let q = if a == x_min && b <= 0.0 && !critical.contains(&b) {
+                // Below the peak, from x = -infinity: in `s = t / (alpha + t)`, where the
+                // integrand (`~ e^(2x)` per unit x) is polynomial (as in `E`'s reference).
+                integrate(
+                    |s: f64| {
+                        let t = alpha * s / (1.0 - s);
+                        point_at(t, 1.0 / (s * (1.0 - s)), cos_phi, sin_phi)
+                    },
+                    0.0,
+                    1.0 / (1.0 + (-b).exp()),
+                    inner_tolerance / pieces,
+                    settings.max_intervals,
+                )
+            } else if critical.contains(&a) {
                 integrate(
                     |s: f64| point(a + s * s, cos_phi, sin_phi).map(|v| 2.0 * s * v),
                     0.0,

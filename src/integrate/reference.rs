@@ -13,6 +13,15 @@
 //!   cancellation ([`Masking::loss`]);
 //! - piece B (`m` visible, `i` below the horizon): only `1 - E` gathers, with `loss = 1`.
 //!
+//! The tails are integrated in the logistic of `x`, `s = t / (alpha + t)` (`t = tan(theta_m)`,
+//! `dx = ds / (s (1 - s))`), which maps the whole line onto `[0, 1]` with nothing cut off: below
+//! the peak (`x < 0`, where the integrand goes as `e^(2x)`, i.e. `s^2`) and over piece B (the bare
+//! distribution, whose GGX tail goes as `e^(-x)`, i.e. `1 - s`), both polynomial in `s`. Piece A
+//! above the peak stays in `x`: there the masking loss has its layer at the horizon curve, which
+//! `s` would squeeze into the last thousandth of the range at a grazing view. The integrand then
+//! needs no exponential, and a table costs 35 to 45 % fewer evaluations than with `x` throughout
+//! (cut to a range the tolerance needs).
+//!
 //! `1 - E` so becomes an integral of its own (by the visible-normal normalisation
 //! `∫ (o.m)+ D dω = mu (1 + Lambda(o))`), never `1 - E` subtracted. `G1(o) / mu` is evaluated as
 //! `1 / projected_area(mu)`, which stays finite at `mu = 0`.
@@ -244,13 +253,36 @@ fn albedo_quadrature<N: MicrofacetDistribution>(
     });
     // G1(o) / mu, finite at mu = 0.
     let inverse_area = 1.0 / ndf.projected_area(mu);
-    // The x range the tolerance needs ([`x_range`]).
-    let (x_min, x_max) = x_range(alpha, settings.tolerance);
-    let x_of_tan = |tan: f64| (tan / alpha).ln().clamp(x_min, x_max);
+    // The inner variables (module docs): `x = ln(t / alpha)`, `t = tan(theta_m)`, above the
+    // peak in piece A; its logistic `s = t / (alpha + t)` below the peak and in piece B.
+    let s_of_x = |x: f64| 1.0 / (1.0 + (-x).exp());
+    let s_of_tan = |tan: f64| {
+        if tan.is_finite() {
+            tan / (alpha + tan)
+        } else {
+            1.0
+        }
+    };
+    // Piece A's variable: `u = s` for `x < 0`, `u = 1/2 + x` beyond; `(t, dx/du)` at `u`.
+    let u_of_x = |x: f64| if x < 0.0 { s_of_x(x) } else { 0.5 + x };
+    let a_variable = |u: f64| {
+        if u < 0.5 {
+            (alpha * u / (1.0 - u), 1.0 / (u * (1.0 - u)))
+        } else {
+            (alpha * (u - 0.5).exp(), 1.0)
+        }
+    };
+    // Piece B's: `(t, dx/ds)` at `s`.
+    let b_variable = |s: f64| (alpha * s / (1.0 - s), 1.0 / (s * (1.0 - s)));
 
-    // The integrand at (x, phi): [E part, 1 - E part] per unit x, before the phi integral.
-    let point = |x: f64, cos_phi: f64, sin_phi: f64, below: bool| -> [f64; 2] {
-        let t = alpha * x.exp();
+    // The integrand at `t = tan(theta_m)` and phi, times `dx/dv` for the variable `v` in use:
+    // [E part, 1 - E part] per unit `v`, before the phi integral.
+    let point = |(t, jacobian): (f64, f64), cos_phi: f64, sin_phi: f64, below: bool| -> [f64; 2] {
+        // A node that rounds onto an end of the range (u = 0, s = 1 in f64), where the integrand
+        // per unit of the variable vanishes (s = 0) or its interval holds nothing f64 can add.
+        if !(t > 0.0 && t < f64::INFINITY) {
+            return [0.0, 0.0];
+        }
         let t2 = t * t;
         let cos_t = 1.0 / (1.0 + t2).sqrt();
         let sin_t = t * cos_t;
@@ -259,8 +291,8 @@ fn albedo_quadrature<N: MicrofacetDistribution>(
         if om <= 0.0 {
             return [0.0, 0.0];
         }
-        // dω_m = sin^2 cos dx dphi in these variables.
-        let weight = ndf.d_from_tan2(t2) * sin_t * sin_t * cos_t * om;
+        // dω_m = sin^2 cos dx dphi.
+        let weight = ndf.d_from_tan2(t2) * sin_t * sin_t * cos_t * om * jacobian;
         let i = o.reflect(m);
         if below || i.z <= 0.0 {
             return [0.0, weight * inverse_area];
@@ -288,24 +320,30 @@ fn albedo_quadrature<N: MicrofacetDistribution>(
         let (sin_phi, cos_phi) = phi.sin_cos();
         // Horizon curve of the reflected direction, and the edge of visibility.
         let theta_star = 0.5 * (PI - mu.atan2(so * cos_phi));
-        let x_star = x_of_tan(theta_star.tan());
-        let x_visible = if cos_phi < 0.0 && so > 0.0 {
-            x_of_tan(mu / (so * -cos_phi))
+        let tan_star = theta_star.tan();
+        let s_visible = if cos_phi < 0.0 && so > 0.0 {
+            s_of_tan(mu / (so * -cos_phi))
         } else {
-            x_max
+            1.0
         };
-        let mut above = |x: f64| point(x, cos_phi, sin_phi, false);
-        let peak = 0.0_f64.clamp(x_min, x_star);
-        let a = integrate_pieces(
-            &mut above,
-            &horizon_breaks(x_min, peak, x_star, alpha, theta_star),
-            inner_tolerance,
-            settings.max_intervals,
-        );
-        let mut below = |x: f64| point(x, cos_phi, sin_phi, true);
+        let mut above = |u: f64| point(a_variable(u), cos_phi, sin_phi, false);
+        let x_star = (tan_star / alpha).ln();
+        let breaks: Vec<f64> = horizon_breaks(
+            f64::NEG_INFINITY,
+            0.0_f64.min(x_star),
+            x_star,
+            alpha,
+            theta_star,
+        )
+        .into_iter()
+        .map(u_of_x)
+        .collect();
+        let s_star = s_of_tan(tan_star);
+        let a = integrate_pieces(&mut above, &breaks, inner_tolerance, settings.max_intervals);
+        let mut below = |s: f64| point(b_variable(s), cos_phi, sin_phi, true);
         let b = integrate_pieces(
             &mut below,
-            &[x_star, x_visible.max(x_star)],
+            &[s_star, s_visible.max(s_star)],
             inner_tolerance,
             settings.max_intervals,
         );
@@ -333,7 +371,8 @@ fn albedo_quadrature<N: MicrofacetDistribution>(
 /// hold about `exp(2 x)` of the mass (`tan^2 / alpha^2` near the peak's foot), above it GGX's tail
 /// holds about `2 alpha exp(-x)` (Beckmann far less): cut where each is a hundredth of the
 /// tolerance, within the hard limits. At loose tolerances this spares the adaptive rule most of
-/// its splits (a 1e-6 table costs 40 % less); at 1e-11 the range is [-15, 30].
+/// its splits (a 1e-6 table costs 40 % less); at 1e-11 the range is [-15, 30]. The dielectric
+/// quadrature's range ([`super::dielectric`]); `E`'s own integrates its tails in `s` instead.
 pub(crate) fn x_range(alpha: f64, tolerance: f64) -> (f64, f64) {
     let x_min = (0.5 * (tolerance * 0.01).ln()).max(X_MIN);
     let x_max = (100.0 * alpha.max(1.0) / tolerance).ln().min(X_MAX);

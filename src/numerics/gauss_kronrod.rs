@@ -82,7 +82,14 @@ fn kronrod<const N: usize>(f: &mut impl FnMut(f64) -> [f64; N], a: f64, b: f64) 
     for c in 0..N {
         k[c] *= half;
         g[c] *= half;
-        error = error.max((k[c] - g[c]).abs());
+        // `f64::max` would drop a NaN: a value that is not a number makes the estimate NaN,
+        // so the interval is never counted as converged.
+        let difference = (k[c] - g[c]).abs();
+        error = if difference.is_nan() {
+            f64::NAN
+        } else {
+            error.max(difference)
+        };
     }
     (k, error)
 }
@@ -182,6 +189,26 @@ pub fn integrate_pieces<const N: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// An integrand that is NaN somewhere gives a NaN value and error and `converged: false`,
+    /// never a finite error beside a NaN value (`f64::max` drops NaN; an estimate built on it
+    /// claimed convergence).
+    #[test]
+    fn a_nan_integrand_is_never_converged() {
+        let q = integrate(
+            |x: f64| [1.0, if x > 0.7 { f64::NAN } else { x }],
+            0.0,
+            1.0,
+            1e-10,
+            50,
+        );
+        assert!(
+            q.value[1].is_nan() && q.error.is_nan() && !q.converged,
+            "{q:?}"
+        );
+        let q = integrate(|x: f64| [x], 0.0, 1.0, 1e-10, 50);
+        assert!(q.converged && (q.value[0] - 0.5).abs() < 1e-15);
+    }
 
     #[test]
     fn rules_integrate_polynomials_exactly() {

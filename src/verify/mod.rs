@@ -312,6 +312,7 @@ pub fn audit(
         };
         let finest = finest.tolerance;
         let mut tolerance = finest;
+        let mut scouted = None;
         if group.len() >= 4 * SCOUT_STRIDE && finest < SCOUT_TOLERANCE {
             let sample: Vec<(Coordinates, f64)> =
                 group.iter().copied().step_by(SCOUT_STRIDE).collect();
@@ -322,9 +323,36 @@ pub fn audit(
             } else {
                 SCOUT_TOLERANCE
             };
+            scouted = Some(scout);
         }
         loop {
-            let measured = compare(group, tolerance);
+            let measured = match scouted.take() {
+                // The scouted points already hold the truth at this tolerance: only the rest.
+                Some(scout) if tolerance == scout.tolerance => {
+                    let rest: Vec<(Coordinates, f64)> = group
+                        .iter()
+                        .enumerate()
+                        .filter(|(k, _)| k % SCOUT_STRIDE != 0)
+                        .map(|(_, p)| *p)
+                        .collect();
+                    let (mut scout_points, mut rest_points) = (
+                        scout.points.into_iter(),
+                        compare(&rest, tolerance).points.into_iter(),
+                    );
+                    let points = (0..group.len())
+                        .map(|k| {
+                            if k % SCOUT_STRIDE == 0 {
+                                scout_points.next()
+                            } else {
+                                rest_points.next()
+                            }
+                            .expect("every point measured once")
+                        })
+                        .collect();
+                    Measured { points, tolerance }
+                }
+                _ => compare(group, tolerance),
+            };
             let figure = measured.smallest_figure(with_p99);
             let needed = tolerance_for(figure, finest);
             // Settled within a factor of two of what the figures call for (or NaN: nothing to
