@@ -551,6 +551,16 @@ fn quadrature<N: MicrofacetDistribution>(
         breaks.retain(|&b| b >= x_min && b <= x_visible);
         breaks.sort_by(f64::total_cmp);
         breaks.dedup();
+        // A piece between the two critical angles has a square root at both ends: split it, so
+        // that each half has one, which its substitution below makes smooth.
+        if let [first, second] = critical[..]
+            && breaks
+                .windows(2)
+                .any(|w| (w[0] == first && w[1] == second) || (w[0] == second && w[1] == first))
+        {
+            breaks.push(0.5 * (first + second));
+            breaks.sort_by(f64::total_cmp);
+        }
         // The piece from x_min is integrated from x = -infinity in s (below); when it ends at a
         // critical angle, a break a unit before it keeps the square-root piece finite.
         if let Some(&first) = breaks.get(1)
