@@ -241,7 +241,7 @@ impl BakeOptions {
     /// verify`: 2.5e-10 at tolerance 1e-7), so every texel is within the tolerance; until
     /// numerics version 5 the tolerance was a tenth of that, and the tables came out 100 to 1000
     /// times better than asked, at up to twice the cost. The dielectric one's has been seen
-    /// short by up to 1.8x, hence its tenth. Either way the result is then checked against the
+    /// short by up to 3.7x (`docs/accuracy.md`, known limits), hence its tenth. Either way the result is then checked against the
     /// reference on a sample of texels ([`confirmation_sample`]).
     #[must_use]
     pub fn resolved(&self) -> BakeOptions {
@@ -329,8 +329,9 @@ impl BakeOptions {
                     .map(move |quantity| {
                         let spec = |quantity: Quantity| TableSpec {
                             // The dielectric quadrature's stated error has been seen short of
-                            // its actual error (by 1.8x on a grid at 1e-9; by 1.6x at a node
-                            // of an inside table at 1e-7): a tenth of the bound for them.
+                            // its actual error (by 1.8x on a grid at 1e-9; by 3.7x at a node of
+                            // an inside table at 1e-7, which then missed a bound of 1e-7 by
+                            // 1.6x): a tenth of the bound for them.
                             reference_digits: reference_digits
                                 .map(|d| if quantity.has_ior() { d + 1 } else { d }),
                             lookup_of: None,

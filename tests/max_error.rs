@@ -88,7 +88,7 @@ fn looser_bounds_cost_fewer_samples() {
     assert_eq!(digits(3e-7), Some(7));
     assert_eq!(digits(1e-2), None);
     // The tables over IOR get a tenth of the bound (their quadrature's stated error has been
-    // seen short of the actual by 1.6x at 1e-7), the others the bound itself.
+    // seen short of the actual by 3.7x at 1e-7), the others the bound itself.
     let specs = BakeOptions {
         max_error: Some(1e-5),
         quantities: vec![
