@@ -34,7 +34,9 @@ use super::albedo::{
 };
 use super::estimate::Estimate;
 use super::gauss_kronrod::{integrate, integrate_pieces};
-use super::reference::{ReferenceSettings, ReferenceValue, phi_breaks, x_range};
+use super::reference::{
+    ReferenceSettings, ReferenceValue, ladder, phi_breaks, s_of_x, t_of_s, x_range,
+};
 use crate::model::dielectric::{TransmissionConvention, refract, scattering_with};
 use crate::model::fresnel::dielectric;
 use crate::model::{
@@ -402,19 +404,8 @@ pub fn reference_dielectric_average_albedo_with(
     }
 }
 
-/// Distances of a geometric ladder of breaks closing in on a masking layer of width `layer`
-/// (in `x`): from a sixteenth of it, four times further each rung, up to 8 (as the `E`
-/// reference's horizon ladder, [`super::reference::horizon_breaks`]), so every scale between the
-/// layer and the piece has intervals of its own.
-fn ladder(layer: f64) -> Vec<f64> {
-    let mut rungs = Vec::new();
-    let mut distance = layer.abs() / 16.0;
-    while distance > 0.0 && distance < 8.0 {
-        rungs.push(distance);
-        distance *= 4.0;
-    }
-    rungs
-}
+/// How far (in `x`) the ladders toward the two horizons reach.
+const LADDER_REACH: f64 = 8.0;
 
 /// `[R, T, 1 - E]` for one distribution (see the module docs).
 fn quadrature<N: MicrofacetDistribution>(
@@ -493,7 +484,8 @@ fn quadrature<N: MicrofacetDistribution>(
         } else {
             x_max
         };
-        let mut breaks = vec![x_min, x_visible, 0.0, x_of_theta(theta_star)];
+        let x_star = x_of_theta(theta_star);
+        let mut breaks = vec![x_min, x_visible, 0.0, x_star];
         let mut critical = Vec::new();
         // o.m = rho cos(theta - delta) along this slice.
         let rho = (mu * mu + so * so * cos_phi * cos_phi).sqrt();
@@ -533,7 +525,7 @@ fn quadrature<N: MicrofacetDistribution>(
                 // The refracted direction grazes the horizon here: its masking layer, on both
                 // sides.
                 let layer = 2.0 * alpha / (2.0 * (alpha * root.exp()).atan()).sin();
-                for rung in ladder(layer) {
+                for rung in ladder(layer, LADDER_REACH) {
                     breaks.extend([root - rung, root + rung]);
                 }
             }
@@ -543,8 +535,7 @@ fn quadrature<N: MicrofacetDistribution>(
         // The reflected direction's masking layer below its horizon curve (as in `E`'s
         // reference: a layer of width ~alpha / sin(2 theta*) in x, which a piece much wider
         // than it can step over unseen).
-        let x_star = x_of_theta(theta_star);
-        for rung in ladder(alpha / (2.0 * theta_star).sin()) {
+        for rung in ladder(alpha / (2.0 * theta_star).sin(), LADDER_REACH) {
             breaks.push(x_star - rung);
         }
         breaks.extend(&critical);
@@ -581,11 +572,11 @@ fn quadrature<N: MicrofacetDistribution>(
                 // integrand (`~ e^(2x)` per unit x) is polynomial (as in `E`'s reference).
                 integrate(
                     |s: f64| {
-                        let t = alpha * s / (1.0 - s);
-                        point_at(t, 1.0 / (s * (1.0 - s)), cos_phi, sin_phi)
+                        let (t, jacobian) = t_of_s(s, alpha);
+                        point_at(t, jacobian, cos_phi, sin_phi)
                     },
                     0.0,
-                    1.0 / (1.0 + (-b).exp()),
+                    s_of_x(b),
                     inner_tolerance / pieces,
                     settings.max_intervals,
                 )

@@ -254,8 +254,8 @@ fn albedo_quadrature<N: MicrofacetDistribution>(
     // G1(o) / mu, finite at mu = 0.
     let inverse_area = 1.0 / ndf.projected_area(mu);
     // The inner variables (module docs): `x = ln(t / alpha)`, `t = tan(theta_m)`, above the
-    // peak in piece A; its logistic `s = t / (alpha + t)` below the peak and in piece B.
-    let s_of_x = |x: f64| 1.0 / (1.0 + (-x).exp());
+    // peak in piece A; its logistic `s = t / (alpha + t)` ([`t_of_s`]) below the peak and in
+    // piece B.
     let s_of_tan = |tan: f64| {
         if tan.is_finite() {
             tan / (alpha + tan)
@@ -267,13 +267,11 @@ fn albedo_quadrature<N: MicrofacetDistribution>(
     let u_of_x = |x: f64| if x < 0.0 { s_of_x(x) } else { 0.5 + x };
     let a_variable = |u: f64| {
         if u < 0.5 {
-            (alpha * u / (1.0 - u), 1.0 / (u * (1.0 - u)))
+            t_of_s(u, alpha)
         } else {
             (alpha * (u - 0.5).exp(), 1.0)
         }
     };
-    // Piece B's: `(t, dx/ds)` at `s`.
-    let b_variable = |s: f64| (alpha * s / (1.0 - s), 1.0 / (s * (1.0 - s)));
 
     // The integrand at `t = tan(theta_m)` and phi, times `dx/dv` for the variable `v` in use:
     // [E part, 1 - E part] per unit `v`, before the phi integral.
@@ -340,7 +338,7 @@ fn albedo_quadrature<N: MicrofacetDistribution>(
         .collect();
         let s_star = s_of_tan(tan_star);
         let a = integrate_pieces(&mut above, &breaks, inner_tolerance, settings.max_intervals);
-        let mut below = |s: f64| point(b_variable(s), cos_phi, sin_phi, true);
+        let mut below = |s: f64| point(t_of_s(s, alpha), cos_phi, sin_phi, true);
         let b = integrate_pieces(
             &mut below,
             &[s_star, s_visible.max(s_star)],
@@ -379,6 +377,29 @@ pub(crate) fn x_range(alpha: f64, tolerance: f64) -> (f64, f64) {
     (x_min, x_max)
 }
 
+/// The logistic of `x = ln(t / alpha)`: `s = t / (alpha + t)` (module docs).
+pub(crate) fn s_of_x(x: f64) -> f64 {
+    1.0 / (1.0 + (-x).exp())
+}
+
+/// `(t, dx/ds)` at `s = t / (alpha + t)`: `t = alpha s / (1 - s)`, `dx/ds = 1 / (s (1 - s))`.
+pub(crate) fn t_of_s(s: f64, alpha: f64) -> (f64, f64) {
+    (alpha * s / (1.0 - s), 1.0 / (s * (1.0 - s)))
+}
+
+/// Distances of a geometric ladder of breaks closing in on a masking layer of width `layer` (in
+/// `x`): from a sixteenth of it, four times further each rung, below `limit`, so that every
+/// scale between the layer and the piece has intervals of its own.
+pub(crate) fn ladder(layer: f64, limit: f64) -> Vec<f64> {
+    let mut rungs = Vec::new();
+    let mut distance = layer.abs() / 16.0;
+    while distance > 0.0 && distance < limit {
+        rungs.push(distance);
+        distance *= 4.0;
+    }
+    rungs
+}
+
 /// Breaks of piece A's `x` range `[x_min, x_star]`: the peak, then a geometric ladder closing in
 /// on the horizon curve `x_star`. Just below it the reflected direction grazes the horizon and
 /// the masking loss climbs from ~0 to 1 within an angle ~`alpha` of the horizon, a tilt of
@@ -396,13 +417,8 @@ pub(crate) fn horizon_breaks(
 ) -> Vec<f64> {
     let mut breaks = vec![x_min, peak];
     let layer = alpha / (2.0 * theta_star).sin().max(1e-300);
-    let mut ladder = Vec::new();
-    let mut distance = layer / 16.0;
-    while x_star - distance > peak && distance > 0.0 {
-        ladder.push(x_star - distance);
-        distance *= 4.0;
-    }
-    breaks.extend(ladder.into_iter().rev());
+    let rungs = ladder(layer, x_star - peak);
+    breaks.extend(rungs.into_iter().rev().map(|d| x_star - d));
     breaks.push(x_star);
     breaks
 }

@@ -113,8 +113,7 @@ pub struct BakeArgs {
     /// Bake an engine's table in that engine's own layout, to drop in for its file: cycles
     /// (shader.tables: table_ggx_E, table_ggx_Eavg and the four glass arrays, in Cycles'
     /// transmission convention, to 1e-5 unless --max-error is given), bevy (dfg.ktx2, RG16F
-    /// scale/bias, 64 x 64,
-    /// zstd), three (DFGLUTData.js as three ships it, 16 x 16 transposed half bits),
+    /// scale/bias, 64 x 64, zstd), three (DFGLUTData.js as three ships it, 16 x 16 transposed half bits),
     /// enterprise-pbr (GGX_E.exr and GGX_E_avg.exr, half channel Y), filament (dfg.inc, 128 x
     /// 128 RGB16F half bits, cloth in B), godot (dfg_lut.dds, RGBA16F, rows at 1 - r,
     /// Schlick-GGX), unity-hdrp (preIntegratedFGD_GGXDisneyDiffuse.exr, 64 x 64, sqrt(NoV)

@@ -60,8 +60,7 @@ pub struct VerifyArgs {
     /// FILE is an engine's own table in that engine's layout (cycles: shader.tables with
     /// table_ggx_E, table_ggx_Eavg and the glass arrays, those in Cycles' convention; bevy:
     /// dfg.ktx2, zstd or not; three: the DFG LUT's Uint16Array; enterprise-pbr: GGX_E.exr or
-    /// GGX_E_avg.exr; filament: dfg.inc, RGB or RG
-    /// half bits; godot: dfg_lut.dds; unity-hdrp and unreal: their EXR; games202:
+    /// GGX_E_avg.exr; filament: dfg.inc, RGB or RG half bits; godot: dfg_lut.dds; unity-hdrp and unreal: their EXR; games202:
     /// GGX_E_LUT.png or GGX_Eavg_LUT.png, told apart by their rows): audit each of its tables
     /// against the reference for the model the engine evaluates (GGX, height-correlated; Godot
     /// and GAMES202: separable Schlick-GGX), with what half-float or 8-bit storage alone costs
