@@ -234,15 +234,16 @@ impl BakeOptions {
     /// falls as about `N^-0.9`, at the smallest power of two `N >= (2 / max_error)^(1 / 0.9)`
     /// (twice the margin; 16 times that for `E_avg`); below 1e-3, where it is cheaper at every
     /// accuracy, the quadrature at tolerance `10^-d`, the largest power of ten at most
-    /// `max_error` (a tenth of that for the tables over IOR), with `E_avg` by the cheapest fixed
-    /// rule whose measured bound is within that tolerance ([`TableSpec::average_rule_order`]).
-    /// The reflection quadrature's stated error is a bound of its actual error (tested against
-    /// itself at far tighter tolerances, and at the default table's every node by `kiln
-    /// verify`: 2.5e-10 at tolerance 1e-7), so every texel is within the tolerance; until
-    /// numerics version 5 the tolerance was a tenth of that, and the tables came out 100 to 1000
-    /// times better than asked, at up to twice the cost. The dielectric one's has been seen
-    /// short by up to 3.7x (`docs/accuracy.md`, known limits), hence its tenth. Either way the result is then checked against the
-    /// reference on a sample of texels ([`confirmation_sample`]).
+    /// `max_error`, with `E_avg` by the cheapest fixed rule whose measured bound is within that
+    /// tolerance ([`TableSpec::average_rule_order`]). The quadrature's stated error is a bound of
+    /// its actual error (tested against itself at far tighter tolerances, and at the default
+    /// table's every node by `kiln verify`: 2.5e-10 at tolerance 1e-7), so every texel is within
+    /// the tolerance. Until numerics version 5 the tolerance was a tenth of that, and the tables
+    /// came out 100 to 1000 times better than asked, at up to twice the cost; until version 6
+    /// the tables over IOR kept that tenth, as their quadrature's stated error had been seen
+    /// short by up to 3.7x where the critical angle meets the horizon (fixed in version 6).
+    /// Either way the result is then checked against the reference on a sample of texels
+    /// ([`confirmation_sample`]).
     #[must_use]
     pub fn resolved(&self) -> BakeOptions {
         let Some(max_error) = self.max_error else {
@@ -328,12 +329,7 @@ impl BakeOptions {
                     .filter(move |&q| q != Quantity::FAvg || Some(model) == first)
                     .map(move |quantity| {
                         let spec = |quantity: Quantity| TableSpec {
-                            // The dielectric quadrature's stated error has been seen short of
-                            // its actual error (by 1.8x on a grid at 1e-9; by 3.7x at a node of
-                            // an inside table at 1e-7, which then missed a bound of 1e-7 by
-                            // 1.6x): a tenth of the bound for them.
-                            reference_digits: reference_digits
-                                .map(|d| if quantity.has_ior() { d + 1 } else { d }),
+                            reference_digits,
                             lookup_of: None,
                             transmission: if quantity.has_ior() && quantity != Quantity::FAvg {
                                 self.transmission
@@ -788,11 +784,11 @@ pub fn check_computed(table: &Table) -> Result<()> {
 /// `kiln plan` and for `kiln bake` to say how long it will take before it starts.
 ///
 /// Per texel, measured as whole-process wall time of `kiln bake --quantity Q` on a 2-core AMD
-/// EPYC (AVX2), times 2, at the default max error 1e-7 (32 x 32 tables, quadrature to 1e-7; the
-/// dielectric ones 8 x 8 x 8, to 1e-8; numerics version 5), given here for 8 digits: GGX `E`
-/// 0.6 ms, Beckmann `E` 1.1 ms, GGX `E_avg` 12 ms, Beckmann `E_avg` 44 ms, the split-sum and
-/// Fresnel-weighted channels 0.2 ms, dielectric `E` 1.4 ms (outside) and 3.6 ms (inside), their
-/// averages 0.11 s and 0.9 s, `F_avg` nothing to speak of.
+/// EPYC (AVX2), times 2, at the default max error 1e-7 (32 x 32 tables, quadrature to 1e-7,
+/// numerics version 5; the dielectric ones 16 x 16 x 16 and 16 x 16, numerics version 6), given
+/// here for 8 digits: GGX `E` 0.6 ms, Beckmann `E` 1.1 ms, GGX `E_avg` 12 ms, Beckmann `E_avg`
+/// 44 ms, the split-sum and Fresnel-weighted channels 0.2 ms, dielectric `E` 1.2 ms (outside)
+/// and 2.8 ms (inside), their averages 45 ms and 60 ms, `F_avg` nothing to speak of.
 /// The quadrature's cost grows about linearly with the digits asked for, so the figure is
 /// scaled by `digits / 8`. QMC costs its samples at the measured kernel rates (GGX 75 M/s per
 /// core for `E`, 50 M/s for `E_avg`; Beckmann 3.5 and 1.7 M/s; 20 M/s for the rest). An
@@ -818,10 +814,10 @@ pub fn estimated_core_seconds(spec: &TableSpec) -> f64 {
                 (Quantity::E, true) => 1.1e-3,
                 (Quantity::EAvg, false) => 12e-3,
                 (Quantity::EAvg, true) => 44e-3,
-                (Quantity::EDielectric, _) => 1.4e-3,
-                (Quantity::EDielectricInside, _) => 3.6e-3,
-                (Quantity::EAvgDielectric, _) => 0.11,
-                (Quantity::EAvgDielectricInside, _) => 0.9,
+                (Quantity::EDielectric, _) => 1.2e-3,
+                (Quantity::EDielectricInside, _) => 2.8e-3,
+                (Quantity::EAvgDielectric, _) => 45e-3,
+                (Quantity::EAvgDielectricInside, _) => 60e-3,
                 (Quantity::FAvg, _) => 1e-5,
                 // Integrals of the E table's lookup, not of the BRDF.
                 (Quantity::FMsNorm, _) => 0.2e-3,

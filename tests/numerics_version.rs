@@ -11,50 +11,60 @@ use kiln::{BakeOptions, Method, Ndf, Quantity, Table};
 
 /// The digests of [`NUMERICS_VERSION`]: (version, table, FNV-1a of its values at 9 digits).
 const GOLDEN: &[(u32, &str, &str)] = &[
-    (5, "ggx-height-correlated-E Reference", "002d558b931e4fe4"),
+    (6, "ggx-height-correlated-E Reference", "002d558b931e4fe4"),
     (
-        5,
+        6,
         "ggx-height-correlated-E_avg Reference",
         "9ae6cc5f05a203b4",
     ),
     (
-        5,
+        6,
         "ggx-height-correlated-f_ms_norm Reference",
         "5855e516f7746e60",
     ),
     (
-        5,
+        6,
         "beckmann-height-correlated-E Reference",
         "b19a32727027d602",
     ),
     (
-        5,
+        6,
         "beckmann-height-correlated-E_avg Reference",
         "86903c59f829e359",
     ),
     (
-        5,
+        6,
         "ggx-height-correlated-E_scale-mu-linear Reference",
         "44458dbad202129e",
     ),
     (
-        5,
+        6,
         "ggx-height-correlated-E_bias-mu-linear Reference",
         "912bf62e8c1c999f",
     ),
     (
-        5,
+        6,
         "ggx-height-correlated-E_dielectric Reference",
-        "1f98df7c1a871b26",
+        "8be1bdf15cfb3879",
     ),
     (
-        5,
+        6,
         "ggx-height-correlated-E_dielectric_inside Reference",
-        "e61dbb380404c47e",
+        "79ed4dc2385f82a4",
     ),
-    (5, "dielectric-F_avg Reference", "6721c906b37a9454"),
-    (5, "ggx-height-correlated-E Qmc", "4f022cec14919ccd"),
-    (5, "ggx-height-correlated-E_avg Qmc", "237b702ae4bc2f45"),
+    (
+        6,
+        "ggx-height-correlated-E_avg_dielectric Reference",
+        "187a7bdcc6797d6a",
+    ),
+    (
+        6,
+        "ggx-height-correlated-E_avg_dielectric_inside Reference",
+        "ab14230185748a72",
+    ),
+    (6, "dielectric-F_avg Reference", "6721c906b37a9454"),
+    (6, "ggx-height-correlated-E Qmc", "4f022cec14919ccd"),
+    (6, "ggx-height-correlated-E_avg Qmc", "237b702ae4bc2f45"),
 ];
 
 fn digest(table: &Table) -> String {
@@ -90,6 +100,8 @@ fn tables() -> Vec<Table> {
         quantities: vec![
             Quantity::EDielectric,
             Quantity::EDielectricInside,
+            Quantity::EAvgDielectric,
+            Quantity::EAvgDielectricInside,
             Quantity::FAvg,
         ],
         ..base.clone()

@@ -3,6 +3,7 @@
 pub mod albedo;
 pub mod average_quadrature;
 pub mod dielectric;
+pub mod dielectric_average;
 pub mod estimate;
 pub mod grazing;
 pub mod quantity;
