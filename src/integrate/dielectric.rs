@@ -20,6 +20,10 @@
 //! `s = t / (alpha + t)`, as in `E`'s reference; above, `x` is cut where GGX's tail holds a
 //! hundredth of the tolerance ([`super::reference::x_range`]).
 //!
+//! The averages integrate over the microfacet normal first ([`super::dielectric_average`]);
+//! [`nested_dielectric_average_albedo_with`], an integral over `mu` of the reference above, is
+//! the other order, kept as an independent check.
+//!
 //! Limits: `alpha = 0` with `mu > 0` is the smooth interface, `R = F(mu)`, `T = 1 - F(mu)`,
 //! `E = 1` exactly. Unlike `E`, `E_eta(0)` is not 1 in general (for `eta < 1` refracted directions
 //! of a grazing view go up and are lost), so `mu = 0` is integrated like any other point. Between
