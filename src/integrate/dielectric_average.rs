@@ -256,7 +256,7 @@ pub(crate) fn average<N: MicrofacetDistribution>(
                         sin_h * sin_p,
                         a - b * cos_p,
                     );
-                    if !(o.z > 0.0) {
+                    if o.z <= 0.0 {
                         return [0.0; 4];
                     }
                     let lambda_o = ndf.lambda(o);
