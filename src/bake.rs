@@ -785,7 +785,8 @@ pub fn check_computed(table: &Table) -> Result<()> {
 ///
 /// Per texel, measured as whole-process wall time of `kiln bake --quantity Q` on a 2-core AMD
 /// EPYC (AVX2), times 2, at the default max error 1e-7 (32 x 32 tables, quadrature to 1e-7,
-/// numerics version 5; the dielectric ones 16 x 16 x 16 and 16 x 16, numerics version 6), given
+/// numerics version 5; the dielectric ones 16 x 16 x 16 and 16 x 16, numerics version 6, on a
+/// 2-core Xeon), given
 /// here for 8 digits: GGX `E` 0.6 ms, Beckmann `E` 1.1 ms, GGX `E_avg` 12 ms, Beckmann `E_avg`
 /// 44 ms, the split-sum and Fresnel-weighted channels 0.2 ms, dielectric `E` 1.2 ms (outside)
 /// and 2.8 ms (inside), their averages 45 ms and 60 ms, `F_avg` nothing to speak of.

@@ -87,8 +87,8 @@ fn looser_bounds_cost_fewer_samples() {
     assert_eq!(digits(1e-10), Some(10));
     assert_eq!(digits(3e-7), Some(7));
     assert_eq!(digits(1e-2), None);
-    // The tables over IOR get the bound itself too (they kept a tenth of it until numerics
-    // version 6, when their quadrature's stated error had been seen short by 3.7x).
+    // The tables over IOR get the bound itself too. Until numerics version 6 they kept a tenth
+    // of it, as their quadrature's stated error had been seen short by 3.7x.
     let specs = BakeOptions {
         max_error: Some(1e-5),
         quantities: vec![

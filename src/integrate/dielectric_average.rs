@@ -1,7 +1,8 @@
 //! The hemispherical average of a rough dielectric's energy albedo, `E_avg,eta = 2 ∫ E_eta(mu) mu
-//! dmu`, by a quadrature over the microfacet normal first: a tenth of the evaluations of the
+//! dmu`, by a quadrature over the microfacet normal first: a sixth of the evaluations of the
 //! nested one (an integral over `mu` of [`super::dielectric`]'s integrals over the visible
-//! normals), and an independent check of it.
+//! normals; 28 M against 167 M over 16 points at 1e-7, GGX, alpha 0.01 to 1, eta 1/3 to 1.5),
+//! which stays as an independent check of it.
 //!
 //! Swapping the order (the view `o` and the normal `m` both range over their hemispheres):
 //!
@@ -91,7 +92,8 @@ fn pieces(breaks: &[f64], singular: &[f64]) -> Vec<Piece> {
         .collect()
 }
 
-/// The integral over `pieces` of `f(point) * weight`, adaptively over all of them at once.
+/// The integral of `f` over `pieces` (at least one), each in its own variable `u` ([`map`]),
+/// adaptively over all of them at once.
 fn integrate_mapped(
     f: &mut impl FnMut(f64) -> [f64; 4],
     pieces: &[Piece],
@@ -145,7 +147,11 @@ pub(crate) fn average<N: MicrofacetDistribution>(
         outer_breaks.push(s_of_x(((FRAC_PI_2 - c).tan() / alpha).ln()));
     }
     tidy(&mut outer_breaks, 0.0, 1.0);
-    // The integral of the outer weight, to share the tolerance between the levels.
+    // The tolerance is shared between the levels as in the nested reference: the outer rule
+    // gets half; each middle integral `tolerance / (4 W)` (half its own rule's, half the inner
+    // integrals', whose weight `sin cos` integrates to 1/2), which the outer weight, of
+    // integral `W`, adds up to a quarter. The stated error adds every level's estimates
+    // whatever they come to; this only aims them.
     let total_weight = integrate_pieces(
         &mut |s: f64| [outer_weight(s).map_or(0.0, |w| w.0)],
         &outer_breaks,
@@ -299,4 +305,50 @@ pub(crate) fn average<N: MicrofacetDistribution>(
         evaluations + outer.evaluations,
         converged && outer.converged,
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each way of mapping a piece integrates polynomials and the square roots at its ends to
+    /// their closed forms, within the rule's own estimate: a wrong point or Jacobian would not.
+    #[test]
+    fn every_mapping_integrates_to_the_closed_form() {
+        let (a, b): (f64, f64) = (0.3, 1.7);
+        let exact = [
+            (b * b * b - a * a * a) / 3.0,
+            2.0 / 3.0 * (b - a).powf(1.5),
+            2.0 / 3.0 * (b - a).powf(1.5),
+        ];
+        for ends in [
+            Ends::Plain,
+            Ends::SquareRootAtStart,
+            Ends::SquareRootAtEnd,
+            Ends::SquareRootAtBoth,
+        ] {
+            let q = integrate_mapped(
+                &mut |x: f64| [x * x, (x - a).max(0.0).sqrt(), (b - x).max(0.0).sqrt(), 0.0],
+                &[Piece { a, b, ends }],
+                1e-10,
+                200,
+            );
+            for (k, want) in exact.into_iter().enumerate() {
+                assert!(
+                    (q.value[k] - want).abs() <= q.error + 1e-14,
+                    "{ends:?} component {k}: {} against {want}, error {:e}",
+                    q.value[k],
+                    q.error
+                );
+            }
+        }
+        // Several pieces at once, each in its own share of the variable.
+        let q = integrate_mapped(
+            &mut |x: f64| [x, 0.0, 0.0, 0.0],
+            &pieces(&[0.0, 0.5, 2.0], &[0.5]),
+            1e-12,
+            200,
+        );
+        assert!((q.value[0] - 2.0).abs() < 1e-12, "{}", q.value[0]);
+    }
 }
