@@ -786,10 +786,10 @@ pub fn check_computed(table: &Table) -> Result<()> {
 /// Per texel, measured as whole-process wall time of `kiln bake --quantity Q` on a 2-core AMD
 /// EPYC (AVX2), times 2, at the default max error 1e-7 (32 x 32 tables, quadrature to 1e-7,
 /// numerics version 5; the dielectric ones 16 x 16 x 16 and 16 x 16, numerics version 6, on a
-/// 2-core Xeon), given
-/// here for 8 digits: GGX `E` 0.6 ms, Beckmann `E` 1.1 ms, GGX `E_avg` 12 ms, Beckmann `E_avg`
-/// 44 ms, the split-sum and Fresnel-weighted channels 0.2 ms, dielectric `E` 1.2 ms (outside)
-/// and 2.8 ms (inside), their averages 45 ms and 60 ms, `F_avg` nothing to speak of.
+/// 2-core Xeon), given here for 8 digits: GGX `E` 0.6 ms, Beckmann `E` 1.1 ms, GGX `E_avg`
+/// 12 ms, Beckmann `E_avg` 44 ms, the split-sum and Fresnel-weighted channels 0.2 ms, dielectric
+/// `E` 1.2 ms (outside) and 2.8 ms (inside), their averages 45 ms and 60 ms, `F_avg` nothing to
+/// speak of.
 /// The quadrature's cost grows about linearly with the digits asked for, so the figure is
 /// scaled by `digits / 8`. QMC costs its samples at the measured kernel rates (GGX 75 M/s per
 /// core for `E`, 50 M/s for `E_avg`; Beckmann 3.5 and 1.7 M/s; 20 M/s for the rest). An
