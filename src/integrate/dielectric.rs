@@ -346,37 +346,36 @@ pub fn reference_dielectric_average_albedo_with(
     convention: TransmissionConvention,
     settings: &ReferenceSettings,
 ) -> DielectricReference {
-    check(alpha, 0.5, eta);
-    if alpha == 0.0 || convention.smooth_at(eta) {
-        return smooth_average(eta);
+    if let Some(smooth) = smooth_average(alpha, eta, convention) {
+        return smooth;
     }
     let alpha = alpha.max(SMOOTH_ALPHA);
     let masking = model.masking;
-    let (value, error, evaluations, converged) = match model.ndf {
+    match model.ndf {
         Ndf::Ggx => average(Ggx { alpha }, masking, eta, convention, settings),
         Ndf::Beckmann => average(Beckmann { alpha }, masking, eta, convention, settings),
-    };
-    DielectricReference {
-        reflection: value[0],
-        transmission: value[1],
-        one_minus_value: value[2],
-        error,
-        evaluations,
-        converged,
     }
 }
 
-/// The smooth interface's averages: `R_avg = F_avg(eta)`, `T_avg = 1 - F_avg(eta)`.
-fn smooth_average(eta: f64) -> DielectricReference {
-    let f_avg = crate::model::Fresnel::Dielectric { eta }.average_report();
-    DielectricReference {
-        reflection: f_avg.value[0],
-        transmission: 1.0 - f_avg.value[0],
-        one_minus_value: 0.0,
-        error: f_avg.error,
-        evaluations: f_avg.evaluations,
-        converged: true,
-    }
+/// The arguments checked, and where the interface is smooth (`alpha = 0`, or an index the
+/// convention takes as matched) its averages: `R_avg = F_avg(eta)`, `T_avg = 1 - F_avg(eta)`.
+fn smooth_average(
+    alpha: f64,
+    eta: f64,
+    convention: TransmissionConvention,
+) -> Option<DielectricReference> {
+    check(alpha, 0.5, eta);
+    (alpha == 0.0 || convention.smooth_at(eta)).then(|| {
+        let f_avg = crate::model::Fresnel::Dielectric { eta }.average_report();
+        DielectricReference {
+            reflection: f_avg.value[0],
+            transmission: 1.0 - f_avg.value[0],
+            one_minus_value: 0.0,
+            error: f_avg.error,
+            evaluations: f_avg.evaluations,
+            converged: true,
+        }
+    })
 }
 
 /// [`reference_dielectric_average_albedo_with`] in the other order, an independent check of it
@@ -394,9 +393,8 @@ pub fn nested_dielectric_average_albedo_with(
     convention: TransmissionConvention,
     settings: &ReferenceSettings,
 ) -> DielectricReference {
-    check(alpha, 0.5, eta);
-    if alpha == 0.0 || convention.smooth_at(eta) {
-        return smooth_average(eta);
+    if let Some(smooth) = smooth_average(alpha, eta, convention) {
+        return smooth;
     }
     let mut breaks = vec![0.0, 1.0];
     for b in [alpha / 16.0, alpha / 4.0, alpha, 4.0 * alpha] {

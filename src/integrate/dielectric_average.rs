@@ -28,6 +28,7 @@
 //! as the nested reference does. With `s_R + s_T + s_L = 1` the three parts add up to 1 (`(1 /
 //! pi) ∫ mu_o dω_o`), which the tests check along with agreement with the nested reference.
 
+use super::dielectric::DielectricReference;
 use super::gauss_kronrod::integrate_pieces;
 use super::reference::{ReferenceSettings, ladder, s_of_x, t_of_s};
 use crate::model::dielectric::{TransmissionConvention, scattering_at_cos};
@@ -116,15 +117,15 @@ fn tidy(breaks: &mut Vec<f64>, lo: f64, hi: f64) {
     breaks.dedup();
 }
 
-/// `[R_avg, T_avg, (1 - E)_avg]` and the stated error, evaluations, convergence (see the module
-/// docs) for one distribution.
+/// `R_avg`, `T_avg` and `(1 - E)_avg` with the stated error (see the module docs) for one
+/// distribution.
 pub(crate) fn average<N: MicrofacetDistribution>(
     ndf: N,
     masking: Masking,
     eta: f64,
     convention: TransmissionConvention,
     settings: &ReferenceSettings,
-) -> ([f64; 3], f64, u64, bool) {
+) -> DielectricReference {
     let alpha = ndf.alpha();
     let tolerance = settings.tolerance;
     let max_intervals = settings.max_intervals;
@@ -299,12 +300,14 @@ pub(crate) fn average<N: MicrofacetDistribution>(
         tolerance / 2.0,
         max_intervals,
     );
-    (
-        [outer.value[0], outer.value[1], outer.value[2]],
-        outer.error + outer.value[3],
-        evaluations + outer.evaluations,
-        converged && outer.converged,
-    )
+    DielectricReference {
+        reflection: outer.value[0],
+        transmission: outer.value[1],
+        one_minus_value: outer.value[2],
+        error: outer.error + outer.value[3],
+        evaluations: evaluations + outer.evaluations,
+        converged: converged && outer.converged,
+    }
 }
 
 #[cfg(test)]
