@@ -40,7 +40,7 @@
 //! the similar point ([`smooth_point`]), and `alpha = 0` with `mu > 0` returns the mirror's
 //! exact `E = 1`.
 
-use super::gauss_kronrod::{Quadrature, integrate_pieces};
+use super::gauss_kronrod::{KRONROD_NODES, Quadrature, integrate_pieces, integrate_pieces_batch};
 use crate::model::{
     Beckmann, Ggx, Masking, MicrofacetDistribution, Model, Ndf, SMOOTH_ALPHA, Vec3,
     albedo_is_exactly_one, smooth_point,
@@ -265,50 +265,14 @@ fn albedo_quadrature<N: MicrofacetDistribution>(
     };
     // Piece A's variable: `u = s` for `x < 0`, `u = 1/2 + x` beyond; `(t, dx/du)` at `u`.
     let u_of_x = |x: f64| if x < 0.0 { s_of_x(x) } else { 0.5 + x };
-    let a_variable = |u: f64| {
-        if u < 0.5 {
-            t_of_s(u, alpha)
-        } else {
-            (alpha * (u - 0.5).exp(), 1.0)
-        }
-    };
 
-    // The integrand at `t = tan(theta_m)` and phi, times `dx/dv` for the variable `v` in use:
-    // [E part, 1 - E part] per unit `v`, before the phi integral.
-    let point = |(t, jacobian): (f64, f64), cos_phi: f64, sin_phi: f64, below: bool| -> [f64; 2] {
-        // A node that rounds onto an end of the range (u = 0, s = 1 in f64), where the integrand
-        // per unit of the variable vanishes (s = 0) or its interval holds nothing f64 can add.
-        if !(t > 0.0 && t < f64::INFINITY) {
-            return [0.0, 0.0];
-        }
-        let t2 = t * t;
-        let cos_t = 1.0 / (1.0 + t2).sqrt();
-        let sin_t = t * cos_t;
-        let m = Vec3::new(sin_t * cos_phi, sin_t * sin_phi, cos_t);
-        let om = o.dot(m);
-        if om <= 0.0 {
-            return [0.0, 0.0];
-        }
-        // dω_m = sin^2 cos dx dphi.
-        let weight = ndf.d_from_tan2(t2) * sin_t * sin_t * cos_t * om * jacobian;
-        let i = o.reflect(m);
-        if below || i.z <= 0.0 {
-            return [0.0, weight * inverse_area];
-        }
-        let lambda_i = ndf.lambda(i);
-        let g2_over_mu = match masking {
-            // G2 / mu = 1 / (mu (1 + Lo) + mu Li).
-            Masking::HeightCorrelated => 1.0 / (1.0 / inverse_area + mu * lambda_i),
-            Masking::Separable => inverse_area / (1.0 + lambda_i),
-            // G1_S(o) G1_S(i) / mu = G1_S(i) / (mu (1 - k) + k), k = alpha / 2.
-            Masking::SchlickGgx => {
-                Masking::schlick_g1(i.z, alpha) / (mu * (1.0 - 0.5 * alpha) + 0.5 * alpha)
-            }
-        };
-        [
-            weight * g2_over_mu * h(om.min(1.0)),
-            weight * inverse_area * masking.loss_at(alpha, mu, i.z, lambda_o, lambda_i),
-        ]
+    let view = View {
+        ndf,
+        masking,
+        mu,
+        o,
+        lambda_o,
+        inverse_area,
     };
 
     let inner_tolerance = settings.tolerance / (4.0 * PI);
@@ -324,7 +288,9 @@ fn albedo_quadrature<N: MicrofacetDistribution>(
         } else {
             1.0
         };
-        let mut above = |u: f64| point(a_variable(u), cos_phi, sin_phi, false);
+        let mut above = |nodes: &[f64; KRONROD_NODES], values: &mut [[f64; 2]; KRONROD_NODES]| {
+            view.values_at(nodes, Piece::A, cos_phi, sin_phi, h, values);
+        };
         let x_star = (tan_star / alpha).ln();
         let breaks: Vec<f64> = horizon_breaks(
             f64::NEG_INFINITY,
@@ -337,9 +303,12 @@ fn albedo_quadrature<N: MicrofacetDistribution>(
         .map(u_of_x)
         .collect();
         let s_star = s_of_tan(tan_star);
-        let a = integrate_pieces(&mut above, &breaks, inner_tolerance, settings.max_intervals);
-        let mut below = |s: f64| point(t_of_s(s, alpha), cos_phi, sin_phi, true);
-        let b = integrate_pieces(
+        let a =
+            integrate_pieces_batch(&mut above, &breaks, inner_tolerance, settings.max_intervals);
+        let mut below = |nodes: &[f64; KRONROD_NODES], values: &mut [[f64; 2]; KRONROD_NODES]| {
+            view.values_at(nodes, Piece::B, cos_phi, sin_phi, h, values);
+        };
+        let b = integrate_pieces_batch(
             &mut below,
             &[s_star, s_visible.max(s_star)],
             inner_tolerance,
@@ -363,6 +332,261 @@ fn albedo_quadrature<N: MicrofacetDistribution>(
         evaluations: evaluations + outer.evaluations,
         converged: all_converged && outer.converged,
     }
+}
+
+/// Lanes of one batch of the integrand: a rule's [`KRONROD_NODES`] padded to a multiple of the
+/// SIMD width (four `f64` with AVX2).
+const LANES: usize = 16;
+
+/// What the integrand needs of the view `o = (so, 0, mu)` at every normal.
+struct View<N> {
+    ndf: N,
+    masking: Masking,
+    mu: f64,
+    o: Vec3,
+    /// `Lambda(o)`.
+    lambda_o: f64,
+    /// `G1(o) / mu = 1 / (mu (1 + Lambda(o)))`.
+    inverse_area: f64,
+}
+
+/// The two pieces of the `x` integral at one azimuth (module docs), each with its variable.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Piece {
+    /// The reflection above the horizon: `u = s` below the peak (`u < 1/2`), `u = 1/2 + x`
+    /// beyond.
+    A,
+    /// The reflection below the horizon, the normal still visible: `s` throughout.
+    B,
+}
+
+impl<N: MicrofacetDistribution> View<N> {
+    /// `[E part, 1 - E part]` per unit of the piece's variable at one rule's nodes, at azimuth
+    /// `phi`: in piece A `D (o.m) G2 / mu h(o.m)` and `D (o.m) / (mu (1 + Lambda(o))) loss`; in
+    /// piece B (and wherever the reflection falls below the horizon) `[0, D (o.m) / (mu (1 +
+    /// Lambda(o)))]`, every visible normal losing all it reflects.
+    #[inline(always)]
+    fn values_at(
+        &self,
+        nodes: &[f64; KRONROD_NODES],
+        piece: Piece,
+        cos_phi: f64,
+        sin_phi: f64,
+        h: impl Fn(f64) -> f64 + Copy,
+        values: &mut [[f64; 2]; KRONROD_NODES],
+    ) {
+        let (mu, alpha, lambda_o) = (self.mu, self.ndf.alpha(), self.lambda_o);
+        let inverse_area = self.inverse_area;
+        // `(G2 / mu, loss)` from `i.z` and `Lambda(i)`, one masking form per loop.
+        match self.masking {
+            // G2 / mu = 1 / (mu (1 + Lo) + mu Li).
+            Masking::HeightCorrelated => self.lanes(
+                nodes,
+                piece,
+                cos_phi,
+                sin_phi,
+                h,
+                values,
+                #[inline(always)]
+                move |iz, lambda_i| {
+                    (
+                        1.0 / (1.0 / inverse_area + mu * lambda_i),
+                        Masking::HeightCorrelated.loss_at(alpha, mu, iz, lambda_o, lambda_i),
+                    )
+                },
+            ),
+            Masking::Separable => self.lanes(
+                nodes,
+                piece,
+                cos_phi,
+                sin_phi,
+                h,
+                values,
+                #[inline(always)]
+                move |iz, lambda_i| {
+                    (
+                        inverse_area / (1.0 + lambda_i),
+                        Masking::Separable.loss_at(alpha, mu, iz, lambda_o, lambda_i),
+                    )
+                },
+            ),
+            // G1_S(o) G1_S(i) / mu = G1_S(i) / (mu (1 - k) + k), k = alpha / 2.
+            Masking::SchlickGgx => self.lanes(
+                nodes,
+                piece,
+                cos_phi,
+                sin_phi,
+                h,
+                values,
+                #[inline(always)]
+                move |iz, lambda_i| {
+                    (
+                        Masking::schlick_g1(iz, alpha) / (mu * (1.0 - 0.5 * alpha) + 0.5 * alpha),
+                        Masking::SchlickGgx.loss_at(alpha, mu, iz, lambda_o, lambda_i),
+                    )
+                },
+            ),
+        }
+    }
+
+    /// [`View::values_at`] with the masking's terms given, compiled for AVX2 where the CPU has
+    /// it. The result is bit-identical either way: the same IEEE operations in the same order per
+    /// lane (Rust never fuses a multiply and an add on its own), several lanes at a time.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn lanes(
+        &self,
+        nodes: &[f64; KRONROD_NODES],
+        piece: Piece,
+        cos_phi: f64,
+        sin_phi: f64,
+        h: impl Fn(f64) -> f64 + Copy,
+        values: &mut [[f64; 2]; KRONROD_NODES],
+        masking_terms: impl Fn(f64, f64) -> (f64, f64) + Copy,
+    ) {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU supports AVX2, checked on the line above.
+            return unsafe {
+                lanes_avx2(
+                    self,
+                    nodes,
+                    piece,
+                    cos_phi,
+                    sin_phi,
+                    h,
+                    values,
+                    masking_terms,
+                )
+            };
+        }
+        lanes_portable(
+            self,
+            nodes,
+            piece,
+            cos_phi,
+            sin_phi,
+            h,
+            values,
+            masking_terms,
+        );
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[allow(clippy::too_many_arguments)]
+fn lanes_avx2<N: MicrofacetDistribution>(
+    view: &View<N>,
+    nodes: &[f64; KRONROD_NODES],
+    piece: Piece,
+    cos_phi: f64,
+    sin_phi: f64,
+    h: impl Fn(f64) -> f64 + Copy,
+    values: &mut [[f64; 2]; KRONROD_NODES],
+    masking_terms: impl Fn(f64, f64) -> (f64, f64) + Copy,
+) {
+    lanes_portable(
+        view,
+        nodes,
+        piece,
+        cos_phi,
+        sin_phi,
+        h,
+        values,
+        masking_terms,
+    );
+}
+
+/// The loops over lanes of [`View::values_at`]: in stages over arrays of lanes, each a loop
+/// simple enough to vectorise (no calls, no branch but selects). The rule's 15 nodes are padded
+/// to [`LANES`] with a copy of the first, whose result is dropped.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn lanes_portable<N: MicrofacetDistribution>(
+    view: &View<N>,
+    nodes: &[f64; KRONROD_NODES],
+    piece: Piece,
+    cos_phi: f64,
+    sin_phi: f64,
+    h: impl Fn(f64) -> f64 + Copy,
+    values: &mut [[f64; 2]; KRONROD_NODES],
+    masking_terms: impl Fn(f64, f64) -> (f64, f64) + Copy,
+) {
+    let alpha = view.ndf.alpha();
+    let in_x = piece == Piece::A;
+    let mut om = [0.0; LANES];
+    let mut weight = [0.0; LANES];
+    let mut counts = [false; LANES];
+    let mut iz = [0.0; LANES];
+    let mut tan2_i = [0.0; LANES];
+    // `t = alpha e^x` at the nodes `u = 1/2 + x` of piece A above the peak (`dx/du = 1`), a
+    // library call per node, made only there.
+    let mut t_x = [f64::NAN; LANES];
+    if in_x {
+        for k in 0..LANES {
+            let v = nodes[k % KRONROD_NODES];
+            if v >= 0.5 {
+                t_x[k] = alpha * (v - 0.5).exp();
+            }
+        }
+    }
+    for k in 0..LANES {
+        // `(t, dx/dv)` at the node: `t = alpha s / (1 - s)`, `dx/ds = 1 / (s (1 - s))` in `s`.
+        let v = nodes[k % KRONROD_NODES];
+        let (t_s, jacobian_s) = t_of_s(v, alpha);
+        let (t, jacobian) = if in_x && v >= 0.5 {
+            (t_x[k], 1.0)
+        } else {
+            (t_s, jacobian_s)
+        };
+        // The normal, and `D(m) sin^2 cos (o.m) dx/dv` (`dω_m = sin^2 cos dx dphi`).
+        let t2 = t * t;
+        let cos_t = 1.0 / (1.0 + t2).sqrt();
+        let sin_t = t * cos_t;
+        let m = Vec3::new(sin_t * cos_phi, sin_t * sin_phi, cos_t);
+        om[k] = view.o.dot(m);
+        weight[k] = view.ndf.d_from_tan2(t2) * sin_t * sin_t * cos_t * om[k] * jacobian;
+        // Nothing where the node rounds onto an end of the range (`u = 0`, `s = 1` in f64, where
+        // the integrand vanishes per unit of the variable or its interval holds nothing f64 can
+        // add), nor where the normal faces away from the view.
+        counts[k] = t > 0.0 && t < f64::INFINITY && om[k] > 0.0;
+        let i = view.o.reflect(m);
+        iz[k] = i.z;
+        tan2_i[k] = i.tan2_theta();
+    }
+    if piece == Piece::B {
+        for k in 0..KRONROD_NODES {
+            values[k] = [
+                0.0,
+                if counts[k] {
+                    weight[k] * view.inverse_area
+                } else {
+                    0.0
+                },
+            ];
+        }
+        return;
+    }
+    let lambda_i = view.ndf.lambdas_from_tan2(&tan2_i);
+    let inverse_area = view.inverse_area;
+    let mut out = [[0.0; 2]; LANES];
+    for k in 0..LANES {
+        let (g2_over_mu, loss) = masking_terms(iz[k], lambda_i[k]);
+        let escapes = iz[k] <= 0.0;
+        let e = if escapes {
+            0.0
+        } else {
+            weight[k] * g2_over_mu * h(om[k].min(1.0))
+        };
+        let lost = if escapes {
+            weight[k] * inverse_area
+        } else {
+            weight[k] * inverse_area * loss
+        };
+        out[k] = if counts[k] { [e, lost] } else { [0.0, 0.0] };
+    }
+    values.copy_from_slice(&out[..KRONROD_NODES]);
 }
 
 /// The `x = ln(tan(theta_m) / alpha)` range a tolerance needs. Below `x` the projected normals
@@ -559,5 +783,139 @@ mod bound_tests {
         });
         assert_eq!((r.value, r.one_minus_value), (1.0, 0.0));
         assert!(r.error >= 3e-9, "{r:?}");
+    }
+}
+
+#[cfg(test)]
+mod lane_tests {
+    use super::*;
+
+    /// The integrand per unit `x` and `phi`, written from the textbook forms: `D(m)` from
+    /// `cos(theta_m)`, `G2` from both `Lambda`s, `dω_m = sin^2 cos dx dphi`, `m` from `theta_m`
+    /// by `atan`. `[E part, 1 - E part]`, with `1 - E` as `D (o.m) (G1(o) - G2) / mu` where the
+    /// reflection is above the horizon and `D (o.m) G1(o) / mu` where it is not.
+    fn textbook<N: MicrofacetDistribution>(
+        ndf: N,
+        masking: Masking,
+        mu: f64,
+        t: f64,
+        phi: f64,
+    ) -> [f64; 2] {
+        let theta = t.atan();
+        let m = Vec3::new(
+            theta.sin() * phi.cos(),
+            theta.sin() * phi.sin(),
+            theta.cos(),
+        );
+        let o = Vec3::new((1.0 - mu * mu).sqrt(), 0.0, mu);
+        let om = o.dot(m);
+        if om <= 0.0 {
+            return [0.0, 0.0];
+        }
+        let per_x = ndf.d(m.z) * theta.sin().powi(2) * m.z * om / mu;
+        let g1_o = ndf.g1(o);
+        let i = m * (2.0 * om) - o;
+        if i.z <= 0.0 {
+            return [0.0, per_x * g1_o];
+        }
+        let g2 = match masking {
+            Masking::SchlickGgx => {
+                Masking::schlick_g1(mu, ndf.alpha()) * Masking::schlick_g1(i.z, ndf.alpha())
+            }
+            _ => masking.g2(ndf.lambda(o), ndf.lambda(i)),
+        };
+        [per_x * g2, per_x * (g1_o - g2)]
+    }
+
+    /// Every lane of one batch, in piece A's variable on both sides of the peak (`u < 1/2` in
+    /// `s`, beyond in `x`) and in piece B's `s`, against the textbook integrand at the same
+    /// normal divided by `dx/dv`; and the AVX2 build against the portable one, bit for bit.
+    #[test]
+    fn the_lanes_agree_with_the_textbook_integrand() {
+        fn check<N: MicrofacetDistribution>(ndf: N) {
+            let alpha = ndf.alpha();
+            for masking in [
+                Masking::HeightCorrelated,
+                Masking::Separable,
+                Masking::SchlickGgx,
+            ] {
+                for mu in [0.05_f64, 0.4, 0.9] {
+                    let so = ((1.0 - mu) * (1.0 + mu)).sqrt();
+                    let view = View {
+                        ndf,
+                        masking,
+                        mu,
+                        o: Vec3::new(so, 0.0, mu),
+                        lambda_o: ndf.lambda_from_tan2((so / mu).powi(2)),
+                        inverse_area: 1.0 / ndf.projected_area(mu),
+                    };
+                    for phi in [0.3, 1.5, 2.9] {
+                        let (sin_phi, cos_phi) = f64::sin_cos(phi);
+                        for (piece, a, b) in [
+                            (Piece::A, 0.1, 0.5),
+                            (Piece::A, 0.5, 2.5),
+                            (Piece::B, 0.2, 0.97),
+                        ] {
+                            let nodes = crate::numerics::gauss_kronrod::tests::nodes_of(a, b);
+                            let mut values = [[0.0; 2]; KRONROD_NODES];
+                            view.values_at(&nodes, piece, cos_phi, sin_phi, |_| 1.0, &mut values);
+                            let mut portable = [[0.0; 2]; KRONROD_NODES];
+                            let terms = |iz: f64, lambda_i: f64| {
+                                let g2 = match masking {
+                                    Masking::HeightCorrelated => {
+                                        1.0 / (1.0 / view.inverse_area + mu * lambda_i)
+                                    }
+                                    Masking::Separable => view.inverse_area / (1.0 + lambda_i),
+                                    Masking::SchlickGgx => {
+                                        Masking::schlick_g1(iz, alpha)
+                                            / (mu * (1.0 - 0.5 * alpha) + 0.5 * alpha)
+                                    }
+                                };
+                                (g2, masking.loss_at(alpha, mu, iz, view.lambda_o, lambda_i))
+                            };
+                            lanes_portable(
+                                &view,
+                                &nodes,
+                                piece,
+                                cos_phi,
+                                sin_phi,
+                                |_| 1.0,
+                                &mut portable,
+                                terms,
+                            );
+                            for (k, &v) in nodes.iter().enumerate() {
+                                assert_eq!(
+                                    values[k].map(f64::to_bits),
+                                    portable[k].map(f64::to_bits),
+                                    "AVX2 and portable builds differ"
+                                );
+                                let (t, dx_dv) = if piece == Piece::A && v >= 0.5 {
+                                    (alpha * (v - 0.5).exp(), 1.0)
+                                } else {
+                                    t_of_s(v, alpha)
+                                };
+                                let mut want = textbook(ndf, masking, mu, t, phi);
+                                if piece == Piece::B {
+                                    // Every visible normal's reflection counted as lost.
+                                    want = [0.0, want[0] + want[1]];
+                                }
+                                for c in 0..2 {
+                                    let got = values[k][c] / dx_dv;
+                                    assert!(
+                                        (got - want[c]).abs() <= 1e-12 * want[c].abs().max(1e-3),
+                                        "{masking} alpha {alpha} mu {mu} phi {phi} v {v}: \
+                                         {got:e} vs {:e}",
+                                        want[c]
+                                    );
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        check(Ggx { alpha: 0.3 });
+        check(Ggx { alpha: 1.2 });
+        check(Beckmann { alpha: 0.5 });
     }
 }

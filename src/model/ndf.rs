@@ -26,6 +26,13 @@ pub trait MicrofacetDistribution: Copy + Send + Sync {
     /// Smith's `Lambda` for a direction with the given `tan^2(theta)` (`+inf` on the horizon).
     fn lambda_from_tan2(&self, tan2_theta: f64) -> f64;
 
+    /// [`MicrofacetDistribution::lambda_from_tan2`] at several directions at once, the same
+    /// value for each, in a loop that vectorises where the distribution's form allows.
+    #[inline(always)]
+    fn lambdas_from_tan2<const L: usize>(&self, tan2_theta: &[f64; L]) -> [f64; L] {
+        tan2_theta.map(|tan2| self.lambda_from_tan2(tan2))
+    }
+
     /// Smith's `Lambda(v)`, with `tan^2(theta)` taken from the components of `v`.
     #[inline(always)]
     fn lambda(&self, v: Vec3) -> f64 {
@@ -98,6 +105,26 @@ impl MicrofacetDistribution for Ggx {
             return f64::INFINITY;
         }
         x / (2.0 * (1.0 + (1.0 + x).sqrt()))
+    }
+
+    /// The same operations as [`Ggx::lambda_from_tan2`] with the horizon's limit as a select,
+    /// so that the loop vectorises.
+    #[inline(always)]
+    fn lambdas_from_tan2<const L: usize>(&self, tan2_theta: &[f64; L]) -> [f64; L] {
+        let mut lambdas = [0.0; L];
+        if self.alpha == 0.0 {
+            return lambdas;
+        }
+        for (lambda, tan2) in lambdas.iter_mut().zip(tan2_theta) {
+            let x = self.alpha * self.alpha * tan2;
+            let finite = x / (2.0 * (1.0 + (1.0 + x).sqrt()));
+            *lambda = if x.is_infinite() {
+                f64::INFINITY
+            } else {
+                finite
+            };
+        }
+        lambdas
     }
 
     /// Dupuy & Benyoub 2023, "Sampling Visible GGX Normals with Spherical Caps": stretch `o` to
@@ -680,6 +707,35 @@ mod tests {
         // Beyond a = 6 Lambda is below 1e-17 (docs/physics.md), and it never goes negative.
         assert!(b.lambda_from_tan2(tan2_at(6.0)) < 1e-17);
         assert!(b.lambda_from_tan2(tan2_at(30.0)) >= 0.0);
+    }
+
+    /// The vectorised `Lambda` gives the scalar one's bits at every direction, the horizon and
+    /// the normal included, and for a mirror.
+    #[test]
+    fn lambdas_at_once_are_the_lambdas_one_at_a_time() {
+        let tan2 = [
+            0.0,
+            1e-300,
+            1e-12,
+            0.3,
+            1.0,
+            7.5,
+            1e12,
+            1e300,
+            f64::INFINITY,
+        ];
+        for alpha in [0.0, 1e-4, 0.3, 1.0, 2.0] {
+            let ggx = Ggx { alpha };
+            let scalar = tan2.map(|t| ggx.lambda_from_tan2(t).to_bits());
+            assert_eq!(
+                ggx.lambdas_from_tan2(&tan2).map(f64::to_bits),
+                scalar,
+                "alpha {alpha}"
+            );
+            let beckmann = Beckmann { alpha };
+            let scalar = tan2.map(|t| beckmann.lambda_from_tan2(t).to_bits());
+            assert_eq!(beckmann.lambdas_from_tan2(&tan2).map(f64::to_bits), scalar);
+        }
     }
 
     #[test]
