@@ -38,11 +38,13 @@ use super::albedo::{
 };
 use super::dielectric_average::average;
 use super::estimate::Estimate;
-use super::gauss_kronrod::{integrate, integrate_pieces};
+use super::gauss_kronrod::{KRONROD_NODES, integrate_pieces, integrate_pieces_batch};
 use super::reference::{
     ReferenceSettings, ReferenceValue, ladder, phi_breaks, s_of_x, t_of_s, x_range,
 };
-use crate::model::dielectric::{TransmissionConvention, refract, scattering_with};
+use crate::model::dielectric::{
+    TransmissionConvention, refract, scattering_with, scatterings_at_cos,
+};
 use crate::model::fresnel::dielectric;
 use crate::model::{
     Beckmann, Ggx, Masking, MicrofacetDistribution, Model, Ndf, SMOOTH_ALPHA, Vec3,
@@ -450,6 +452,165 @@ pub fn nested_dielectric_average_albedo_with(
 /// How far (in `x`) the ladders toward the two horizons reach.
 const LADDER_REACH: f64 = 8.0;
 
+/// Lanes of one batch of the integrand: a rule's [`KRONROD_NODES`] padded to a multiple of the
+/// SIMD width.
+const LANES: usize = 16;
+
+/// The variable of one piece of the `x` integral at one azimuth (see [`quadrature`]).
+#[derive(Clone, Copy)]
+enum Variable {
+    /// `x` itself: `t = alpha e^x`.
+    X,
+    /// `s = t / (alpha + t)`, from `x = -infinity`.
+    Logistic,
+    /// `x = edge + s^2`, beside a critical angle at the piece's start.
+    SquareFrom(f64),
+    /// `x = edge - s^2`, beside a critical angle at the piece's end.
+    SquareTo(f64),
+}
+
+/// What the integrand needs of the view and the interface at every normal.
+struct DielectricView<N> {
+    ndf: N,
+    masking: Masking,
+    o: Vec3,
+    /// `Lambda(o)`.
+    lambda_o: f64,
+    /// `G1(o) / mu`.
+    inverse_area: f64,
+    eta: f64,
+    convention: TransmissionConvention,
+}
+
+impl<N: MicrofacetDistribution> DielectricView<N> {
+    /// `[R, T, 1 - E]` per unit of the piece's variable at one rule's nodes, at azimuth `phi`:
+    /// the visible density `D (o.m) G1(o) / mu` per unit `x` and `phi` (`dω_m = sin^2 cos dx
+    /// dphi`) times what the normal scatters ([`scatterings_at_cos`]), times `dx/dv`.
+    #[inline(always)]
+    fn values_at(
+        &self,
+        nodes: &[f64; KRONROD_NODES],
+        variable: Variable,
+        cos_phi: f64,
+        sin_phi: f64,
+        values: &mut [[f64; 3]; KRONROD_NODES],
+    ) {
+        // `t = tan(theta_m)` and `dx/dv` at each node, and the factor `dx/ds = +-2 s` of the
+        // square maps, applied to the result.
+        let alpha = self.ndf.alpha();
+        let mut t = [0.0; LANES];
+        let mut jacobian = [1.0; LANES];
+        let mut factor = [1.0; LANES];
+        for k in 0..LANES {
+            let v = nodes[k % KRONROD_NODES];
+            match variable {
+                Variable::X => t[k] = alpha * v.exp(),
+                Variable::Logistic => (t[k], jacobian[k]) = t_of_s(v, alpha),
+                Variable::SquareFrom(edge) => {
+                    t[k] = alpha * (edge + v * v).exp();
+                    factor[k] = 2.0 * v;
+                }
+                Variable::SquareTo(edge) => {
+                    t[k] = alpha * (edge - v * v).exp();
+                    factor[k] = 2.0 * v;
+                }
+            }
+        }
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU supports AVX2, checked on the line above.
+            let lanes = unsafe { dielectric_lanes_avx2(self, &t, &jacobian, cos_phi, sin_phi) };
+            return finish_lanes(&lanes, &factor, values);
+        }
+        let lanes = dielectric_lanes(self, &t, &jacobian, cos_phi, sin_phi);
+        finish_lanes(&lanes, &factor, values);
+    }
+}
+
+/// The first [`KRONROD_NODES`] lanes, each times its factor.
+fn finish_lanes(
+    lanes: &[[f64; 3]; LANES],
+    factor: &[f64; LANES],
+    values: &mut [[f64; 3]; KRONROD_NODES],
+) {
+    for k in 0..KRONROD_NODES {
+        values[k] = lanes[k].map(|v| factor[k] * v);
+    }
+}
+
+/// [`dielectric_lanes`] compiled for AVX2: bit-identical (the same IEEE operations in the same
+/// order per lane), several lanes at a time.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn dielectric_lanes_avx2<N: MicrofacetDistribution>(
+    view: &DielectricView<N>,
+    t: &[f64; LANES],
+    jacobian: &[f64; LANES],
+    cos_phi: f64,
+    sin_phi: f64,
+) -> [[f64; 3]; LANES] {
+    dielectric_lanes(view, t, jacobian, cos_phi, sin_phi)
+}
+
+/// `[R, T, 1 - E]` per unit `x` and `phi` at `t_k = tan(theta_m)`, times `jacobian_k`; nothing
+/// where a node rounds onto an end of its range (`s = 0`, where the integrand vanishes) or the
+/// normal faces away from the view.
+#[inline(always)]
+fn dielectric_lanes<N: MicrofacetDistribution>(
+    view: &DielectricView<N>,
+    t: &[f64; LANES],
+    jacobian: &[f64; LANES],
+    cos_phi: f64,
+    sin_phi: f64,
+) -> [[f64; 3]; LANES] {
+    let o = view.o;
+    let mut m = [Vec3::new(0.0, 0.0, 1.0); LANES];
+    let mut om = [0.0; LANES];
+    let mut density = [0.0; LANES];
+    let mut counts = [false; LANES];
+    for k in 0..LANES {
+        let t = t[k];
+        let cos_t = 1.0 / (1.0 + t * t).sqrt();
+        let sin_t = t * cos_t;
+        m[k] = Vec3::new(sin_t * cos_phi, sin_t * sin_phi, cos_t);
+        om[k] = o.dot(m[k]);
+        // dω_m = sin^2 cos dx dphi in these variables; G1(o) (o.m) D / mu is the visible density.
+        let sin_t = t * m[k].z;
+        density[k] = view.ndf.d_from_tan2(t * t)
+            * sin_t
+            * sin_t
+            * m[k].z
+            * om[k]
+            * view.inverse_area
+            * jacobian[k];
+        counts[k] = t > 0.0 && t < f64::INFINITY && om[k] > 0.0;
+    }
+    let scattering = scatterings_at_cos(
+        view.ndf,
+        view.masking,
+        &[o; LANES],
+        &[view.lambda_o; LANES],
+        &m,
+        &om,
+        view.eta,
+        view.convention,
+    );
+    let mut values = [[0.0; 3]; LANES];
+    for k in 0..LANES {
+        let s = scattering[k];
+        values[k] = if counts[k] {
+            [
+                density[k] * s.reflection,
+                density[k] * s.transmission,
+                density[k] * s.loss,
+            ]
+        } else {
+            [0.0; 3]
+        };
+    }
+    values
+}
+
 /// `[R, T, 1 - E]` for one distribution (see the module docs).
 fn quadrature<N: MicrofacetDistribution>(
     ndf: N,
@@ -480,30 +641,15 @@ fn quadrature<N: MicrofacetDistribution>(
         let t = alpha * x.exp();
         (normal_at(t, cos_phi, sin_phi), t)
     };
-    // [R, T, 1 - E] per unit x and phi at `t = tan(theta_m)`, times `jacobian` (`dx/dv` for
-    // another variable `v`).
-    let point_at = |t: f64, jacobian: f64, cos_phi: f64, sin_phi: f64| -> [f64; 3] {
-        // A node rounded onto `s = 0` (see below), where the integrand vanishes.
-        if !(t > 0.0 && t < f64::INFINITY) {
-            return [0.0; 3];
-        }
-        let m = normal_at(t, cos_phi, sin_phi);
-        let om = o.dot(m);
-        if om <= 0.0 {
-            return [0.0; 3];
-        }
-        // dω_m = sin^2 cos dx dphi in these variables; G1(o) (o.m) D / mu is the visible density.
-        let sin_t = t * m.z;
-        let density = ndf.d_from_tan2(t * t) * sin_t * sin_t * m.z * om * inverse_area * jacobian;
-        let s = scattering_with(ndf, masking, o, lambda_o, m, eta, convention);
-        [
-            density * s.reflection,
-            density * s.transmission,
-            density * s.loss,
-        ]
+    let view = DielectricView {
+        ndf,
+        masking,
+        o,
+        lambda_o,
+        inverse_area,
+        eta,
+        convention,
     };
-    let point =
-        |x: f64, cos_phi: f64, sin_phi: f64| point_at(alpha * x.exp(), 1.0, cos_phi, sin_phi);
     // The z of the refracted direction, where there is one.
     let refracted_z = |x: f64, cos_phi: f64, sin_phi: f64| -> Option<f64> {
         let (m, _) = normal(x, cos_phi, sin_phi);
@@ -619,44 +765,25 @@ fn quadrature<N: MicrofacetDistribution>(
         let mut total = [0.0; 4];
         for pair in breaks.windows(2) {
             let (a, b) = (pair[0], pair[1]);
-            let q = if a == x_min && b <= 0.0 && !critical.contains(&b) {
+            let (variable, lo, hi) = if a == x_min && b <= 0.0 && !critical.contains(&b) {
                 // Below the peak, from x = -infinity: in `s = t / (alpha + t)`, where the
                 // integrand (`~ e^(2x)` per unit x) is polynomial (as in `E`'s reference).
-                integrate(
-                    |s: f64| {
-                        let (t, jacobian) = t_of_s(s, alpha);
-                        point_at(t, jacobian, cos_phi, sin_phi)
-                    },
-                    0.0,
-                    s_of_x(b),
-                    inner_tolerance / pieces,
-                    settings.max_intervals,
-                )
+                (Variable::Logistic, 0.0, s_of_x(b))
             } else if critical.contains(&a) {
-                integrate(
-                    |s: f64| point(a + s * s, cos_phi, sin_phi).map(|v| 2.0 * s * v),
-                    0.0,
-                    (b - a).sqrt(),
-                    inner_tolerance / pieces,
-                    settings.max_intervals,
-                )
+                (Variable::SquareFrom(a), 0.0, (b - a).sqrt())
             } else if critical.contains(&b) {
-                integrate(
-                    |s: f64| point(b - s * s, cos_phi, sin_phi).map(|v| 2.0 * s * v),
-                    0.0,
-                    (b - a).sqrt(),
-                    inner_tolerance / pieces,
-                    settings.max_intervals,
-                )
+                (Variable::SquareTo(b), 0.0, (b - a).sqrt())
             } else {
-                integrate(
-                    |x: f64| point(x, cos_phi, sin_phi),
-                    a,
-                    b,
-                    inner_tolerance / pieces,
-                    settings.max_intervals,
-                )
+                (Variable::X, a, b)
             };
+            let q = integrate_pieces_batch(
+                &mut |nodes: &[f64; KRONROD_NODES], values: &mut [[f64; 3]; KRONROD_NODES]| {
+                    view.values_at(nodes, variable, cos_phi, sin_phi, values);
+                },
+                &[lo, hi],
+                inner_tolerance / pieces,
+                settings.max_intervals,
+            );
             evaluations += q.evaluations;
             all_converged &= q.converged;
             for (sum, value) in total.iter_mut().zip(q.value) {
@@ -698,5 +825,95 @@ fn quadrature<N: MicrofacetDistribution>(
         error: 2.0 * (outer.error + outer.value[3]),
         evaluations: evaluations + outer.evaluations,
         converged: all_converged && outer.converged,
+    }
+}
+
+#[cfg(test)]
+mod lane_tests {
+    use super::*;
+    use crate::model::Ggx;
+
+    /// Each lane against the scalar integrand written out (the normal at `t`, the visible
+    /// density per unit `x` and `phi`, [`scattering_with`]), bit for bit; and the AVX2 build
+    /// against the portable one. Both sides of the interface, both conventions, nodes through
+    /// the critical angle and total internal reflection.
+    #[test]
+    fn the_lanes_give_the_scalar_integrand() {
+        for eta in [1.0 / 1.5, 1.0, 1.5] {
+            for convention in [
+                TransmissionConvention::SingleScattering,
+                TransmissionConvention::Cycles,
+            ] {
+                for mu in [0.1_f64, 0.6] {
+                    let ndf = Ggx { alpha: 0.4 };
+                    let so = (1.0 - mu * mu).sqrt();
+                    let o = Vec3::new(so, 0.0, mu);
+                    let view = DielectricView {
+                        ndf,
+                        masking: Masking::HeightCorrelated,
+                        o,
+                        lambda_o: ndf.lambda(o),
+                        inverse_area: 1.0 / ndf.projected_area(mu),
+                        eta,
+                        convention,
+                    };
+                    let (sin_phi, cos_phi) = 2.0_f64.sin_cos();
+                    let mut t = [0.0; LANES];
+                    let jacobian = [1.5; LANES];
+                    for (k, t) in t.iter_mut().enumerate() {
+                        *t = 0.02 * 1.5_f64.powi(k as i32);
+                    }
+                    let lanes = dielectric_lanes(&view, &t, &jacobian, cos_phi, sin_phi);
+                    #[cfg(target_arch = "x86_64")]
+                    if std::arch::is_x86_feature_detected!("avx2") {
+                        // SAFETY: checked on the line above.
+                        let simd = unsafe {
+                            dielectric_lanes_avx2(&view, &t, &jacobian, cos_phi, sin_phi)
+                        };
+                        assert_eq!(
+                            simd.map(|v| v.map(f64::to_bits)),
+                            lanes.map(|v| v.map(f64::to_bits))
+                        );
+                    }
+                    for k in 0..LANES {
+                        let cos_t = 1.0 / (1.0 + t[k] * t[k]).sqrt();
+                        let m = Vec3::new(t[k] * cos_t * cos_phi, t[k] * cos_t * sin_phi, cos_t);
+                        let om = o.dot(m);
+                        let want = if om <= 0.0 {
+                            [0.0; 3]
+                        } else {
+                            let sin_t = t[k] * m.z;
+                            let density = ndf.d_from_tan2(t[k] * t[k])
+                                * sin_t
+                                * sin_t
+                                * m.z
+                                * om
+                                * view.inverse_area
+                                * jacobian[k];
+                            let s = scattering_with(
+                                ndf,
+                                Masking::HeightCorrelated,
+                                o,
+                                view.lambda_o,
+                                m,
+                                eta,
+                                convention,
+                            );
+                            [
+                                density * s.reflection,
+                                density * s.transmission,
+                                density * s.loss,
+                            ]
+                        };
+                        assert_eq!(
+                            lanes[k].map(f64::to_bits),
+                            want.map(f64::to_bits),
+                            "eta {eta} mu {mu} t {}",
+                            t[k]
+                        );
+                    }
+                }
+            }
+        }
     }
 }

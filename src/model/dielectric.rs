@@ -205,25 +205,94 @@ pub fn scattering_at_cos<N: MicrofacetDistribution>(
     eta: f64,
     convention: TransmissionConvention,
 ) -> Scattering {
-    let c = c.clamp(0.0, 1.0);
-    let fresnel = super::fresnel::dielectric(eta, c);
-    let reflection_loss = crate::model::masking::reflection_loss(ndf, masking, o, lambda_o, m);
-    let transmission_loss = match refract(o, m, c, eta) {
-        // Index-matched, i_t = -o: Lambda(i_t) = Lambda(o), and at a grazing view the loss takes
-        // its limit along the view (1/2 height-correlated, 1 separable), not the value at
-        // Lambda(o) = infinity with Lambda(i) finite that `Masking::loss` gives.
-        _ if eta == 1.0 => masking.loss_index_matched(ndf.alpha(), o.z, lambda_o),
-        Some(i_t) if i_t.z < 0.0 || (convention.keeps_refraction_above() && i_t.z > 0.0) => {
-            masking.loss_at(ndf.alpha(), o.z, i_t.z, lambda_o, ndf.lambda(i_t))
-        }
-        _ => 1.0,
-    };
-    let transmitted = 1.0 - fresnel;
-    Scattering {
-        reflection: fresnel * (1.0 - reflection_loss),
-        transmission: transmitted * (1.0 - transmission_loss),
-        loss: fresnel * reflection_loss + transmitted * transmission_loss,
+    let [s] = scatterings_at_cos(ndf, masking, &[o], &[lambda_o], &[m], &[c], eta, convention);
+    s
+}
+
+/// [`scattering_at_cos`] at `L` pairs of view and normal at once (`o[k]`, `lambda_o[k] =
+/// Lambda(o[k])`, `m[k]`, `c[k] = o[k].m[k]`), in stages over arrays of lanes whose every branch
+/// is a select, so that a caller's loop compiled for SIMD vectorises. The one home of the
+/// formulas: the scalar form calls it with one lane.
+#[must_use]
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+pub fn scatterings_at_cos<N: MicrofacetDistribution, const L: usize>(
+    ndf: N,
+    masking: Masking,
+    o: &[Vec3; L],
+    lambda_o: &[f64; L],
+    m: &[Vec3; L],
+    c: &[f64; L],
+    eta: f64,
+    convention: TransmissionConvention,
+) -> [Scattering; L] {
+    let alpha = ndf.alpha();
+    let mut fresnel = [0.0; L];
+    let mut reflected_z = [0.0; L];
+    let mut reflected_tan2 = [0.0; L];
+    let mut refracts = [false; L];
+    let mut refracted_z = [0.0; L];
+    let mut refracted_tan2 = [0.0; L];
+    for k in 0..L {
+        let c = c[k].clamp(0.0, 1.0);
+        fresnel[k] = super::fresnel::dielectric(eta, c);
+        let i = o[k].reflect(m[k]);
+        reflected_z[k] = i.z;
+        reflected_tan2[k] = i.tan2_theta();
+        // [`refract`], its total internal reflection a flag.
+        let sin2_t = (1.0 - c) * (1.0 + c) / (eta * eta);
+        refracts[k] = sin2_t < 1.0;
+        let cos_t = ((1.0 - sin2_t).max(0.0)).sqrt();
+        let i_t = m[k] * (c / eta - cos_t) - o[k] * (1.0 / eta);
+        refracted_z[k] = i_t.z;
+        refracted_tan2[k] = i_t.tan2_theta();
     }
+    let lambda_reflected = ndf.lambdas_from_tan2(&reflected_tan2);
+    let lambda_refracted = ndf.lambdas_from_tan2(&refracted_tan2);
+    let keeps_above = convention.keeps_refraction_above();
+    let mut scattering = [Scattering {
+        reflection: 0.0,
+        transmission: 0.0,
+        loss: 0.0,
+    }; L];
+    for k in 0..L {
+        let mu_o = o[k].z;
+        // [`crate::model::masking::reflection_loss`].
+        let reflection_loss = if reflected_z[k] > 0.0 {
+            masking.loss_at(
+                alpha,
+                mu_o,
+                reflected_z[k],
+                lambda_o[k],
+                lambda_reflected[k],
+            )
+        } else {
+            1.0
+        };
+        let transmission_loss = if eta == 1.0 {
+            // Index-matched, i_t = -o: Lambda(i_t) = Lambda(o), and at a grazing view the loss
+            // takes its limit along the view (1/2 height-correlated, 1 separable), not the value
+            // at Lambda(o) = infinity with Lambda(i) finite that `Masking::loss` gives.
+            masking.loss_index_matched(alpha, mu_o, lambda_o[k])
+        } else if refracts[k] && (refracted_z[k] < 0.0 || (keeps_above && refracted_z[k] > 0.0)) {
+            masking.loss_at(
+                alpha,
+                mu_o,
+                refracted_z[k],
+                lambda_o[k],
+                lambda_refracted[k],
+            )
+        } else {
+            1.0
+        };
+        let transmitted = 1.0 - fresnel[k];
+        scattering[k] = Scattering {
+            reflection: fresnel[k] * (1.0 - reflection_loss),
+            transmission: transmitted * (1.0 - transmission_loss),
+            loss: fresnel[k] * reflection_loss + transmitted * transmission_loss,
+        };
+    }
+    scattering
 }
 
 #[cfg(test)]
