@@ -29,6 +29,11 @@
 //! `E_avg = ∫_0^1 2 mu E(mu) dmu` integrates the inner result over `mu`, with breaks at
 //! `alpha / 16, alpha / 4, alpha, 4 alpha` where `E` has its grazing boundary layer.
 //!
+//! The integrand is evaluated a whole 15-point rule at a time
+//! ([`integrate_pieces_batch`]), in stages over arrays of lanes with selects for branches, and
+//! compiled a second time for AVX2 (picked at run time): the same operations in the same order
+//! per node as one node at a time, so the results are the same bits, 1.7 times faster.
+//!
 //! Error estimates are Gauss-Kronrod's `|K15 - G7|`, summed over intervals and propagated through
 //! the nesting (the outer integral adds the integral of the inner estimates). They are pessimistic
 //! for these smooth pieces: the tests compare against closed forms to far below the estimate.
@@ -289,7 +294,16 @@ fn albedo_quadrature<N: MicrofacetDistribution>(
             1.0
         };
         let mut above = |nodes: &[f64; KRONROD_NODES], values: &mut [[f64; 2]; KRONROD_NODES]| {
-            view.values_at(nodes, Piece::A, cos_phi, sin_phi, h, values);
+            view.values_at(
+                Batch {
+                    nodes,
+                    piece: Piece::A,
+                    cos_phi,
+                    sin_phi,
+                },
+                h,
+                values,
+            );
         };
         let x_star = (tan_star / alpha).ln();
         let breaks: Vec<f64> = horizon_breaks(
@@ -306,7 +320,16 @@ fn albedo_quadrature<N: MicrofacetDistribution>(
         let a =
             integrate_pieces_batch(&mut above, &breaks, inner_tolerance, settings.max_intervals);
         let mut below = |nodes: &[f64; KRONROD_NODES], values: &mut [[f64; 2]; KRONROD_NODES]| {
-            view.values_at(nodes, Piece::B, cos_phi, sin_phi, h, values);
+            view.values_at(
+                Batch {
+                    nodes,
+                    piece: Piece::B,
+                    cos_phi,
+                    sin_phi,
+                },
+                h,
+                values,
+            );
         };
         let b = integrate_pieces_batch(
             &mut below,
@@ -360,6 +383,15 @@ enum Piece {
     B,
 }
 
+/// One rule's nodes in a piece's variable, at one azimuth.
+#[derive(Clone, Copy)]
+struct Batch<'a> {
+    nodes: &'a [f64; KRONROD_NODES],
+    piece: Piece,
+    cos_phi: f64,
+    sin_phi: f64,
+}
+
 impl<N: MicrofacetDistribution> View<N> {
     /// `[E part, 1 - E part]` per unit of the piece's variable at one rule's nodes, at azimuth
     /// `phi`: in piece A `D (o.m) G2 / mu h(o.m)` and `D (o.m) / (mu (1 + Lambda(o))) loss`; in
@@ -368,10 +400,7 @@ impl<N: MicrofacetDistribution> View<N> {
     #[inline(always)]
     fn values_at(
         &self,
-        nodes: &[f64; KRONROD_NODES],
-        piece: Piece,
-        cos_phi: f64,
-        sin_phi: f64,
+        batch: Batch,
         h: impl Fn(f64) -> f64 + Copy,
         values: &mut [[f64; 2]; KRONROD_NODES],
     ) {
@@ -381,10 +410,7 @@ impl<N: MicrofacetDistribution> View<N> {
         match self.masking {
             // G2 / mu = 1 / (mu (1 + Lo) + mu Li).
             Masking::HeightCorrelated => self.lanes(
-                nodes,
-                piece,
-                cos_phi,
-                sin_phi,
+                batch,
                 h,
                 values,
                 #[inline(always)]
@@ -396,10 +422,7 @@ impl<N: MicrofacetDistribution> View<N> {
                 },
             ),
             Masking::Separable => self.lanes(
-                nodes,
-                piece,
-                cos_phi,
-                sin_phi,
+                batch,
                 h,
                 values,
                 #[inline(always)]
@@ -412,10 +435,7 @@ impl<N: MicrofacetDistribution> View<N> {
             ),
             // G1_S(o) G1_S(i) / mu = G1_S(i) / (mu (1 - k) + k), k = alpha / 2.
             Masking::SchlickGgx => self.lanes(
-                nodes,
-                piece,
-                cos_phi,
-                sin_phi,
+                batch,
                 h,
                 values,
                 #[inline(always)]
@@ -433,13 +453,9 @@ impl<N: MicrofacetDistribution> View<N> {
     /// it. The result is bit-identical either way: the same IEEE operations in the same order per
     /// lane (Rust never fuses a multiply and an add on its own), several lanes at a time.
     #[inline(always)]
-    #[allow(clippy::too_many_arguments)]
     fn lanes(
         &self,
-        nodes: &[f64; KRONROD_NODES],
-        piece: Piece,
-        cos_phi: f64,
-        sin_phi: f64,
+        batch: Batch,
         h: impl Fn(f64) -> f64 + Copy,
         values: &mut [[f64; 2]; KRONROD_NODES],
         masking_terms: impl Fn(f64, f64) -> (f64, f64) + Copy,
@@ -447,72 +463,41 @@ impl<N: MicrofacetDistribution> View<N> {
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU supports AVX2, checked on the line above.
-            return unsafe {
-                lanes_avx2(
-                    self,
-                    nodes,
-                    piece,
-                    cos_phi,
-                    sin_phi,
-                    h,
-                    values,
-                    masking_terms,
-                )
-            };
+            return unsafe { lanes_avx2(self, batch, h, values, masking_terms) };
         }
-        lanes_portable(
-            self,
-            nodes,
-            piece,
-            cos_phi,
-            sin_phi,
-            h,
-            values,
-            masking_terms,
-        );
+        lanes_portable(self, batch, h, values, masking_terms);
     }
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-#[allow(clippy::too_many_arguments)]
 fn lanes_avx2<N: MicrofacetDistribution>(
     view: &View<N>,
-    nodes: &[f64; KRONROD_NODES],
-    piece: Piece,
-    cos_phi: f64,
-    sin_phi: f64,
+    batch: Batch,
     h: impl Fn(f64) -> f64 + Copy,
     values: &mut [[f64; 2]; KRONROD_NODES],
     masking_terms: impl Fn(f64, f64) -> (f64, f64) + Copy,
 ) {
-    lanes_portable(
-        view,
-        nodes,
-        piece,
-        cos_phi,
-        sin_phi,
-        h,
-        values,
-        masking_terms,
-    );
+    lanes_portable(view, batch, h, values, masking_terms);
 }
 
 /// The loops over lanes of [`View::values_at`]: in stages over arrays of lanes, each a loop
 /// simple enough to vectorise (no calls, no branch but selects). The rule's 15 nodes are padded
 /// to [`LANES`] with a copy of the first, whose result is dropped.
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
 fn lanes_portable<N: MicrofacetDistribution>(
     view: &View<N>,
-    nodes: &[f64; KRONROD_NODES],
-    piece: Piece,
-    cos_phi: f64,
-    sin_phi: f64,
+    batch: Batch,
     h: impl Fn(f64) -> f64 + Copy,
     values: &mut [[f64; 2]; KRONROD_NODES],
     masking_terms: impl Fn(f64, f64) -> (f64, f64) + Copy,
 ) {
+    let Batch {
+        nodes,
+        piece,
+        cos_phi,
+        sin_phi,
+    } = batch;
     let alpha = view.ndf.alpha();
     let in_x = piece == Piece::A;
     let mut om = [0.0; LANES];
@@ -858,7 +843,16 @@ mod lane_tests {
                         ] {
                             let nodes = crate::numerics::gauss_kronrod::tests::nodes_of(a, b);
                             let mut values = [[0.0; 2]; KRONROD_NODES];
-                            view.values_at(&nodes, piece, cos_phi, sin_phi, |_| 1.0, &mut values);
+                            view.values_at(
+                                Batch {
+                                    nodes: &nodes,
+                                    piece,
+                                    cos_phi,
+                                    sin_phi,
+                                },
+                                |_| 1.0,
+                                &mut values,
+                            );
                             let mut portable = [[0.0; 2]; KRONROD_NODES];
                             let terms = |iz: f64, lambda_i: f64| {
                                 let g2 = match masking {
@@ -873,16 +867,13 @@ mod lane_tests {
                                 };
                                 (g2, masking.loss_at(alpha, mu, iz, view.lambda_o, lambda_i))
                             };
-                            lanes_portable(
-                                &view,
-                                &nodes,
+                            let batch = Batch {
+                                nodes: &nodes,
                                 piece,
                                 cos_phi,
                                 sin_phi,
-                                |_| 1.0,
-                                &mut portable,
-                                terms,
-                            );
+                            };
+                            lanes_portable(&view, batch, |_| 1.0, &mut portable, terms);
                             for (k, &v) in nodes.iter().enumerate() {
                                 assert_eq!(
                                     values[k].map(f64::to_bits),
