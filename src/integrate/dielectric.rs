@@ -38,7 +38,7 @@ use super::albedo::{
 };
 use super::dielectric_average::average;
 use super::estimate::Estimate;
-use super::gauss_kronrod::{KRONROD_NODES, integrate_pieces, integrate_pieces_batch};
+use super::gauss_kronrod::{KRONROD_NODES, Quadrature, integrate_pieces, integrate_pieces_batch};
 use super::reference::{
     ReferenceSettings, ReferenceValue, ladder, phi_breaks, s_of_x, t_of_s, x_range,
 };
@@ -235,6 +235,25 @@ pub struct DielectricReference {
 }
 
 impl DielectricReference {
+    /// From the outer integral of `[R, T, 1 - E, the inner integrals' error estimates]`, each
+    /// times `scale`; the stated error adds the outer rule's estimate to the inner ones', and
+    /// the inner integrals' evaluations and convergence are the caller's tally.
+    pub(crate) fn from_outer(
+        outer: &Quadrature<4>,
+        scale: f64,
+        inner_evaluations: u64,
+        inner_converged: bool,
+    ) -> Self {
+        Self {
+            reflection: scale * outer.value[0],
+            transmission: scale * outer.value[1],
+            one_minus_value: scale * outer.value[2],
+            error: scale * (outer.error + outer.value[3]),
+            evaluations: inner_evaluations + outer.evaluations,
+            converged: inner_converged && outer.converged,
+        }
+    }
+
     /// `E = R + T`.
     #[must_use]
     pub fn value(&self) -> f64 {
@@ -439,14 +458,7 @@ pub fn nested_dielectric_average_albedo_with(
         settings.tolerance / 2.0,
         settings.max_intervals,
     );
-    DielectricReference {
-        reflection: outer.value[0],
-        transmission: outer.value[1],
-        one_minus_value: outer.value[2],
-        error: outer.error + outer.value[3],
-        evaluations: evaluations + outer.evaluations,
-        converged: converged && outer.converged,
-    }
+    DielectricReference::from_outer(&outer, 1.0, evaluations, converged)
 }
 
 /// How far (in `x`) the ladders toward the two horizons reach.
@@ -818,14 +830,8 @@ fn quadrature<N: MicrofacetDistribution>(
         settings.tolerance / 4.0,
         settings.max_intervals,
     );
-    DielectricReference {
-        reflection: 2.0 * outer.value[0],
-        transmission: 2.0 * outer.value[1],
-        one_minus_value: 2.0 * outer.value[2],
-        error: 2.0 * (outer.error + outer.value[3]),
-        evaluations: evaluations + outer.evaluations,
-        converged: all_converged && outer.converged,
-    }
+    // Doubled: the azimuths run over [0, pi] of the symmetric [-pi, pi].
+    DielectricReference::from_outer(&outer, 2.0, evaluations, all_converged)
 }
 
 #[cfg(test)]

@@ -132,6 +132,19 @@ struct Slice<N> {
     convention: TransmissionConvention,
 }
 
+impl<N: MicrofacetDistribution> Slice<N> {
+    /// [`slice_lanes`], compiled for AVX2 where the CPU has it.
+    #[inline(always)]
+    fn values_at(&self, o: &[Vec3; LANES]) -> [[f64; 4]; LANES] {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU supports AVX2, checked on the line above.
+            return unsafe { slice_lanes_avx2(self, o) };
+        }
+        slice_lanes(self, o)
+    }
+}
+
 /// [`slice_lanes`] compiled for AVX2: bit-identical (the same IEEE operations in the same order
 /// per lane), several lanes at a time.
 #[cfg(target_arch = "x86_64")]
@@ -312,6 +325,14 @@ pub(crate) fn average<N: MicrofacetDistribution>(
             if breaks.len() < 2 {
                 return [0.0; 4];
             }
+            let slice = Slice {
+                ndf,
+                masking,
+                m,
+                cos_h,
+                eta,
+                convention,
+            };
             let q = integrate_pieces_batch(
                 &mut |nodes: &[f64; KRONROD_NODES], values: &mut [[f64; 4]; KRONROD_NODES]| {
                     // The view at each node `phi_h` (around `m`, at angle `theta_h` from it).
@@ -324,23 +345,7 @@ pub(crate) fn average<N: MicrofacetDistribution>(
                             a - b * cos_p,
                         );
                     }
-                    let slice = Slice {
-                        ndf,
-                        masking,
-                        m,
-                        cos_h,
-                        eta,
-                        convention,
-                    };
-                    #[cfg(target_arch = "x86_64")]
-                    if std::arch::is_x86_feature_detected!("avx2") {
-                        // SAFETY: the CPU supports AVX2, checked on the line above.
-                        let lanes = unsafe { slice_lanes_avx2(&slice, &o) };
-                        values.copy_from_slice(&lanes[..KRONROD_NODES]);
-                        return;
-                    }
-                    let lanes = slice_lanes(&slice, &o);
-                    values.copy_from_slice(&lanes[..KRONROD_NODES]);
+                    values.copy_from_slice(&slice.values_at(&o)[..KRONROD_NODES]);
                 },
                 &breaks,
                 inner_tolerance,
@@ -371,14 +376,7 @@ pub(crate) fn average<N: MicrofacetDistribution>(
         tolerance / 2.0,
         max_intervals,
     );
-    DielectricReference {
-        reflection: outer.value[0],
-        transmission: outer.value[1],
-        one_minus_value: outer.value[2],
-        error: outer.error + outer.value[3],
-        evaluations: evaluations + outer.evaluations,
-        converged: converged && outer.converged,
-    }
+    DielectricReference::from_outer(&outer, 1.0, evaluations, converged)
 }
 
 #[cfg(test)]
