@@ -6,7 +6,6 @@
 
 use crate::cache::{Cache, CacheKey};
 use crate::error::{Error, Result};
-use crate::integrate::average_quadrature::rule_average_albedo;
 use crate::integrate::reference::ReferenceSettings;
 use crate::integrate::value::Point;
 use crate::integrate::{Estimate, QmcSettings};
@@ -234,8 +233,9 @@ impl BakeOptions {
     /// falls as about `N^-0.9`, at the smallest power of two `N >= (2 / max_error)^(1 / 0.9)`
     /// (twice the margin; 16 times that for `E_avg`); below 1e-3, where it is cheaper at every
     /// accuracy, the quadrature at tolerance `10^-d`, the largest power of ten at most
-    /// `max_error`, with `E_avg` by the cheapest fixed rule whose measured bound is within that
-    /// tolerance ([`TableSpec::average_rule_order`]). The quadrature's stated error is a bound of
+    /// `max_error`, with `E_avg` by the cheapest fixed rule whose measured bound is within half
+    /// that tolerance, its `E` evaluations at the other half
+    /// ([`crate::integrate::average_quadrature::average_albedo_to`]). The quadrature's stated error is a bound of
     /// its actual error (tested against itself at far tighter tolerances, and at the default
     /// table's every node by `kiln verify`: 2.5e-10 at tolerance 1e-7), so every texel is within
     /// the tolerance. Until numerics version 5 the tolerance was a tenth of that, and the tables
@@ -683,8 +683,9 @@ pub fn bake_table(spec: TableSpec, command: String, progress: &(dyn Fn(u64) + Sy
 
 /// The estimate of one texel (row-major index, slowest axis first): the spec's integral
 /// ([`TableSpec::integral`]) at the texel's point by the spec's method
-/// ([`crate::integrate::value`]); with [`Method::Reference`] at a chosen tolerance, `E_avg`
-/// by a fixed rule whose measured error bound is within it ([`TableSpec::average_rule_order`]).
+/// ([`crate::integrate::value`]), with [`Method::Reference`] at the spec's tolerance (`E_avg`
+/// by a fixed rule whose measured error bound is within half of it where one is,
+/// [`crate::integrate::average_quadrature::average_albedo_to`]).
 #[must_use]
 pub fn estimate_texel(spec: &TableSpec, index: usize) -> Estimate {
     let (alpha, mu) = spec.texel_coordinates(index);
@@ -697,11 +698,7 @@ pub fn estimate_texel(spec: &TableSpec, index: usize) -> Estimate {
     match spec.method {
         Method::Qmc => integral.qmc(at, &spec.qmc),
         Method::Reference => {
-            let settings = spec.reference_settings();
-            let r = match (mu, spec.average_rule_order()) {
-                (None, Some(order)) => rule_average_albedo(spec.model, alpha, order, &settings),
-                _ => integral.reference(at, &settings),
-            };
+            let r = integral.reference(at, &spec.reference_settings());
             Estimate {
                 value: r.value,
                 one_minus_value: r.one_minus_value,

@@ -49,6 +49,7 @@ use crate::model::fresnel::dielectric;
 use crate::model::{
     Beckmann, Ggx, Masking, MicrofacetDistribution, Model, Ndf, SMOOTH_ALPHA, Vec3,
 };
+use crate::numerics::elementary::exp_lane;
 use serde::Serialize;
 use std::f64::consts::PI;
 
@@ -516,14 +517,14 @@ impl<N: MicrofacetDistribution> DielectricView<N> {
         for k in 0..LANES {
             let v = nodes[k % KRONROD_NODES];
             match variable {
-                Variable::X => t[k] = alpha * v.exp(),
+                Variable::X => t[k] = alpha * exp_lane(v),
                 Variable::Logistic => (t[k], jacobian[k]) = t_of_s(v, alpha),
                 Variable::SquareFrom(edge) => {
-                    t[k] = alpha * (edge + v * v).exp();
+                    t[k] = alpha * exp_lane(edge + v * v);
                     factor[k] = 2.0 * v;
                 }
                 Variable::SquareTo(edge) => {
-                    t[k] = alpha * (edge - v * v).exp();
+                    t[k] = alpha * exp_lane(edge - v * v);
                     factor[k] = 2.0 * v;
                 }
             }

@@ -33,6 +33,7 @@ use super::gauss_kronrod::{KRONROD_NODES, integrate_pieces, integrate_pieces_bat
 use super::reference::{ReferenceSettings, ladder, s_of_x, t_of_s};
 use crate::model::dielectric::{TransmissionConvention, scatterings_at_cos};
 use crate::model::{Masking, MicrofacetDistribution, Vec3};
+use crate::numerics::elementary::sin_cos_lane;
 use std::f64::consts::{FRAC_PI_2, PI};
 
 /// How a piece of a level is mapped onto its share `[k, k + 1]` of the rule's variable: plainly,
@@ -338,7 +339,7 @@ pub(crate) fn average<N: MicrofacetDistribution>(
                     // The view at each node `phi_h` (around `m`, at angle `theta_h` from it).
                     let mut o = [m; LANES];
                     for k in 0..LANES {
-                        let (sin_p, cos_p) = nodes[k % KRONROD_NODES].sin_cos();
+                        let (sin_p, cos_p) = sin_cos_lane(nodes[k % KRONROD_NODES]);
                         o[k] = Vec3::new(
                             cos_h * sin_m + sin_h * cos_p * cos_m,
                             sin_h * sin_p,

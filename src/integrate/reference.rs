@@ -50,6 +50,7 @@ use crate::model::{
     Beckmann, Ggx, Masking, MicrofacetDistribution, Model, Ndf, SMOOTH_ALPHA, Vec3,
     albedo_is_exactly_one, smooth_point,
 };
+use crate::numerics::elementary::exp_lane;
 use serde::Serialize;
 use std::f64::consts::PI;
 
@@ -505,15 +506,13 @@ fn lanes_portable<N: MicrofacetDistribution>(
     let mut counts = [false; LANES];
     let mut iz = [0.0; LANES];
     let mut tan2_i = [0.0; LANES];
-    // `t = alpha e^x` at the nodes `u = 1/2 + x` of piece A above the peak (`dx/du = 1`), a
-    // library call per node, made only there.
+    // `t = alpha e^x` at the nodes `u = 1/2 + x` of piece A above the peak (`dx/du = 1`), by
+    // the lane-wise `exp` (the nodes below the peak, `u < 1/2`, are clamped into its range and
+    // take `t_s` instead).
     let mut t_x = [f64::NAN; LANES];
     if in_x {
         for k in 0..LANES {
-            let v = nodes[k % KRONROD_NODES];
-            if v >= 0.5 {
-                t_x[k] = alpha * (v - 0.5).exp();
-            }
+            t_x[k] = alpha * exp_lane((nodes[k % KRONROD_NODES] - 0.5).max(0.0));
         }
     }
     for k in 0..LANES {

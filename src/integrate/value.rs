@@ -13,7 +13,9 @@
 //! - `E_F` for a grey Fresnel model: for a dielectric the reflected part of the dielectric
 //!   quadrature (it splits at the critical angle, where `F` has a square-root kink that misleads
 //!   the generic rule's error estimate), otherwise the reference weighted by `F(o.h)`;
-//! - `E_avg`: the composite rule in smooth variables ([`quadrature_average_albedo`], within
+//! - `E_avg`: the fixed Gauss-Legendre rule whose measured bound is within half the tolerance,
+//!   where one is ([`average_albedo_to`]), else the composite rule in smooth variables
+//!   ([`super::average_quadrature::quadrature_average_albedo`], within
 //!   1e-10 of the nested reference), or 3-D QMC;
 //! - the dielectric tables: their own quadrature or QMC ([`super::dielectric`]) in the
 //!   integral's [`TransmissionConvention`], light from inside at `1 / eta` for the `_inside`
@@ -21,7 +23,7 @@
 //! - `F_avg`: Gauss-Kronrod to 1e-14 whatever the method (a 1-D integral).
 
 use super::albedo::{QmcSettings, albedo, average_albedo, weighted_albedo};
-use super::average_quadrature::quadrature_average_albedo;
+use super::average_quadrature::average_albedo_to;
 use super::dielectric::{
     dielectric_albedo_with, dielectric_average_albedo_with, reference_dielectric_albedo_with,
     reference_dielectric_average_albedo_with,
@@ -106,7 +108,7 @@ impl Integral {
         match (mu, self.quantity.weight()) {
             (Some(mu), None) => reference_albedo(self.model, alpha, mu, settings),
             (Some(mu), Some(h)) => reference_weighted_albedo(self.model, alpha, mu, h, settings),
-            (None, _) => quadrature_average_albedo(self.model, alpha, settings),
+            (None, _) => average_albedo_to(self.model, alpha, settings),
         }
     }
 

@@ -117,27 +117,6 @@ impl TableSpec {
         settings
     }
 
-    /// With [`Method::Reference`] at a chosen tolerance (`reference_digits` set, as a bake at a
-    /// requested max error does), `E_avg` entries use the fixed Gauss-Legendre rule of this order
-    /// ([`crate::integrate::average_quadrature::rule_average_albedo`]) whose measured bound is
-    /// within the tolerance; otherwise (`None`, or no offered rule is that good) the adaptive
-    /// rule.
-    #[must_use]
-    pub fn average_rule_order(&self) -> Option<usize> {
-        // The rules' bounds were measured for the Smith forms only.
-        if self.method != Method::Reference
-            || self.quantity != Quantity::EAvg
-            || self.reference_digits.is_none()
-            || !self.model.masking.is_smith()
-        {
-            return None;
-        }
-        crate::integrate::average_quadrature::rule_order_for(
-            self.model.ndf,
-            self.reference_settings().tolerance,
-        )
-    }
-
     /// The axes, slowest-varying first: `[eta, roughness, mu]` with the absent ones left out.
     #[must_use]
     pub fn axes(&self) -> Vec<Axis> {
@@ -491,30 +470,6 @@ mod tests {
     use crate::integrate::QmcSettings;
     use crate::model::{Masking, Ndf};
     use axis::{Grid, MuMapping};
-
-    /// The fixed E_avg rules' bounds were measured for the Smith forms: a Schlick-GGX table at a
-    /// chosen tolerance takes the adaptive rule, a height-correlated one a fixed rule.
-    #[test]
-    fn fixed_average_rules_serve_the_smith_forms_only() {
-        let spec = |masking| {
-            crate::BakeOptions {
-                quantities: vec![Quantity::EAvg],
-                maskings: vec![masking],
-                max_error: Some(1e-6),
-                ..crate::BakeOptions::default()
-            }
-            .resolved()
-            .specs()
-            .remove(0)
-        };
-        assert!(
-            spec(Masking::HeightCorrelated)
-                .average_rule_order()
-                .is_some()
-        );
-        assert!(spec(Masking::Separable).average_rule_order().is_some());
-        assert_eq!(spec(Masking::SchlickGgx).average_rule_order(), None);
-    }
 
     fn synthetic(grid: Grid, mapping: MuMapping) -> Table {
         let spec = TableSpec {
