@@ -405,8 +405,22 @@ impl<N: MicrofacetDistribution> View<N> {
         h: impl Fn(f64) -> f64 + Copy,
         values: &mut [[f64; 2]; KRONROD_NODES],
     ) {
+        self.values_with(batch, h, values, true);
+    }
+
+    /// [`View::values_at`], compiled for AVX2 where the CPU has it if `allow_avx2` (the portable
+    /// build otherwise, for the test that the two agree bit for bit).
+    #[inline(always)]
+    fn values_with(
+        &self,
+        batch: Batch,
+        h: impl Fn(f64) -> f64 + Copy,
+        values: &mut [[f64; 2]; KRONROD_NODES],
+        allow_avx2: bool,
+    ) {
         let (mu, alpha, lambda_o) = (self.mu, self.ndf.alpha(), self.lambda_o);
         let inverse_area = self.inverse_area;
+        let area = 1.0 / inverse_area;
         // `(G2 / mu, loss)` from `i.z` and `Lambda(i)`, one masking form per loop.
         match self.masking {
             // G2 / mu = 1 / (mu (1 + Lo) + mu Li).
@@ -414,24 +428,37 @@ impl<N: MicrofacetDistribution> View<N> {
                 batch,
                 h,
                 values,
+                allow_avx2,
                 #[inline(always)]
-                move |iz, lambda_i| {
-                    (
-                        1.0 / (1.0 / inverse_area + mu * lambda_i),
-                        Masking::HeightCorrelated.loss_at(alpha, mu, iz, lambda_o, lambda_i),
-                    )
+                move |_iz, lambda_i| {
+                    // One division for both: the loss `Li / (1 + Lo + Li)` is `mu Li G2 / mu`
+                    // ([`Masking::loss`]'s limits as selects: 1 for a horizontal `i`, 0 for a
+                    // view on the horizon).
+                    let g2_over_mu = 1.0 / (area + mu * lambda_i);
+                    let loss = if lambda_i == f64::INFINITY {
+                        if lambda_o == f64::INFINITY { 0.0 } else { 1.0 }
+                    } else {
+                        mu * lambda_i * g2_over_mu
+                    };
+                    (g2_over_mu, loss)
                 },
             ),
             Masking::Separable => self.lanes(
                 batch,
                 h,
                 values,
+                allow_avx2,
                 #[inline(always)]
-                move |iz, lambda_i| {
-                    (
-                        inverse_area / (1.0 + lambda_i),
-                        Masking::Separable.loss_at(alpha, mu, iz, lambda_o, lambda_i),
-                    )
+                move |_iz, lambda_i| {
+                    // G1(i) = 1 / (1 + Li) once for both; the loss `1 - G1(i)` is `Li G1(i)`
+                    // (1 for a horizontal `i`, [`Masking::loss`]).
+                    let g1_i = 1.0 / (1.0 + lambda_i);
+                    let loss = if lambda_i == f64::INFINITY {
+                        1.0
+                    } else {
+                        lambda_i * g1_i
+                    };
+                    (inverse_area * g1_i, loss)
                 },
             ),
             // G1_S(o) G1_S(i) / mu = G1_S(i) / (mu (1 - k) + k), k = alpha / 2.
@@ -439,6 +466,7 @@ impl<N: MicrofacetDistribution> View<N> {
                 batch,
                 h,
                 values,
+                allow_avx2,
                 #[inline(always)]
                 move |iz, lambda_i| {
                     (
@@ -459,10 +487,11 @@ impl<N: MicrofacetDistribution> View<N> {
         batch: Batch,
         h: impl Fn(f64) -> f64 + Copy,
         values: &mut [[f64; 2]; KRONROD_NODES],
+        allow_avx2: bool,
         masking_terms: impl Fn(f64, f64) -> (f64, f64) + Copy,
     ) {
         #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") {
+        if allow_avx2 && std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU supports AVX2, checked on the line above.
             return unsafe { lanes_avx2(self, batch, h, values, masking_terms) };
         }
@@ -499,45 +528,39 @@ fn lanes_portable<N: MicrofacetDistribution>(
         cos_phi,
         sin_phi,
     } = batch;
-    let alpha = view.ndf.alpha();
-    let in_x = piece == Piece::A;
+    // The normals and their density per unit of the piece's variable: piece A above the peak
+    // in `x` (a rule's nodes all lie on one side of the peak, a break: the centre tells),
+    // through the lane-wise `exp`; `s` elsewhere.
+    let polar = if piece == Piece::A && nodes[0] >= 0.5 {
+        let mut exp_x = [0.0; LANES];
+        for k in 0..LANES {
+            exp_x[k] = exp_lane((nodes[k % KRONROD_NODES] - 0.5).max(0.0));
+        }
+        view.ndf.polar_lanes_in_x(&exp_x)
+    } else {
+        let mut s = [0.0; LANES];
+        for k in 0..LANES {
+            s[k] = nodes[k % KRONROD_NODES];
+        }
+        view.ndf.polar_lanes_in_s(&s)
+    };
     let mut om = [0.0; LANES];
     let mut weight = [0.0; LANES];
     let mut counts = [false; LANES];
     let mut iz = [0.0; LANES];
-    let mut tan2_i = [0.0; LANES];
-    // `t = alpha e^x` at the nodes `u = 1/2 + x` of piece A above the peak (`dx/du = 1`), by
-    // the lane-wise `exp` (the nodes below the peak, `u < 1/2`, are clamped into its range and
-    // take `t_s` instead).
-    let mut t_x = [f64::NAN; LANES];
-    if in_x {
-        for k in 0..LANES {
-            t_x[k] = alpha * exp_lane((nodes[k % KRONROD_NODES] - 0.5).max(0.0));
-        }
-    }
+    let mut xy2_i = [0.0; LANES];
     for k in 0..LANES {
-        // `(t, dx/dv)` at the node: `t = alpha s / (1 - s)`, `dx/ds = 1 / (s (1 - s))` in `s`.
-        let v = nodes[k % KRONROD_NODES];
-        let (t_s, jacobian_s) = t_of_s(v, alpha);
-        let (t, jacobian) = if in_x && v >= 0.5 {
-            (t_x[k], 1.0)
-        } else {
-            (t_s, jacobian_s)
-        };
-        // The normal, and `D(m) sin^2 cos (o.m) dx/dv` (`dω_m = sin^2 cos dx dphi`).
-        let t2 = t * t;
-        let cos_t = 1.0 / (1.0 + t2).sqrt();
-        let sin_t = t * cos_t;
-        let m = Vec3::new(sin_t * cos_phi, sin_t * sin_phi, cos_t);
+        // The normal, and `D(m) sin^2 cos (o.m) dx/dv` (`dω_m = sin^2 cos dx dphi`); nothing
+        // where the normal faces away from the view (or where the node rounds onto an end of
+        // its range, which the density makes 0).
+        let sin_t = polar.sin[k];
+        let m = Vec3::new(sin_t * cos_phi, sin_t * sin_phi, polar.cos[k]);
         om[k] = view.o.dot(m);
-        weight[k] = view.ndf.d_from_tan2(t2) * sin_t * sin_t * cos_t * om[k] * jacobian;
-        // Nothing where the node rounds onto an end of the range (`u = 0`, `s = 1` in f64, where
-        // the integrand vanishes per unit of the variable or its interval holds nothing f64 can
-        // add), nor where the normal faces away from the view.
-        counts[k] = t > 0.0 && t < f64::INFINITY && om[k] > 0.0;
+        weight[k] = polar.density[k] * om[k];
+        counts[k] = om[k] > 0.0;
         let i = view.o.reflect(m);
         iz[k] = i.z;
-        tan2_i[k] = i.tan2_theta();
+        xy2_i[k] = i.x * i.x + i.y * i.y;
     }
     if piece == Piece::B {
         for k in 0..KRONROD_NODES {
@@ -552,7 +575,7 @@ fn lanes_portable<N: MicrofacetDistribution>(
         }
         return;
     }
-    let lambda_i = view.ndf.lambdas_from_tan2(&tan2_i);
+    let lambda_i = view.ndf.lambdas_of_directions(&xy2_i, &iz);
     let inverse_area = view.inverse_area;
     let mut out = [[0.0; 2]; LANES];
     for k in 0..LANES {
@@ -853,26 +876,13 @@ mod lane_tests {
                                 &mut values,
                             );
                             let mut portable = [[0.0; 2]; KRONROD_NODES];
-                            let terms = |iz: f64, lambda_i: f64| {
-                                let g2 = match masking {
-                                    Masking::HeightCorrelated => {
-                                        1.0 / (1.0 / view.inverse_area + mu * lambda_i)
-                                    }
-                                    Masking::Separable => view.inverse_area / (1.0 + lambda_i),
-                                    Masking::SchlickGgx => {
-                                        Masking::schlick_g1(iz, alpha)
-                                            / (mu * (1.0 - 0.5 * alpha) + 0.5 * alpha)
-                                    }
-                                };
-                                (g2, masking.loss_at(alpha, mu, iz, view.lambda_o, lambda_i))
-                            };
                             let batch = Batch {
                                 nodes: &nodes,
                                 piece,
                                 cos_phi,
                                 sin_phi,
                             };
-                            lanes_portable(&view, batch, |_| 1.0, &mut portable, terms);
+                            view.values_with(batch, |_| 1.0, &mut portable, false);
                             for (k, &v) in nodes.iter().enumerate() {
                                 assert_eq!(
                                     values[k].map(f64::to_bits),

@@ -17,7 +17,7 @@ use serde::{Deserialize, Serialize};
 
 pub use fresnel::Fresnel;
 pub use masking::Masking;
-pub use ndf::{Beckmann, Ggx, MicrofacetDistribution};
+pub use ndf::{Beckmann, Ggx, MicrofacetDistribution, Polar};
 pub use vector::Vec3;
 
 /// Below this slope-space roughness kiln treats the surface as smooth: `E` comes from the

@@ -33,6 +33,50 @@ pub trait MicrofacetDistribution: Copy + Send + Sync {
         tan2_theta.map(|tan2| self.lambda_from_tan2(tan2))
     }
 
+    /// Smith's `Lambda` of unit directions given `x^2 + y^2` and `z > 0` (infinite at `z = 0`;
+    /// what it gives below the horizon is not meant to be used), at several at once. The
+    /// default divides for `tan^2 = (x^2 + y^2) / z^2` and calls
+    /// [`MicrofacetDistribution::lambdas_from_tan2`].
+    #[inline(always)]
+    fn lambdas_of_directions<const L: usize>(&self, xy2: &[f64; L], z: &[f64; L]) -> [f64; L] {
+        let mut tan2 = [0.0; L];
+        for k in 0..L {
+            tan2[k] = xy2[k] / (z[k] * z[k]);
+        }
+        self.lambdas_from_tan2(&tan2)
+    }
+
+    /// The normals at nodes of the reference quadrature's logistic variable
+    /// `s = t / (alpha + t)`, `t = tan(theta_m)` (`crate::integrate::reference`): their polar
+    /// angle and the density of normals per unit `s` and azimuth, `D(m) sin^2 cos dx/ds` with
+    /// `x = ln(t / alpha)`, `dx/ds = 1 / (s (1 - s))` (`dω_m = sin^2 cos dx dphi`). Where `t`
+    /// rounds to 0 or infinity (an `s` of 0 or 1 in f64) the density is 0 and the normal `+z`.
+    /// The default computes `t` and `D` from `tan^2`; GGX has a closed form with one division.
+    #[inline(always)]
+    fn polar_lanes_in_s<const L: usize>(&self, s: &[f64; L]) -> Polar<L> {
+        let alpha = self.alpha();
+        let mut polar = Polar::default();
+        for (k, &s) in s.iter().enumerate() {
+            let t = alpha * s / (1.0 - s);
+            let jacobian = 1.0 / (s * (1.0 - s));
+            polar.set(k, t, self.d_from_tan2(t * t), jacobian);
+        }
+        polar
+    }
+
+    /// As [`MicrofacetDistribution::polar_lanes_in_s`] at nodes of `x = ln(t / alpha)` itself,
+    /// given `e^x` at each (`dx/dx = 1`; `e^x` up to `1e60`).
+    #[inline(always)]
+    fn polar_lanes_in_x<const L: usize>(&self, exp_x: &[f64; L]) -> Polar<L> {
+        let alpha = self.alpha();
+        let mut polar = Polar::default();
+        for (k, &e) in exp_x.iter().enumerate() {
+            let t = alpha * e;
+            polar.set(k, t, self.d_from_tan2(t * t), 1.0);
+        }
+        polar
+    }
+
     /// Smith's `Lambda(v)`, with `tan^2(theta)` taken from the components of `v`.
     #[inline(always)]
     fn lambda(&self, v: Vec3) -> f64 {
@@ -56,6 +100,42 @@ pub trait MicrofacetDistribution: Copy + Send + Sync {
     /// Samples a microfacet normal from the distribution of normals visible from `o`, density
     /// `G1(o) max(0, o.m) D(m) / o.z` (Heitz 2014, eq. 2). `u` is a point of the unit square.
     fn sample_visible_normal(&self, o: Vec3, u: [f64; 2]) -> Vec3;
+}
+
+/// Microfacet normals at several nodes of a quadrature over `tan(theta_m)`: each one's
+/// `sin(theta_m)`, `cos(theta_m)` and the density of normals per unit of the node's variable and
+/// of azimuth ([`MicrofacetDistribution::polar_lanes_in_s`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Polar<const L: usize> {
+    pub sin: [f64; L],
+    pub cos: [f64; L],
+    pub density: [f64; L],
+}
+
+impl<const L: usize> Default for Polar<L> {
+    fn default() -> Self {
+        Self {
+            sin: [0.0; L],
+            cos: [1.0; L],
+            density: [0.0; L],
+        }
+    }
+}
+
+impl<const L: usize> Polar<L> {
+    /// Lane `k` from `t = tan(theta_m)`, `D(m)` and `dx/dv`: `cos = 1 / sqrt(1 + t^2)`,
+    /// `sin = t cos`, density `D sin^2 cos dx/dv`; the normal `+z` with no density unless `t`
+    /// is positive and finite. A select, not a branch: the loop around it vectorises.
+    #[inline(always)]
+    fn set(&mut self, k: usize, t: f64, d: f64, jacobian: f64) {
+        let cos = 1.0 / (1.0 + t * t).sqrt();
+        let sin = t * cos;
+        let density = d * sin * sin * cos * jacobian;
+        let valid = t > 0.0 && t < f64::INFINITY;
+        self.sin[k] = if valid { sin } else { 0.0 };
+        self.cos[k] = if valid { cos } else { 1.0 };
+        self.density[k] = if valid { density } else { 0.0 };
+    }
 }
 
 /// GGX / Trowbridge-Reitz.
@@ -105,6 +185,65 @@ impl MicrofacetDistribution for Ggx {
             return f64::INFINITY;
         }
         x / (2.0 * (1.0 + (1.0 + x).sqrt()))
+    }
+
+    /// `Lambda = alpha^2 (x^2 + y^2) / (2 (z^2 + z sqrt(z^2 + alpha^2 (x^2 + y^2))))`:
+    /// [`Ggx::lambda_from_tan2`]'s `x / (2 (1 + sqrt(1 + x)))` with `x = alpha^2 tan^2` multiplied
+    /// through by `z^2`, one division instead of two; infinite at `z = 0`.
+    #[inline(always)]
+    fn lambdas_of_directions<const L: usize>(&self, xy2: &[f64; L], z: &[f64; L]) -> [f64; L] {
+        let a2 = self.alpha * self.alpha;
+        let mut lambdas = [0.0; L];
+        for k in 0..L {
+            let numerator = a2 * xy2[k];
+            let z2 = z[k] * z[k];
+            lambdas[k] = numerator / (2.0 * (z2 + z[k] * (z2 + numerator).sqrt()));
+        }
+        lambdas
+    }
+
+    /// GGX in `s` (`u = 1 - s`, `t = alpha s / u`): with `P = u^2 + alpha^2 s^2` and
+    /// `Q = u^2 + s^2`, `1 + t^2 = P / u^2` and `alpha^2 + t^2 = alpha^2 Q / u^2`, so
+    /// `cos = u / sqrt(P)`, `sin = alpha s / sqrt(P)`, `D = P^2 / (pi alpha^2 Q^2)` and the
+    /// density `D sin^2 cos / (s u) = s sqrt(P) / (pi Q^2)`: one division and one square root,
+    /// finite at both ends (the horizon's `alpha / pi` at `s = 1`, 0 at `s = 0`).
+    #[inline(always)]
+    fn polar_lanes_in_s<const L: usize>(&self, s: &[f64; L]) -> Polar<L> {
+        let a2 = self.alpha * self.alpha;
+        let mut polar = Polar::default();
+        for (k, &s) in s.iter().enumerate() {
+            let u = 1.0 - s;
+            let p = u * u + a2 * s * s;
+            let q = u * u + s * s;
+            let root = p.sqrt();
+            let inverse = 1.0 / (root * q * q);
+            let w = inverse * q * q;
+            polar.cos[k] = u * w;
+            polar.sin[k] = self.alpha * s * w;
+            polar.density[k] = s * p * inverse / PI;
+        }
+        polar
+    }
+
+    /// GGX in `x` (`t = alpha e^x`, `R = 1 + t^2`): `D = R^2 / (pi alpha^2 (1 + e^(2x))^2)` and
+    /// `sin^2 cos = t^2 / R^(3/2)`, so the density is `sqrt(R) e^(2x) / (pi (1 + e^(2x))^2)`:
+    /// one division and one square root.
+    #[inline(always)]
+    fn polar_lanes_in_x<const L: usize>(&self, exp_x: &[f64; L]) -> Polar<L> {
+        let mut polar = Polar::default();
+        for (k, &e) in exp_x.iter().enumerate() {
+            let e2 = e * e;
+            let t = self.alpha * e;
+            let r = 1.0 + t * t;
+            let root = r.sqrt();
+            let square = (1.0 + e2) * (1.0 + e2);
+            let inverse = 1.0 / (root * square);
+            let cos = inverse * square;
+            polar.cos[k] = cos;
+            polar.sin[k] = t * cos;
+            polar.density[k] = r * e2 * inverse / PI;
+        }
+        polar
     }
 
     /// The same operations as [`Ggx::lambda_from_tan2`] with the horizon's limit as a select,
@@ -735,6 +874,115 @@ mod tests {
             let beckmann = Beckmann { alpha };
             let scalar = tan2.map(|t| beckmann.lambda_from_tan2(t).to_bits());
             assert_eq!(beckmann.lambdas_from_tan2(&tan2).map(f64::to_bits), scalar);
+        }
+    }
+
+    /// GGX's closed forms of the normals at the reference's nodes, in `s` and in `x`, against
+    /// the textbook: `t` from the variable, `cos = 1 / sqrt(1 + t^2)`, `D` as Walter writes it
+    /// with `cos^4 = 1 / (1 + t^2)^2` (the form in `cos` cancels near the normal), the density
+    /// `D sin^2 cos dx/dv`; and Beckmann's (the trait's default) alike. Within 1e-13 relative, from near 0 to the horizon; at the ends
+    /// of `s` the limits (GGX's horizon density `alpha / pi`, nothing at `s = 0`).
+    #[test]
+    fn normals_at_the_nodes_are_the_textbook_normals() {
+        let s = [1e-9, 0.01, 0.2, 0.4999, 0.5, 0.73, 0.97, 0.999_999];
+        let x = [0.0, 1e-6, 0.3, 1.0, 2.5, 7.0, 20.0, 40.0];
+        let close = |got: f64, want: f64| (got - want).abs() <= 1e-13 * want.abs().max(1e-300);
+        for alpha in [1e-4, 0.05, 0.3, 1.0, 2.0] {
+            let a2 = alpha * alpha;
+            // Walter 2007, eqs. 33 and 25, `1 / cos^4 = (1 + t^2)^2`.
+            let walter_ggx = |t: f64| {
+                let c4 = 1.0 / ((1.0 + t * t) * (1.0 + t * t));
+                1.0 / (PI * a2 * c4 * (1.0 + t * t / a2).powi(2))
+            };
+            let walter_beckmann = |t: f64| {
+                let c4 = 1.0 / ((1.0 + t * t) * (1.0 + t * t));
+                (-t * t / a2).exp() / (PI * a2 * c4)
+            };
+            let check = |what: &str, t: f64, jacobian: f64, d: f64, got: (f64, f64, f64)| {
+                let cos = 1.0 / (1.0 + t * t).sqrt();
+                let sin = t * cos;
+                let density = d * sin * sin * cos * jacobian;
+                assert!(
+                    close(got.0, sin) && close(got.1, cos) && close(got.2, density),
+                    "{what} alpha {alpha} t {t}: {got:?} vs {:?}",
+                    (sin, cos, density)
+                );
+            };
+            let ggx = Ggx { alpha };
+            let beckmann = Beckmann { alpha };
+            let (in_s, beckmann_s) = (ggx.polar_lanes_in_s(&s), beckmann.polar_lanes_in_s(&s));
+            for (k, &v) in s.iter().enumerate() {
+                let t = alpha * v / (1.0 - v);
+                let jacobian = 1.0 / (v * (1.0 - v));
+                let at = |p: &Polar<8>| (p.sin[k], p.cos[k], p.density[k]);
+                check("GGX in s", t, jacobian, walter_ggx(t), at(&in_s));
+                check(
+                    "Beckmann in s",
+                    t,
+                    jacobian,
+                    walter_beckmann(t),
+                    at(&beckmann_s),
+                );
+            }
+            let exp_x = x.map(f64::exp);
+            let (in_x, beckmann_x) = (
+                ggx.polar_lanes_in_x(&exp_x),
+                beckmann.polar_lanes_in_x(&exp_x),
+            );
+            for (k, &e) in exp_x.iter().enumerate() {
+                let t = alpha * e;
+                let at = |p: &Polar<8>| (p.sin[k], p.cos[k], p.density[k]);
+                check("GGX in x", t, 1.0, walter_ggx(t), at(&in_x));
+                // Beckmann's tail underflows to nothing long before x = 40.
+                if t < 20.0 * alpha.max(1.0) {
+                    check("Beckmann in x", t, 1.0, walter_beckmann(t), at(&beckmann_x));
+                }
+            }
+            let ends = ggx.polar_lanes_in_s(&[0.0, 1.0]);
+            assert_eq!((ends.sin[0], ends.cos[0], ends.density[0]), (0.0, 1.0, 0.0));
+            assert_eq!((ends.sin[1], ends.cos[1]), (1.0, 0.0));
+            assert!(close(ends.density[1], alpha / PI), "{ends:?}");
+            let ends = beckmann.polar_lanes_in_s(&[0.0, 1.0]);
+            assert_eq!(
+                ends,
+                Polar::default(),
+                "nothing where t rounds to 0 or infinity"
+            );
+        }
+    }
+
+    /// GGX's `Lambda` from a direction's components agrees with the `tan^2` form within 1e-14
+    /// relative, from the zenith to the horizon (infinite there), and Beckmann's default divides.
+    #[test]
+    fn lambdas_of_directions_are_lambdas_of_their_tangents() {
+        let theta = [
+            0.0,
+            1e-8,
+            0.2,
+            0.9,
+            1.3,
+            1.5,
+            std::f64::consts::FRAC_PI_2 - 1e-6,
+            std::f64::consts::FRAC_PI_2,
+        ];
+        let xy2 = theta.map(|t: f64| t.sin() * t.sin());
+        let z = theta.map(f64::cos);
+        for alpha in [1e-4, 0.3, 1.0, 2.0] {
+            let ggx = Ggx { alpha };
+            let at_once = ggx.lambdas_of_directions(&xy2, &z);
+            let beckmann = Beckmann { alpha }.lambdas_of_directions(&xy2, &z);
+            for k in 0..theta.len() {
+                let tan2 = xy2[k] / (z[k] * z[k]);
+                let want = ggx.lambda_from_tan2(tan2);
+                assert!(
+                    (at_once[k] - want).abs() <= 1e-14 * want || at_once[k] == want,
+                    "alpha {alpha} theta {}: {} vs {want}",
+                    theta[k],
+                    at_once[k]
+                );
+                assert_eq!(beckmann[k], Beckmann { alpha }.lambda_from_tan2(tan2));
+            }
+            assert_eq!(ggx.lambdas_of_directions(&[1.0], &[0.0]), [f64::INFINITY]);
         }
     }
 
