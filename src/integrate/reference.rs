@@ -307,7 +307,7 @@ fn albedo_quadrature<N: MicrofacetDistribution>(
             );
         };
         let x_star = (tan_star / alpha).ln();
-        let breaks: Vec<f64> = horizon_breaks(
+        let breaks: Breaks = horizon_breaks(
             f64::NEG_INFINITY,
             0.0_f64.min(x_star),
             x_star,
@@ -618,11 +618,15 @@ pub(crate) fn t_of_s(s: f64, alpha: f64) -> (f64, f64) {
     (alpha * s / (1.0 - s), 1.0 / (s * (1.0 - s)))
 }
 
+/// A short list of breaks or rungs, inline (no allocation) up to the lengths the ladders reach
+/// at `alpha = 1e-4`, where the inner integrals run once per azimuth node.
+pub(crate) type Breaks = smallvec::SmallVec<[f64; 24]>;
+
 /// Distances of a geometric ladder of breaks closing in on a masking layer of width `layer` (in
 /// `x`): from a sixteenth of it, four times further each rung, below `limit`, so that every
 /// scale between the layer and the piece has intervals of its own.
-pub(crate) fn ladder(layer: f64, limit: f64) -> Vec<f64> {
-    let mut rungs = Vec::new();
+pub(crate) fn ladder(layer: f64, limit: f64) -> Breaks {
+    let mut rungs = Breaks::new();
     let mut distance = layer.abs() / 16.0;
     while distance > 0.0 && distance < limit {
         rungs.push(distance);
@@ -645,8 +649,9 @@ pub(crate) fn horizon_breaks(
     x_star: f64,
     alpha: f64,
     theta_star: f64,
-) -> Vec<f64> {
-    let mut breaks = vec![x_min, peak];
+) -> Breaks {
+    let mut breaks = Breaks::new();
+    breaks.extend([x_min, peak]);
     let layer = alpha / (2.0 * theta_star).sin().max(1e-300);
     let rungs = ladder(layer, x_star - peak);
     breaks.extend(rungs.into_iter().rev().map(|d| x_star - d));

@@ -164,8 +164,8 @@ pub fn integrate_pieces_batch<const N: usize>(
         value: [f64; N],
         error: f64,
     }
-    let mut intervals: Vec<Interval<N>> =
-        Vec::with_capacity(max_intervals.min(2 * breaks.len() + 8));
+    // Inline up to a typical piece count plus a few splits: most calls never touch the heap.
+    let mut intervals: smallvec::SmallVec<[Interval<N>; 24]> = smallvec::SmallVec::new();
     for pair in breaks.windows(2) {
         let (a, b) = (pair[0], pair[1]);
         if b > a {
