@@ -535,15 +535,16 @@ pub fn audit_points(spec: &TableSpec, settings: &AuditSettings) -> u64 {
     (spec.len() + lookup_coordinates(spec, settings).len()) as u64
 }
 
-/// The largest number of `E_avg` entries [`node_errors`] checks: each costs the reference about
-/// 0.5 s of CPU ([`quadrature_average_albedo`]).
+/// The largest number of `E_avg` entries [`node_errors`] checks: each costs the reference a
+/// few hundredths of a second of CPU at 1e-9, and up to half a second where no fixed rule
+/// serves ([`crate::integrate::average_quadrature::average_albedo_to`]).
 pub const MAX_AVERAGE_ENTRIES_CHECKED: usize = 5;
 
 /// Node errors of a freshly baked table against the reference, in `1 - E` (which both carry
 /// directly): on every texel of an `E` table, and on at most [`MAX_AVERAGE_ENTRIES_CHECKED`]
 /// evenly spaced entries of an `E_avg` table, first and last included (by
-/// [`quadrature_average_albedo`], within 1e-10 of the nested reference at half its cost). What
-/// `kiln bake` records.
+/// [`crate::integrate::average_quadrature::average_albedo_to`]: the fixed rule whose measured
+/// bound is within half the tolerance, or the composite rule). What `kiln bake` records.
 #[must_use]
 pub fn node_errors(table: &Table, settings: &ReferenceSettings) -> NodeErrors {
     node_errors_at(table, &node_error_indices(&table.spec), settings)
