@@ -235,10 +235,10 @@ impl BakeOptions {
     /// accuracy, the quadrature at tolerance `10^-d`, the largest power of ten at most
     /// `max_error`, with `E_avg` by the cheapest fixed rule whose measured bound is within half
     /// that tolerance, its `E` evaluations at the other half
-    /// ([`crate::integrate::average_quadrature::average_albedo_to`]). The quadrature's stated error is a bound of
-    /// its actual error (tested against itself at far tighter tolerances, and at the default
-    /// table's every node by `kiln verify`: 2.5e-10 at tolerance 1e-7), so every texel is within
-    /// the tolerance. Until numerics version 5 the tolerance was a tenth of that, and the tables
+    /// ([`crate::integrate::average_quadrature::average_albedo_to`]). The quadrature's stated
+    /// error is a bound of its actual error (tested against itself at far tighter tolerances,
+    /// and at the default table's every node by `kiln verify`: 2.5e-10 at tolerance 1e-7), so
+    /// every texel is within the tolerance. Until numerics version 5 the tolerance was a tenth of that, and the tables
     /// came out 100 to 1000 times better than asked, at up to twice the cost; until version 6
     /// the tables over IOR kept that tenth, as their quadrature's stated error had been seen
     /// short by up to 3.7x where the critical angle meets the horizon (fixed in version 6).
