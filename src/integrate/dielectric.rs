@@ -508,61 +508,67 @@ impl<N: MicrofacetDistribution> DielectricView<N> {
         sin_phi: f64,
         values: &mut [[f64; 3]; KRONROD_NODES],
     ) {
-        // `t = tan(theta_m)` and `dx/dv` at each node, and the factor `dx/ds = +-2 s` of the
-        // square maps, applied to the result.
-        let alpha = self.ndf.alpha();
-        let mut t = [0.0; LANES];
-        let mut jacobian = [1.0; LANES];
-        let mut factor = [1.0; LANES];
-        for k in 0..LANES {
-            let v = nodes[k % KRONROD_NODES];
-            match variable {
-                Variable::X => t[k] = alpha * exp_lane(v),
-                Variable::Logistic => (t[k], jacobian[k]) = t_of_s(v, alpha),
-                Variable::SquareFrom(edge) => {
-                    t[k] = alpha * exp_lane(edge + v * v);
-                    factor[k] = 2.0 * v;
-                }
-                Variable::SquareTo(edge) => {
-                    t[k] = alpha * exp_lane(edge - v * v);
-                    factor[k] = 2.0 * v;
-                }
-            }
-        }
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU supports AVX2, checked on the line above.
-            let lanes = unsafe { dielectric_lanes_avx2(self, &t, &jacobian, cos_phi, sin_phi) };
-            return finish_lanes(&lanes, &factor, values);
+            let lanes = unsafe { dielectric_values_avx2(self, nodes, variable, cos_phi, sin_phi) };
+            values.copy_from_slice(&lanes[..KRONROD_NODES]);
+            return;
         }
-        let lanes = dielectric_lanes(self, &t, &jacobian, cos_phi, sin_phi);
-        finish_lanes(&lanes, &factor, values);
+        let lanes = dielectric_values(self, nodes, variable, cos_phi, sin_phi);
+        values.copy_from_slice(&lanes[..KRONROD_NODES]);
     }
 }
 
-/// The first [`KRONROD_NODES`] lanes, each times its factor.
-fn finish_lanes(
-    lanes: &[[f64; 3]; LANES],
-    factor: &[f64; LANES],
-    values: &mut [[f64; 3]; KRONROD_NODES],
-) {
-    for k in 0..KRONROD_NODES {
-        values[k] = lanes[k].map(|v| factor[k] * v);
-    }
-}
-
-/// [`dielectric_lanes`] compiled for AVX2: bit-identical (the same IEEE operations in the same
-/// order per lane), several lanes at a time.
+/// [`dielectric_values`] compiled for AVX2: bit-identical (the same IEEE operations in the same
+/// order per lane), several lanes at a time, the nodes' `exp` included.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn dielectric_lanes_avx2<N: MicrofacetDistribution>(
+fn dielectric_values_avx2<N: MicrofacetDistribution>(
     view: &DielectricView<N>,
-    t: &[f64; LANES],
-    jacobian: &[f64; LANES],
+    nodes: &[f64; KRONROD_NODES],
+    variable: Variable,
     cos_phi: f64,
     sin_phi: f64,
 ) -> [[f64; 3]; LANES] {
-    dielectric_lanes(view, t, jacobian, cos_phi, sin_phi)
+    dielectric_values(view, nodes, variable, cos_phi, sin_phi)
+}
+
+/// [`DielectricView::values_at`] in lanes: `t = tan(theta_m)` and `dx/dv` at each node of the
+/// piece's variable, [`dielectric_lanes`] there, and the factor `dx/ds = +-2 s` of the square
+/// maps applied to the result.
+#[inline(always)]
+fn dielectric_values<N: MicrofacetDistribution>(
+    view: &DielectricView<N>,
+    nodes: &[f64; KRONROD_NODES],
+    variable: Variable,
+    cos_phi: f64,
+    sin_phi: f64,
+) -> [[f64; 3]; LANES] {
+    let alpha = view.ndf.alpha();
+    let mut t = [0.0; LANES];
+    let mut jacobian = [1.0; LANES];
+    let mut factor = [1.0; LANES];
+    for k in 0..LANES {
+        let v = nodes[k % KRONROD_NODES];
+        match variable {
+            Variable::X => t[k] = alpha * exp_lane(v),
+            Variable::Logistic => (t[k], jacobian[k]) = t_of_s(v, alpha),
+            Variable::SquareFrom(edge) => {
+                t[k] = alpha * exp_lane(edge + v * v);
+                factor[k] = 2.0 * v;
+            }
+            Variable::SquareTo(edge) => {
+                t[k] = alpha * exp_lane(edge - v * v);
+                factor[k] = 2.0 * v;
+            }
+        }
+    }
+    let mut lanes = dielectric_lanes(view, &t, &jacobian, cos_phi, sin_phi);
+    for (lane, factor) in lanes.iter_mut().zip(factor) {
+        *lane = lane.map(|v| factor * v);
+    }
+    lanes
 }
 
 /// `[R, T, 1 - E]` per unit `x` and `phi` at `t_k = tan(theta_m)`, times `jacobian_k`; nothing
@@ -588,7 +594,6 @@ fn dielectric_lanes<N: MicrofacetDistribution>(
         m[k] = Vec3::new(sin_t * cos_phi, sin_t * sin_phi, cos_t);
         om[k] = o.dot(m[k]);
         // dω_m = sin^2 cos dx dphi in these variables; G1(o) (o.m) D / mu is the visible density.
-        let sin_t = t * m[k].z;
         density[k] = view.ndf.d_from_tan2(t * t)
             * sin_t
             * sin_t
@@ -873,14 +878,24 @@ mod lane_tests {
                     let lanes = dielectric_lanes(&view, &t, &jacobian, cos_phi, sin_phi);
                     #[cfg(target_arch = "x86_64")]
                     if std::arch::is_x86_feature_detected!("avx2") {
-                        // SAFETY: checked on the line above.
-                        let simd = unsafe {
-                            dielectric_lanes_avx2(&view, &t, &jacobian, cos_phi, sin_phi)
-                        };
-                        assert_eq!(
-                            simd.map(|v| v.map(f64::to_bits)),
-                            lanes.map(|v| v.map(f64::to_bits))
-                        );
+                        let nodes = crate::numerics::gauss_kronrod::tests::nodes_of(0.1, 0.9);
+                        for variable in [
+                            Variable::X,
+                            Variable::Logistic,
+                            Variable::SquareFrom(-1.0),
+                            Variable::SquareTo(0.5),
+                        ] {
+                            // SAFETY: checked above.
+                            let simd = unsafe {
+                                dielectric_values_avx2(&view, &nodes, variable, cos_phi, sin_phi)
+                            };
+                            let portable =
+                                dielectric_values(&view, &nodes, variable, cos_phi, sin_phi);
+                            assert_eq!(
+                                simd.map(|v| v.map(f64::to_bits)),
+                                portable.map(|v| v.map(f64::to_bits))
+                            );
+                        }
                     }
                     for k in 0..LANES {
                         let cos_t = 1.0 / (1.0 + t[k] * t[k]).sqrt();
