@@ -549,17 +549,29 @@ fn dielectric_values<N: MicrofacetDistribution>(
     let mut t = [0.0; LANES];
     let mut jacobian = [1.0; LANES];
     let mut factor = [1.0; LANES];
-    for k in 0..LANES {
-        let v = nodes[k % KRONROD_NODES];
-        match variable {
-            Variable::X => t[k] = alpha * exp_lane(v),
-            Variable::Logistic => (t[k], jacobian[k]) = t_of_s(v, alpha),
-            Variable::SquareFrom(edge) => {
-                t[k] = alpha * exp_lane(edge + v * v);
-                factor[k] = 2.0 * v;
+    let padded: [f64; LANES] = std::array::from_fn(|k| nodes[k % KRONROD_NODES]);
+    // One loop per variable, so that each vectorises (a `match` inside the loop kept the
+    // `exp` scalar).
+    match variable {
+        Variable::X => {
+            for (t, &v) in t.iter_mut().zip(&padded) {
+                *t = alpha * exp_lane(v);
             }
-            Variable::SquareTo(edge) => {
-                t[k] = alpha * exp_lane(edge - v * v);
+        }
+        Variable::Logistic => {
+            for k in 0..LANES {
+                (t[k], jacobian[k]) = t_of_s(padded[k], alpha);
+            }
+        }
+        Variable::SquareFrom(edge) | Variable::SquareTo(edge) => {
+            let sign = if matches!(variable, Variable::SquareFrom(_)) {
+                1.0
+            } else {
+                -1.0
+            };
+            for k in 0..LANES {
+                let v = padded[k];
+                t[k] = alpha * exp_lane(edge + sign * (v * v));
                 factor[k] = 2.0 * v;
             }
         }

@@ -128,33 +128,59 @@ struct Slice<N> {
     ndf: N,
     masking: Masking,
     m: Vec3,
+    sin_h: f64,
     cos_h: f64,
     eta: f64,
     convention: TransmissionConvention,
 }
 
 impl<N: MicrofacetDistribution> Slice<N> {
-    /// [`slice_lanes`], compiled for AVX2 where the CPU has it.
+    /// [`slice_values`], compiled for AVX2 where the CPU has it.
     #[inline(always)]
-    fn values_at(&self, o: &[Vec3; LANES]) -> [[f64; 4]; LANES] {
+    fn values_at(&self, nodes: &[f64; KRONROD_NODES]) -> [[f64; 4]; LANES] {
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU supports AVX2, checked on the line above.
-            return unsafe { slice_lanes_avx2(self, o) };
+            return unsafe { slice_values_avx2(self, nodes) };
         }
-        slice_lanes(self, o)
+        slice_values(self, nodes)
     }
 }
 
-/// [`slice_lanes`] compiled for AVX2: bit-identical (the same IEEE operations in the same order
-/// per lane), several lanes at a time.
+/// [`slice_values`] compiled for AVX2: bit-identical (the same IEEE operations in the same
+/// order per lane), several lanes at a time, the views' `sin` and `cos` included.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn slice_lanes_avx2<N: MicrofacetDistribution>(
+fn slice_values_avx2<N: MicrofacetDistribution>(
     slice: &Slice<N>,
-    o: &[Vec3; LANES],
+    nodes: &[f64; KRONROD_NODES],
 ) -> [[f64; 4]; LANES] {
-    slice_lanes(slice, o)
+    slice_values(slice, nodes)
+}
+
+/// The views at a rule's nodes `phi_h` (around `m`, at angle `theta_h` from it), and
+/// [`slice_lanes`] there.
+#[inline(always)]
+fn slice_values<N: MicrofacetDistribution>(
+    slice: &Slice<N>,
+    nodes: &[f64; KRONROD_NODES],
+) -> [[f64; 4]; LANES] {
+    let Vec3 {
+        x: sin_m, z: cos_m, ..
+    } = slice.m;
+    let (sin_h, cos_h) = (slice.sin_h, slice.cos_h);
+    let a = cos_h * cos_m;
+    let b = sin_h * sin_m;
+    let mut o = [slice.m; LANES];
+    for k in 0..LANES {
+        let (sin_p, cos_p) = sin_cos_lane(nodes[k % KRONROD_NODES]);
+        o[k] = Vec3::new(
+            cos_h * sin_m + sin_h * cos_p * cos_m,
+            sin_h * sin_p,
+            a - b * cos_p,
+        );
+    }
+    slice_lanes(slice, &o)
 }
 
 /// The inner integrand at the views `o[k]`: `G1(o) [R, T, 1 - E, 0]` of the slice's normal
@@ -330,23 +356,14 @@ pub(crate) fn average<N: MicrofacetDistribution>(
                 ndf,
                 masking,
                 m,
+                sin_h,
                 cos_h,
                 eta,
                 convention,
             };
             let q = integrate_pieces_batch(
                 &mut |nodes: &[f64; KRONROD_NODES], values: &mut [[f64; 4]; KRONROD_NODES]| {
-                    // The view at each node `phi_h` (around `m`, at angle `theta_h` from it).
-                    let mut o = [m; LANES];
-                    for k in 0..LANES {
-                        let (sin_p, cos_p) = sin_cos_lane(nodes[k % KRONROD_NODES]);
-                        o[k] = Vec3::new(
-                            cos_h * sin_m + sin_h * cos_p * cos_m,
-                            sin_h * sin_p,
-                            a - b * cos_p,
-                        );
-                    }
-                    values.copy_from_slice(&slice.values_at(&o)[..KRONROD_NODES]);
+                    values.copy_from_slice(&slice.values_at(nodes)[..KRONROD_NODES]);
                 },
                 &breaks,
                 inner_tolerance,
@@ -401,13 +418,15 @@ mod tests {
                     ndf,
                     masking: Masking::Separable,
                     m,
+                    sin_h,
                     cos_h,
                     eta,
                     convention: TransmissionConvention::SingleScattering,
                 };
+                let nodes: [f64; KRONROD_NODES] = std::array::from_fn(|k| 0.2 * k as f64);
                 let mut o = [m; LANES];
                 for (k, o) in o.iter_mut().enumerate() {
-                    let (sin_p, cos_p) = (0.2 * k as f64).sin_cos();
+                    let (sin_p, cos_p) = nodes[k % KRONROD_NODES].sin_cos();
                     *o = Vec3::new(
                         cos_h * sin_m + sin_h * cos_p * cos_m,
                         sin_h * sin_p,
@@ -415,13 +434,22 @@ mod tests {
                     );
                 }
                 let lanes = slice_lanes(&slice, &o);
+                // From the nodes, with the lane-wise sin and cos: the same within rounding,
+                // and the AVX2 build gives the portable build's bits.
+                let from_nodes = slice_values(&slice, &nodes);
+                for k in 0..LANES {
+                    for c in 0..3 {
+                        let (got, want) = (from_nodes[k][c], lanes[k][c]);
+                        assert!((got - want).abs() <= 1e-13 * want.abs(), "{got} vs {want}");
+                    }
+                }
                 #[cfg(target_arch = "x86_64")]
                 if std::arch::is_x86_feature_detected!("avx2") {
                     // SAFETY: checked on the line above.
-                    let simd = unsafe { slice_lanes_avx2(&slice, &o) };
+                    let simd = unsafe { slice_values_avx2(&slice, &nodes) };
                     assert_eq!(
                         simd.map(|v| v.map(f64::to_bits)),
-                        lanes.map(|v| v.map(f64::to_bits))
+                        from_nodes.map(|v| v.map(f64::to_bits))
                     );
                 }
                 assert!(o.iter().any(|o| o.z <= 0.0) && o.iter().any(|o| o.z > 0.0));

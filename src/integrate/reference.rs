@@ -128,28 +128,41 @@ fn quadrature_for(
     mu: f64,
     settings: &ReferenceSettings,
 ) -> Quadrature<2> {
-    weighted_quadrature_for(model, alpha, mu, |_| 1.0, settings)
+    weighted_quadrature_for(model, alpha, mu, |_| 1.0, Channels::WithLoss, settings)
 }
 
-/// `[E_h, 1 - E]` for the model's distribution at `alpha` (see [`reference_weighted_albedo`]).
+/// `[E_h, 1 - E]` for the model's distribution at `alpha` (see [`reference_weighted_albedo`]),
+/// or `[E_h, 0]` with [`Channels::WeightedOnly`].
 fn weighted_quadrature_for(
     model: Model,
     alpha: f64,
     mu: f64,
     h: impl Fn(f64) -> f64 + Copy,
+    channels: Channels,
     settings: &ReferenceSettings,
 ) -> Quadrature<2> {
     match model.ndf {
-        Ndf::Ggx => albedo_quadrature(Ggx { alpha }, model.masking, mu, h, settings),
-        Ndf::Beckmann => albedo_quadrature(Beckmann { alpha }, model.masking, mu, h, settings),
+        Ndf::Ggx => albedo_quadrature(Ggx { alpha }, model.masking, mu, h, channels, settings),
+        Ndf::Beckmann => {
+            albedo_quadrature(Beckmann { alpha }, model.masking, mu, h, channels, settings)
+        }
     }
+}
+
+/// Which integrals a quadrature of the albedo takes: both `E_h` and the loss `1 - E`, or `E_h`
+/// alone, so that neither the loss's own piece (the reflection below the horizon, where `E_h`
+/// gathers nothing) nor its error estimate costs evaluations that no result uses.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Channels {
+    WithLoss,
+    WeightedOnly,
 }
 
 /// The weighted albedo `E_h(mu) = ∫ f(o, i) h(o.m) mu_i dω_i` (`F = 1` inside `f`, `m` the half
 /// vector; see [`crate::integrate::albedo::weighted_albedo`]) by the same quadrature as `E`, with
 /// `h` applied to the `E` integrand. `one_minus_value` is `1 - E_h` by subtraction (the weighted
-/// integrand has no loss form); `error` is the estimate for the weighted integral and `1 - E`
-/// together.
+/// integrand has no loss form); `error` is the estimate for the weighted integral, which alone
+/// steers the quadrature (no loss integral is taken: numerics version 8).
 #[must_use]
 pub fn reference_weighted_albedo(
     model: Model,
@@ -168,7 +181,7 @@ pub fn reference_weighted_albedo(
         };
     }
     let (alpha, mu) = smooth_point(alpha, mu);
-    let q = weighted_quadrature_for(model, alpha, mu, h, settings);
+    let q = weighted_quadrature_for(model, alpha, mu, h, Channels::WeightedOnly, settings);
     // A raw value outside [0, 1] is the quadrature's error showing: kept within the range, with
     // the stated error widened to cover the distance (never clamped silently).
     let value = q.value[0].clamp(0.0, 1.0);
@@ -245,12 +258,14 @@ fn finish(q: Quadrature<2>) -> ReferenceValue {
     }
 }
 
-/// `[E, 1 - E]` with the error estimate, for one distribution.
+/// `[E_h, 1 - E]` with the error estimate, for one distribution (`[E_h, 0]` and the estimate of
+/// `E_h` alone with [`Channels::WeightedOnly`]).
 fn albedo_quadrature<N: MicrofacetDistribution>(
     ndf: N,
     masking: Masking,
     mu: f64,
     h: impl Fn(f64) -> f64 + Copy,
+    channels: Channels,
     settings: &ReferenceSettings,
 ) -> Quadrature<2> {
     let alpha = ndf.alpha();
@@ -309,6 +324,11 @@ fn albedo_quadrature<N: MicrofacetDistribution>(
                 h,
                 values,
             );
+            if channels == Channels::WeightedOnly {
+                for value in values.iter_mut() {
+                    value[1] = 0.0;
+                }
+            }
         };
         let x_star = (tan_star / alpha).ln();
         let breaks: Breaks = horizon_breaks(
@@ -336,12 +356,17 @@ fn albedo_quadrature<N: MicrofacetDistribution>(
                 values,
             );
         };
-        let b = integrate_pieces_batch(
-            &mut below,
-            &[s_star, s_visible.max(s_star)],
-            inner_tolerance,
-            settings.max_intervals,
-        );
+        let b = match channels {
+            Channels::WithLoss => integrate_pieces_batch(
+                &mut below,
+                &[s_star, s_visible.max(s_star)],
+                inner_tolerance,
+                settings.max_intervals,
+            ),
+            Channels::WeightedOnly => {
+                integrate_pieces_batch(&mut below, &[], inner_tolerance, settings.max_intervals)
+            }
+        };
         evaluations += a.evaluations + b.evaluations;
         all_converged &= a.converged && b.converged;
         [a.value[0], a.value[1] + b.value[1], a.error + b.error]

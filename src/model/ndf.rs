@@ -9,7 +9,7 @@
 //! Lambda of both distributions); Heitz 2014, "Understanding the Masking-Shadowing Function in
 //! Microfacet-Based BRDFs" (Smith Lambda, G1, G2); `docs/physics.md` for the stable forms.
 
-use super::special::{FRAC_1_SQRT_PI, erf_inv_uniform, erfc};
+use super::special::{FRAC_1_SQRT_PI, beckmann_lambda_of_a, erf_inv_uniform, erfc};
 use super::vector::Vec3;
 use crate::numerics::elementary::exp_lane;
 use std::f64::consts::PI;
@@ -271,11 +271,6 @@ pub struct Beckmann {
     pub alpha: f64,
 }
 
-/// Above this `a`, Beckmann's Lambda is evaluated by its asymptotic series (see
-/// [`Beckmann::lambda_from_tan2`]), whose smallest term there is below 1e-16 of the sum; below it
-/// the `erfc` form loses at most `log10(2 a^2) < 2` digits to cancellation.
-const BECKMANN_SERIES_FROM: f64 = 6.0;
-
 impl MicrofacetDistribution for Beckmann {
     fn alpha(&self) -> f64 {
         self.alpha
@@ -356,37 +351,37 @@ impl MicrofacetDistribution for Beckmann {
     /// Exact Smith Lambda, `a = 1 / (alpha tan(theta))` (Walter 2007, eq. 27 before the rational
     /// fit; `docs/physics.md`):
     ///
-    /// `Lambda = (erf(a) - 1) / 2 + exp(-a^2) / (2 a sqrt(pi)) = (exp(-a^2) / (a sqrt(pi)) - erfc(a)) / 2`.
+    /// `Lambda = (erf(a) - 1) / 2 + exp(-a^2) / (2 a sqrt(pi)) = (exp(-a^2) / (a sqrt(pi)) - erfc(a)) / 2`,
     ///
-    /// The two terms cancel as `a` grows (and `erf(a) - 1` would lose everything), so for `a >= 6`
-    /// kiln sums the asymptotic series of `erfc`,
-    /// `Lambda = exp(-a^2) / (2 a sqrt(pi)) * Σ_k (-1)^(k+1) (2k-1)!! / (2 a^2)^k`, stopping at
-    /// full precision or at the smallest term (below 1e-16 of the sum for `a >= 6`).
+    /// by [`beckmann_lambda_of_a`] (Cody's rational `erfc`, written so that the two terms cancel
+    /// as little as they can, and without them for `a > 4`), the same bits as
+    /// [`Beckmann::lambdas_from_tan2`].
     fn lambda_from_tan2(&self, tan2_theta: f64) -> f64 {
-        if self.alpha == 0.0 || tan2_theta == 0.0 {
-            return 0.0;
+        self.lambdas_from_tan2(&[tan2_theta])[0]
+    }
+
+    /// [`Beckmann::lambda_from_tan2`] in a loop that vectorises: `a = 1 / (alpha sqrt(tan^2))`,
+    /// then [`beckmann_lambda_of_a`] (no library call). Nothing for a mirror, nothing at the
+    /// normal, infinite on the horizon.
+    #[inline(always)]
+    fn lambdas_from_tan2<const L: usize>(&self, tan2_theta: &[f64; L]) -> [f64; L] {
+        if self.alpha == 0.0 {
+            return [0.0; L];
         }
-        let a = 1.0 / (self.alpha * tan2_theta.sqrt());
-        if a == 0.0 {
-            return f64::INFINITY;
+        beckmann_lambda_of_a(&tan2_theta.map(|tan2| 1.0 / (self.alpha * tan2.sqrt())))
+    }
+
+    /// `a = z / (alpha sqrt(x^2 + y^2))`, one division, then [`beckmann_lambda_of_a`].
+    #[inline(always)]
+    fn lambdas_of_directions<const L: usize>(&self, xy2: &[f64; L], z: &[f64; L]) -> [f64; L] {
+        if self.alpha == 0.0 {
+            return [0.0; L];
         }
-        if a < BECKMANN_SERIES_FROM {
-            return 0.5 * ((-a * a).exp() * FRAC_1_SQRT_PI / a - erfc(a));
+        let mut a = [0.0; L];
+        for k in 0..L {
+            a[k] = z[k] / (self.alpha * xy2[k].sqrt());
         }
-        let inv_2a2 = 0.5 / (a * a);
-        let mut term = inv_2a2;
-        let mut sum = 0.0_f64;
-        let mut k = 1.0;
-        while term.abs() > 1e-17 * sum.abs() {
-            sum += term;
-            let next = term * -(2.0 * k + 1.0) * inv_2a2;
-            if next.abs() >= term.abs() {
-                break; // the asymptotic series starts to diverge here
-            }
-            term = next;
-            k += 1.0;
-        }
-        (-a * a).exp() * FRAC_1_SQRT_PI / (2.0 * a) * sum
+        beckmann_lambda_of_a(&a)
     }
 
     /// Heitz & d'Eon 2014, "Importance Sampling Microfacet-Based BSDFs using the Distribution of
@@ -825,39 +820,92 @@ mod tests {
         assert!((b - 0.25 * FRAC_1_SQRT_PI).abs() < 1e-16);
     }
 
-    #[test]
-    fn beckmann_lambda_is_continuous_where_the_series_takes_over() {
-        let b = Beckmann { alpha: 1.0 };
-        let tan2_at = |a: f64| 1.0 / (a * a);
-        // d ln(Lambda) / da = -(2a + 3/a) ~ -12.5 there: a relative step of 1e-15 on either side
-        // moves Lambda by ~1e-13.
-        let below = b.lambda_from_tan2(tan2_at(BECKMANN_SERIES_FROM * (1.0 - 1e-15)));
-        let above = b.lambda_from_tan2(tan2_at(BECKMANN_SERIES_FROM * (1.0 + 1e-15)));
-        assert!(
-            ((below - above) / above).abs() < 1e-12,
-            "{below} vs {above}"
-        );
-        // mpmath, 40 digits: Lambda(a = 6) = 1.455534739558135634e-19.
-        let at6 = b.lambda_from_tan2(1.0 / 36.0);
-        assert!(
-            (at6 / 1.455_534_739_558_135_6e-19 - 1.0).abs() < 1e-13,
-            "{at6}"
-        );
-        // The series and the erfc form agree where both are accurate (a = 4.5, 5.5).
-        for a in [4.5f64, 5.5] {
-            let erfc_form = 0.5 * ((-a * a).exp() * FRAC_1_SQRT_PI / a - erfc(a));
-            let mut sum = 0.0;
-            let mut term = 0.5 / (a * a);
-            for k in 1..12 {
-                sum += term;
-                term *= -(2.0 * k as f64 + 1.0) * 0.5 / (a * a);
-            }
-            let series = (-a * a).exp() * FRAC_1_SQRT_PI / (2.0 * a) * sum;
-            assert!(((series - erfc_form) / erfc_form).abs() < 1e-6, "a = {a}");
+    /// `Lambda(a) = (exp(-a^2) / (a sqrt(pi)) - erfc(a)) / 2` by `libm`'s `erfc` (fdlibm's
+    /// approximations, independent of Cody's), switching to the asymptotic series of `erfc` for
+    /// `a >= 6` where the two terms cancel: kiln's form before numerics version 8.
+    fn beckmann_lambda_by_libm(a: f64) -> f64 {
+        if a < 6.0 {
+            return 0.5 * ((-a * a).exp() * FRAC_1_SQRT_PI / a - erfc(a));
         }
-        // Beyond a = 6 Lambda is below 1e-17 (docs/physics.md), and it never goes negative.
-        assert!(b.lambda_from_tan2(tan2_at(6.0)) < 1e-17);
-        assert!(b.lambda_from_tan2(tan2_at(30.0)) >= 0.0);
+        let inv_2a2 = 0.5 / (a * a);
+        let (mut term, mut sum, mut k) = (inv_2a2, 0.0_f64, 1.0);
+        while term.abs() > 1e-17 * sum.abs() {
+            sum += term;
+            let next = term * -(2.0 * k + 1.0) * inv_2a2;
+            if next.abs() >= term.abs() {
+                break;
+            }
+            term = next;
+            k += 1.0;
+        }
+        (-a * a).exp() * FRAC_1_SQRT_PI / (2.0 * a) * sum
+    }
+
+    /// Beckmann's `Lambda` by Cody's rationals against `mpmath` (50 digits) on both sides of
+    /// Cody's interval ends (0.46875 and 4) and from `a = 1e-8` to 26, and against the `libm`
+    /// form on a fine grid (where `Lambda` passes 1e-280); it is continuous across the ends.
+    #[test]
+    fn beckmann_lambda_matches_mpmath_and_an_independent_erfc() {
+        // mpmath 1.3: (exp(-a^2) / (a sqrt(pi)) - erfc(a)) / 2 at 50 digits, each rounded to
+        // the nearest double.
+        let published = [
+            (1e-8, 28209478.67738782),
+            (1e-4, 2820.4479459482604),
+            (0.01, 27.712300078290696),
+            (0.1, 2.349110474981485),
+            (0.3, 0.5236974710786996),
+            (0.46875, 0.22939640955569746),
+            (0.46876, 0.22938610391083716),
+            (0.7, 0.08578447563675873),
+            (1.0, 0.02512727083000611),
+            (1.5, 0.002874288108260259),
+            (2.0, 0.0002445056787378738),
+            (3.0, 5.591724962696005e-07),
+            (3.99, 2.4847570105502594e-10),
+            (4.0, 2.2776771977658948e-10),
+            (4.01, 2.087471594278031e-10),
+            (5.0, 1.481342933684934e-14),
+            (6.0, 1.4555347395581357e-19),
+            (8.0, 4.318515368348727e-32),
+            (12.0, 2.3385453759653967e-67),
+            (20.0, 3.364037179547612e-179),
+            (26.0, 2.09128909718775e-299),
+        ];
+        for &(a, want) in &published {
+            let got = beckmann_lambda_of_a(&[a])[0];
+            // Where `Lambda` is tiny the rounding of `-a^2` into `exp` costs up to `a^2 / 2` ulps.
+            let allowed = 4e-15_f64.max(1.2e-16 * a * a);
+            assert!(
+                ((got - want) / want).abs() <= allowed,
+                "a = {a}: {got} vs {want}"
+            );
+        }
+        // Continuity across Cody's interval ends: a relative step of 1e-15 moves `Lambda` by
+        // at most `(2 a^2 + 3) 1e-15` relative.
+        for end in [0.468_75_f64, 4.0] {
+            let below = beckmann_lambda_of_a(&[end * (1.0 - 1e-15)])[0];
+            let above = beckmann_lambda_of_a(&[end * (1.0 + 1e-15)])[0];
+            assert!(
+                ((below - above) / above).abs() < 1e-13,
+                "{end}: {below} vs {above}"
+            );
+        }
+        // The libm form's own error: its two terms cancel by `2 a^2`, each carrying the `a^2`
+        // ulps of `exp(-a * a)` (its series past 6 likewise).
+        for i in 0..=20_000 {
+            let a = 1e-6 * (26e6_f64).powf(f64::from(i) / 20_000.0);
+            let got = beckmann_lambda_of_a(&[a])[0];
+            let want = beckmann_lambda_by_libm(a);
+            let allowed = 2.2e-16 * (2.0 * a * a + 3.0) * (a * a + 4.0);
+            assert!(
+                ((got - want) / want).abs() <= allowed,
+                "a = {a}: {got} vs {want}"
+            );
+        }
+        assert_eq!(
+            beckmann_lambda_of_a(&[0.0, f64::INFINITY]),
+            [f64::INFINITY, 0.0]
+        );
     }
 
     /// The vectorised `Lambda` gives the scalar one's bits at every direction, the horizon and
@@ -992,7 +1040,13 @@ mod tests {
                     theta[k],
                     at_once[k]
                 );
-                assert_eq!(beckmann[k], Beckmann { alpha }.lambda_from_tan2(tan2));
+                let want = Beckmann { alpha }.lambda_from_tan2(tan2);
+                assert!(
+                    (beckmann[k] - want).abs() <= 1e-12 * want || beckmann[k] == want,
+                    "Beckmann alpha {alpha} theta {}: {} vs {want}",
+                    theta[k],
+                    beckmann[k]
+                );
             }
             assert_eq!(ggx.lambdas_of_directions(&[1.0], &[0.0]), [f64::INFINITY]);
         }

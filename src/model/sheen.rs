@@ -19,6 +19,7 @@ pub fn charlie_d(cos_h: f64, alpha: f64) -> f64 {
 
 /// Ashikhmin's visibility `1 / (4 (mu_i + mu_o - mu_i mu_o))` for cosines in `[0, 1]`, not both 0.
 #[must_use]
+#[inline]
 pub fn ashikhmin_v(mu_o: f64, mu_i: f64) -> f64 {
     1.0 / (4.0 * (mu_i + mu_o - mu_i * mu_o))
 }
