@@ -781,12 +781,11 @@ pub fn check_computed(table: &Table) -> Result<()> {
 /// `kiln plan` and for `kiln bake` to say how long it will take before it starts.
 ///
 /// Per texel, measured as whole-process wall time of `kiln bake --quantity Q` on a 2-core AMD
-/// EPYC (AVX2), times 2, at the default max error 1e-7 (32 x 32 tables, quadrature to 1e-7,
-/// numerics version 5; the dielectric ones 16 x 16 x 16 and 16 x 16, numerics version 6, on a
-/// 2-core Xeon), given here for 8 digits: GGX `E` 0.6 ms, Beckmann `E` 1.1 ms, GGX `E_avg`
-/// 12 ms, Beckmann `E_avg` 44 ms, the split-sum and Fresnel-weighted channels 0.2 ms, dielectric
-/// `E` 1.2 ms (outside) and 2.8 ms (inside), their averages 45 ms and 60 ms, `F_avg` nothing to
-/// speak of.
+/// EPYC (AVX2), times 2, at the default max error 1e-7 (32 x 32 tables, the dielectric ones
+/// 16 x 16 x 16 and 16 x 16; numerics version 8, one run each, 2026-12-02), given here for 8
+/// digits: GGX `E` 0.3 ms, Beckmann `E` 0.6 ms, GGX `E_avg` 4 ms, Beckmann `E_avg` 25 ms, the
+/// split-sum and Fresnel-weighted channels 0.15 ms, dielectric `E` 1.1 ms (outside) and 3.2 ms
+/// (inside), their averages 37 ms and 49 ms, `F_avg` nothing to speak of.
 /// The quadrature's cost grows about linearly with the digits asked for, so the figure is
 /// scaled by `digits / 8`. QMC costs its samples at the measured kernel rates (GGX 75 M/s per
 /// core for `E`, 50 M/s for `E_avg`; Beckmann 3.5 and 1.7 M/s; 20 M/s for the rest). An
@@ -808,18 +807,18 @@ pub fn estimated_core_seconds(spec: &TableSpec) -> f64 {
         }
         Method::Reference => {
             let per_texel = match (spec.quantity, beckmann) {
-                (Quantity::E, false) => 0.6e-3,
-                (Quantity::E, true) => 1.1e-3,
-                (Quantity::EAvg, false) => 12e-3,
-                (Quantity::EAvg, true) => 44e-3,
-                (Quantity::EDielectric, _) => 1.2e-3,
-                (Quantity::EDielectricInside, _) => 2.8e-3,
-                (Quantity::EAvgDielectric, _) => 45e-3,
-                (Quantity::EAvgDielectricInside, _) => 60e-3,
+                (Quantity::E, false) => 0.3e-3,
+                (Quantity::E, true) => 0.6e-3,
+                (Quantity::EAvg, false) => 4e-3,
+                (Quantity::EAvg, true) => 25e-3,
+                (Quantity::EDielectric, _) => 1.1e-3,
+                (Quantity::EDielectricInside, _) => 3.2e-3,
+                (Quantity::EAvgDielectric, _) => 37e-3,
+                (Quantity::EAvgDielectricInside, _) => 49e-3,
                 (Quantity::FAvg, _) => 1e-5,
                 // Integrals of the E table's lookup, not of the BRDF.
-                (Quantity::FMsNorm, _) => 0.2e-3,
-                _ => 0.2e-3,
+                (Quantity::FMsNorm, _) => 0.15e-3,
+                _ => 0.15e-3,
             };
             let digits = spec.reference_digits.unwrap_or(10);
             texels * per_texel * f64::from(digits) / 8.0
