@@ -171,10 +171,12 @@ fn slice_values<N: MicrofacetDistribution>(
     let (sin_h, cos_h) = (slice.sin_h, slice.cos_h);
     let a = cos_h * cos_m;
     let b = sin_h * sin_m;
+    // Padded first: an index `k % KRONROD_NODES` inside the loop kept `sin_cos_lane` scalar.
+    let padded: [f64; LANES] = std::array::from_fn(|k| nodes[k % KRONROD_NODES]);
     let mut o = [slice.m; LANES];
-    for k in 0..LANES {
-        let (sin_p, cos_p) = sin_cos_lane(nodes[k % KRONROD_NODES]);
-        o[k] = Vec3::new(
+    for (o, &phi) in o.iter_mut().zip(&padded) {
+        let (sin_p, cos_p) = sin_cos_lane(phi);
+        *o = Vec3::new(
             cos_h * sin_m + sin_h * cos_p * cos_m,
             sin_h * sin_p,
             a - b * cos_p,

@@ -560,18 +560,13 @@ fn lanes_portable<N: MicrofacetDistribution>(
     // The normals and their density per unit of the piece's variable: piece A above the peak
     // in `x` (a rule's nodes all lie on one side of the peak, a break: the centre tells),
     // through the lane-wise `exp`; `s` elsewhere.
+    // Padded first: an index `k % KRONROD_NODES` inside the loop kept `exp_lane` scalar.
+    let padded: [f64; LANES] = std::array::from_fn(|k| nodes[k % KRONROD_NODES]);
     let polar = if piece == Piece::A && nodes[0] >= 0.5 {
-        let mut exp_x = [0.0; LANES];
-        for k in 0..LANES {
-            exp_x[k] = exp_lane((nodes[k % KRONROD_NODES] - 0.5).max(0.0));
-        }
-        view.ndf.polar_lanes_in_x(&exp_x)
+        view.ndf
+            .polar_lanes_in_x(&padded.map(|u| exp_lane((u - 0.5).max(0.0))))
     } else {
-        let mut s = [0.0; LANES];
-        for k in 0..LANES {
-            s[k] = nodes[k % KRONROD_NODES];
-        }
-        view.ndf.polar_lanes_in_s(&s)
+        view.ndf.polar_lanes_in_s(&padded)
     };
     let mut om = [0.0; LANES];
     let mut weight = [0.0; LANES];
