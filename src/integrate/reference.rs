@@ -560,7 +560,8 @@ fn lanes_portable<N: MicrofacetDistribution>(
     // The normals and their density per unit of the piece's variable: piece A above the peak
     // in `x` (a rule's nodes all lie on one side of the peak, a break: the centre tells),
     // through the lane-wise `exp`; `s` elsewhere.
-    // Padded first: an index `k % KRONROD_NODES` inside the loop kept `exp_lane` scalar.
+    // Padded first, as in the glass lanes, where an index `k % KRONROD_NODES` inside the loop
+    // kept the lane-wise functions scalar (here it measured no different).
     let padded: [f64; LANES] = std::array::from_fn(|k| nodes[k % KRONROD_NODES]);
     let polar = if piece == Piece::A && nodes[0] >= 0.5 {
         view.ndf
