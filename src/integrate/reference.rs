@@ -141,10 +141,20 @@ fn weighted_quadrature_for(
     channels: Channels,
     settings: &ReferenceSettings,
 ) -> Quadrature<2> {
-    match model.ndf {
-        Ndf::Ggx => albedo_quadrature(Ggx { alpha }, model.masking, mu, h, channels, settings),
-        Ndf::Beckmann => {
-            albedo_quadrature(Beckmann { alpha }, model.masking, mu, h, channels, settings)
+    // The choice compiled in (a run-time test inside the integrand cost `E` 4 %).
+    let masking = model.masking;
+    match (model.ndf, channels) {
+        (Ndf::Ggx, Channels::WithLoss) => {
+            albedo_quadrature::<_, true>(Ggx { alpha }, masking, mu, h, settings)
+        }
+        (Ndf::Ggx, Channels::WeightedOnly) => {
+            albedo_quadrature::<_, false>(Ggx { alpha }, masking, mu, h, settings)
+        }
+        (Ndf::Beckmann, Channels::WithLoss) => {
+            albedo_quadrature::<_, true>(Beckmann { alpha }, masking, mu, h, settings)
+        }
+        (Ndf::Beckmann, Channels::WeightedOnly) => {
+            albedo_quadrature::<_, false>(Beckmann { alpha }, masking, mu, h, settings)
         }
     }
 }
@@ -259,13 +269,12 @@ fn finish(q: Quadrature<2>) -> ReferenceValue {
 }
 
 /// `[E_h, 1 - E]` with the error estimate, for one distribution (`[E_h, 0]` and the estimate of
-/// `E_h` alone with [`Channels::WeightedOnly`]).
-fn albedo_quadrature<N: MicrofacetDistribution>(
+/// `E_h` alone without `WITH_LOSS`, [`Channels::WeightedOnly`]).
+fn albedo_quadrature<N: MicrofacetDistribution, const WITH_LOSS: bool>(
     ndf: N,
     masking: Masking,
     mu: f64,
     h: impl Fn(f64) -> f64 + Copy,
-    channels: Channels,
     settings: &ReferenceSettings,
 ) -> Quadrature<2> {
     let alpha = ndf.alpha();
@@ -324,7 +333,7 @@ fn albedo_quadrature<N: MicrofacetDistribution>(
                 h,
                 values,
             );
-            if channels == Channels::WeightedOnly {
+            if !WITH_LOSS {
                 for value in values.iter_mut() {
                     value[1] = 0.0;
                 }
@@ -356,17 +365,17 @@ fn albedo_quadrature<N: MicrofacetDistribution>(
                 values,
             );
         };
-        let b = match channels {
-            Channels::WithLoss => integrate_pieces_batch(
-                &mut below,
-                &[s_star, s_visible.max(s_star)],
-                inner_tolerance,
-                settings.max_intervals,
-            ),
-            Channels::WeightedOnly => {
-                integrate_pieces_batch(&mut below, &[], inner_tolerance, settings.max_intervals)
-            }
+        let below_breaks: &[f64] = if WITH_LOSS {
+            &[s_star, s_visible.max(s_star)]
+        } else {
+            &[]
         };
+        let b = integrate_pieces_batch(
+            &mut below,
+            below_breaks,
+            inner_tolerance,
+            settings.max_intervals,
+        );
         evaluations += a.evaluations + b.evaluations;
         all_converged &= a.converged && b.converged;
         [a.value[0], a.value[1] + b.value[1], a.error + b.error]
@@ -560,14 +569,18 @@ fn lanes_portable<N: MicrofacetDistribution>(
     // The normals and their density per unit of the piece's variable: piece A above the peak
     // in `x` (a rule's nodes all lie on one side of the peak, a break: the centre tells),
     // through the lane-wise `exp`; `s` elsewhere.
-    // Padded first, as in the glass lanes, where an index `k % KRONROD_NODES` inside the loop
-    // kept the lane-wise functions scalar (here it measured no different).
-    let padded: [f64; LANES] = std::array::from_fn(|k| nodes[k % KRONROD_NODES]);
     let polar = if piece == Piece::A && nodes[0] >= 0.5 {
-        view.ndf
-            .polar_lanes_in_x(&padded.map(|u| exp_lane((u - 0.5).max(0.0))))
+        let mut exp_x = [0.0; LANES];
+        for k in 0..LANES {
+            exp_x[k] = exp_lane((nodes[k % KRONROD_NODES] - 0.5).max(0.0));
+        }
+        view.ndf.polar_lanes_in_x(&exp_x)
     } else {
-        view.ndf.polar_lanes_in_s(&padded)
+        let mut s = [0.0; LANES];
+        for k in 0..LANES {
+            s[k] = nodes[k % KRONROD_NODES];
+        }
+        view.ndf.polar_lanes_in_s(&s)
     };
     let mut om = [0.0; LANES];
     let mut weight = [0.0; LANES];
