@@ -396,29 +396,60 @@ impl Table {
     /// inside table (`eta < 1` is looked up at `1 / eta`). Absent axes ignore their coordinate.
     #[must_use]
     pub fn lookup_channel_eta(&self, channel: &[f64], mu: f64, roughness: f64, eta: f64) -> f64 {
+        self.lookup_along_mu(channel, roughness, eta)(mu)
+    }
+
+    /// [`Table::lookup_channel_eta`] as a function of `mu` at a fixed `(roughness, eta)`: the
+    /// slower axes' corners are found once, each call finds only `mu`'s (the same operations
+    /// per lookup, so the same bits). For the integrals of a lookup over `mu` (`f_ms_norm`).
+    pub fn lookup_along_mu<'a>(
+        &'a self,
+        channel: &'a [f64],
+        roughness: f64,
+        eta: f64,
+    ) -> impl Fn(f64) -> f64 + 'a {
         let alpha = self.spec.roughness_convention().to_alpha(roughness);
-        let shape = self.spec.shape();
-        // Per axis, slowest first: the two samples to blend, the second's weight, the stride.
-        let corners: Vec<Corner> = [
-            (self.spec.ior, eta),
-            (self.spec.roughness, roughness),
-            (self.spec.mu, mu),
-        ]
-        .into_iter()
-        .filter_map(|(axis, x)| axis.map(|axis| (axis, x)))
-        .enumerate()
-        .map(|(k, (axis, x))| {
+        let corner = move |axis: Axis, x: f64, stride: usize| {
             let p = axis.position(x, alpha);
             let i = (p.floor() as usize).min(axis.size().saturating_sub(2));
             Corner {
                 low: i,
                 high: (i + 1).min(axis.size() - 1),
                 weight: p - i as f64,
-                stride: shape[k + 1..].iter().product(),
+                stride,
             }
-        })
-        .collect();
-        blend(channel, &corners, 0)
+        };
+        // Per axis, slowest first: the two samples to blend, the second's weight, the stride
+        // (the product of the faster axes' sizes). In place: a lookup allocates nothing (the
+        // audits and `f_ms_norm` make millions).
+        let mut corners = [Corner::default(); 3];
+        let mut slower = 0;
+        let mut stride = self.spec.mu.map_or(1, |axis| axis.size());
+        let mut strides = [0; 2];
+        for (k, axis) in [self.spec.roughness, self.spec.ior].into_iter().enumerate() {
+            strides[k] = stride;
+            if let Some(axis) = axis {
+                stride *= axis.size();
+            }
+        }
+        for (axis, x, stride) in [
+            (self.spec.ior, eta, strides[1]),
+            (self.spec.roughness, roughness, strides[0]),
+        ] {
+            if let Some(axis) = axis {
+                corners[slower] = corner(axis, x, stride);
+                slower += 1;
+            }
+        }
+        move |mu: f64| {
+            let mut corners = corners;
+            let mut count = slower;
+            if let Some(axis) = self.spec.mu {
+                corners[count] = corner(axis, mu, 1);
+                count += 1;
+            }
+            blend(channel, &corners[..count], 0)
+        }
     }
 
     /// As [`Table::lookup`] with the IOR coordinate of a dielectric table.
@@ -429,6 +460,7 @@ impl Table {
 }
 
 /// One axis of a lookup: the two samples blended, the second's weight, the index stride.
+#[derive(Clone, Copy, Default)]
 struct Corner {
     low: usize,
     high: usize,

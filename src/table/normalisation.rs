@@ -42,7 +42,7 @@ use rayon::prelude::*;
 pub const SUBDIVISIONS: usize = 16;
 
 /// `1 - Ē(roughness) = 2 ∫ (1 - E_lookup(mu, roughness)) mu dmu` of an E table's bilinear
-/// lookup ([`Table::lookup_one_minus`]), integrated by adaptive Gauss-Kronrod over `mu`, split
+/// lookup ([`Table::lookup_one_minus`], along `mu`: [`Table::lookup_along_mu`]), integrated by adaptive Gauss-Kronrod over `mu`, split
 /// at the `mu` of the table's columns at that roughness (where the lookup has kinks), to an
 /// absolute accuracy of 1e-16. Returns the value and the quadrature's error estimate.
 #[must_use]
@@ -62,8 +62,9 @@ pub fn one_minus_lookup_average(e: &Table, roughness: f64) -> (f64, f64) {
         .collect();
     breaks.sort_by(f64::total_cmp);
     breaks.dedup();
+    let lookup = e.lookup_along_mu(&e.one_minus_value, roughness, 1.0);
     let integral = integrate_pieces(
-        &mut |mu: f64| [2.0 * mu * e.lookup_one_minus(mu, roughness)],
+        &mut |mu: f64| [2.0 * mu * lookup(mu)],
         &breaks,
         1e-16,
         20_000,
