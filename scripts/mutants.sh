@@ -5,9 +5,10 @@
 #   scripts/mutants.sh src/format/f16.rs src/integrate/estimate.rs   # some files
 #   SHARD=0/4 scripts/mutants.sh       # one of four shards of the scope
 #   TESTS="--lib --test containers" scripts/mutants.sh src/format/f16.rs   # fewer test binaries
+#   RE="cody_rational|beckmann_lambda_of_a" scripts/mutants.sh src/model/special.rs   # some functions
 # Needs cargo-mutants (`cargo install cargo-mutants --locked`). Results in target/mutants.out/:
 # caught.txt, missed.txt, timeout.txt, unviable.txt (under target/, which git ignores). Runs every
-# test binary in release mode, as CI does.
+# test binary with release's optimisation, as CI does.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if ! command -v cargo-mutants > /dev/null; then
@@ -29,9 +30,14 @@ done
 if [ -n "${SHARD:-}" ]; then
     args+=(--shard "$SHARD")
 fi
-# --release for the build and the test alike (a test-only flag builds each mutant twice, in
-# debug and then in release).
-test_args=(--cargo-arg=--release)
+if [ -n "${RE:-}" ]; then
+    args+=(--re "$RE")
+fi
+# Cargo.toml's `mutants` profile for the build and the test alike: the release build's code
+# (the tests' tolerances and run times are release's) without debug info and incremental, so a
+# mutant rebuilds in about a third of a release build's time. (A test-only flag builds each
+# mutant twice.)
+test_args=(--profile mutants)
 for t in ${TESTS:-}; do
     test_args+=("--cargo-test-arg=$t")
 done

@@ -422,19 +422,14 @@ impl Table {
         // Per axis, slowest first: the two samples to blend, the second's weight, the stride
         // (the product of the faster axes' sizes). In place: a lookup allocates nothing (the
         // audits and `f_ms_norm` make millions).
+        let size = |axis: Option<Axis>| axis.map_or(1, |axis| axis.size());
+        let roughness_stride = size(self.spec.mu);
+        let ior_stride = roughness_stride * size(self.spec.roughness);
         let mut corners = [Corner::default(); 3];
         let mut slower = 0;
-        let mut stride = self.spec.mu.map_or(1, |axis| axis.size());
-        let mut strides = [0; 2];
-        for (k, axis) in [self.spec.roughness, self.spec.ior].into_iter().enumerate() {
-            strides[k] = stride;
-            if let Some(axis) = axis {
-                stride *= axis.size();
-            }
-        }
         for (axis, x, stride) in [
-            (self.spec.ior, eta, strides[1]),
-            (self.spec.roughness, roughness, strides[0]),
+            (self.spec.ior, eta, ior_stride),
+            (self.spec.roughness, roughness, roughness_stride),
         ] {
             if let Some(axis) = axis {
                 corners[slower] = corner(axis, x, stride);
