@@ -6,6 +6,8 @@
 #   SHARD=0/4 scripts/mutants.sh       # one of four shards of the scope
 #   TESTS="--lib --test containers" scripts/mutants.sh src/format/f16.rs   # fewer test binaries
 #   RE="cody_rational|beckmann_lambda_of_a" scripts/mutants.sh src/model/special.rs   # some functions
+#   TIMEOUT=60 scripts/mutants.sh ...  # seconds a mutant's tests may take (default 300; a mutant
+#                                      # can make a test run far longer than it does)
 # Needs cargo-mutants (`cargo install cargo-mutants --locked`). Results in target/mutants.out/:
 # caught.txt, missed.txt, timeout.txt, unviable.txt (under target/, which git ignores). Runs every
 # test binary with release's optimisation, as CI does.
@@ -41,4 +43,4 @@ test_args=(--profile mutants)
 for t in ${TESTS:-}; do
     test_args+=("--cargo-test-arg=$t")
 done
-exec cargo mutants "${args[@]}" --output target --jobs 1 --timeout 300 --build-timeout 900 "${test_args[@]}"
+exec cargo mutants "${args[@]}" --output target --jobs 1 --timeout "${TIMEOUT:-300}" --build-timeout 900 "${test_args[@]}"
