@@ -4,7 +4,8 @@
 #   scripts/mutants.sh                 # the whole scope below (hours on 2 cores)
 #   scripts/mutants.sh src/format/f16.rs src/integrate/estimate.rs   # some files
 #   SHARD=0/4 scripts/mutants.sh       # one of four shards of the scope
-#   TESTS="--lib --test containers" scripts/mutants.sh src/format/f16.rs   # fewer test binaries
+#   TARGETS="--lib --test containers" scripts/mutants.sh src/format/f16.rs   # fewer test binaries
+#   TARGETS=--lib TESTS="-- model::" scripts/mutants.sh src/model/special.rs  # and fewer tests
 #   RE="cody_rational|beckmann_lambda_of_a" scripts/mutants.sh src/model/special.rs   # some functions
 #   TIMEOUT=60 scripts/mutants.sh ...  # seconds a mutant's tests may take (default 300; a mutant
 #                                      # can make a test run far longer than it does)
@@ -40,6 +41,11 @@ fi
 # mutant rebuilds in about a third of a release build's time. (A test-only flag builds each
 # mutant twice.)
 test_args=(--profile mutants)
+# TARGETS: the test targets built and run (cargo's --lib, --test NAME), for the build of each
+# mutant as well as its test; TESTS: arguments of the test run alone (a name filter after --).
+for t in ${TARGETS:-}; do
+    test_args+=("--cargo-arg=$t")
+done
 for t in ${TESTS:-}; do
     test_args+=("--cargo-test-arg=$t")
 done
