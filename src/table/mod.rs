@@ -536,6 +536,39 @@ mod tests {
         }
     }
 
+    /// A 3-D lookup (IOR, roughness, `mu`) at every node and between them: the values are
+    /// `100 eta_index + 10 row + column`, linear in each index, so the trilinear blend anywhere
+    /// is the same form of the texture coordinates, and a wrong stride of either slower axis
+    /// reads another texel.
+    #[test]
+    fn a_lookup_over_ior_finds_every_axis_by_its_stride() {
+        let mut t = synthetic(Grid::Nodes, MuMapping::Linear);
+        t.spec.ior = Some(Axis::Ior {
+            size: 3,
+            mapping: IorMapping::Linear,
+            max: axis::IorBound(3.0),
+            grid: Grid::Nodes,
+        });
+        t.value = (0..60)
+            .map(|k| (100 * (k / 20) + 10 * (k % 20 / 4) + k % 4) as f64)
+            .collect();
+        let etas = t.spec.ior.unwrap().listed_values();
+        assert_eq!(etas, [1.0, 2.0, 3.0]);
+        for (e, &eta) in etas.iter().enumerate() {
+            for row in 0..5 {
+                for col in 0..4 {
+                    let (r, mu) = (row as f64 / 4.0, col as f64 / 3.0);
+                    let want = (100 * e + 10 * row + col) as f64;
+                    let got = t.lookup_eta(mu, r, eta);
+                    assert!((got - want).abs() < 1e-9, "{e} {row} {col}: {got}");
+                }
+            }
+        }
+        // Halfway along every axis: index positions 1.5, 2.5 and 0.5.
+        let got = t.lookup_eta(0.5 / 3.0, 2.5 / 4.0, 2.5);
+        assert!((got - 175.5).abs() < 1e-9, "{got}");
+    }
+
     #[test]
     fn lookup_returns_stored_values_at_sample_coordinates_and_lerps_between() {
         for grid in [Grid::Centers, Grid::Nodes] {
