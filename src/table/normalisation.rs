@@ -42,9 +42,10 @@ use rayon::prelude::*;
 pub const SUBDIVISIONS: usize = 16;
 
 /// `1 - Ē(roughness) = 2 ∫ (1 - E_lookup(mu, roughness)) mu dmu` of an E table's bilinear
-/// lookup ([`Table::lookup_one_minus`], along `mu`: [`Table::lookup_along_mu`]), integrated by adaptive Gauss-Kronrod over `mu`, split
-/// at the `mu` of the table's columns at that roughness (where the lookup has kinks), to an
-/// absolute accuracy of 1e-16. Returns the value and the quadrature's error estimate.
+/// lookup ([`Table::lookup_one_minus`], taken along `mu` by [`Table::lookup_along_mu`]),
+/// integrated by adaptive Gauss-Kronrod over `mu`, split at the `mu` of the table's columns at
+/// that roughness (where the lookup has kinks), to an absolute accuracy of 1e-16. Returns the
+/// value and the quadrature's error estimate.
 #[must_use]
 pub fn one_minus_lookup_average(e: &Table, roughness: f64) -> (f64, f64) {
     let Some(Axis::Mu {
