@@ -141,21 +141,28 @@ fn weighted_quadrature_for(
     channels: Channels,
     settings: &ReferenceSettings,
 ) -> Quadrature<2> {
-    // The choice compiled in (a run-time test inside the integrand cost `E` 4 %).
     let masking = model.masking;
-    match (model.ndf, channels) {
-        (Ndf::Ggx, Channels::WithLoss) => {
-            albedo_quadrature::<_, true>(Ggx { alpha }, masking, mu, h, settings)
+    match model.ndf {
+        Ndf::Ggx => channels_quadrature(Ggx { alpha }, masking, mu, h, channels, settings),
+        Ndf::Beckmann => {
+            channels_quadrature(Beckmann { alpha }, masking, mu, h, channels, settings)
         }
-        (Ndf::Ggx, Channels::WeightedOnly) => {
-            albedo_quadrature::<_, false>(Ggx { alpha }, masking, mu, h, settings)
-        }
-        (Ndf::Beckmann, Channels::WithLoss) => {
-            albedo_quadrature::<_, true>(Beckmann { alpha }, masking, mu, h, settings)
-        }
-        (Ndf::Beckmann, Channels::WeightedOnly) => {
-            albedo_quadrature::<_, false>(Beckmann { alpha }, masking, mu, h, settings)
-        }
+    }
+}
+
+/// [`albedo_quadrature`] with the channels compiled in (a run-time test inside the integrand
+/// cost `E` 4 %).
+fn channels_quadrature<N: MicrofacetDistribution>(
+    ndf: N,
+    masking: Masking,
+    mu: f64,
+    h: impl Fn(f64) -> f64 + Copy,
+    channels: Channels,
+    settings: &ReferenceSettings,
+) -> Quadrature<2> {
+    match channels {
+        Channels::WithLoss => albedo_quadrature::<_, true>(ndf, masking, mu, h, settings),
+        Channels::WeightedOnly => albedo_quadrature::<_, false>(ndf, masking, mu, h, settings),
     }
 }
 

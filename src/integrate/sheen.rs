@@ -17,7 +17,7 @@
 
 use super::albedo::sin_from_cos;
 use super::gauss_kronrod::{KRONROD_NODES, Quadrature, integrate_pieces, integrate_pieces_batch};
-use crate::model::sheen::{ashikhmin_v, charlie_d};
+use crate::model::sheen::{ashikhmin_v, charlie_d, charlie_weight};
 use crate::numerics::elementary::sin_cos_lane;
 use std::f64::consts::{FRAC_PI_2, PI};
 
@@ -96,16 +96,6 @@ pub fn sheen_albedo(alpha: f64, mu_o: f64, tolerance: f64) -> Quadrature<1> {
 /// from 88 to 57 million evaluations (a tenth: 61 million; a fixed 1e-3 of the tolerance for
 /// every `alpha`, as before: 88 million, and a stated error up to 1.001 times the tolerance).
 const INNER_SHARE: f64 = 0.25;
-
-/// `∫_0^1 2 D(c) dc` of the Charlie distribution ([`charlie_d`]): with `k = 1 / (2 alpha)`,
-/// `∫_0^1 (1 - c^2)^k dc = (sqrt(pi) / 2) Γ(k + 1) / Γ(k + 3/2)` (the Beta function
-/// `B(1/2, k + 1) / 2`), so the integral is `(2 + 1/alpha) / pi` times that; about
-/// `1 / sqrt(pi alpha)` for small `alpha`, where `D` peaks at `c = 0`.
-fn charlie_weight(alpha: f64) -> f64 {
-    let k = 0.5 / alpha;
-    let beta_half = 0.5 * PI.sqrt() * (libm::lgamma(k + 1.0) - libm::lgamma(k + 1.5)).exp();
-    (2.0 + 1.0 / alpha) / PI * beta_half
-}
 
 /// One inner integral's fixed terms: the view `mu_o`, `a = sin(theta_o) sin(theta_h)` and
 /// `c = cos(theta_h)`, so that `o.h = a cos(phi) + mu_o c`.

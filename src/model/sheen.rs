@@ -17,6 +17,20 @@ pub fn charlie_d(cos_h: f64, alpha: f64) -> f64 {
     (2.0 + 1.0 / alpha) * sin2.powf(0.5 / alpha) / (2.0 * std::f64::consts::PI)
 }
 
+/// `∫_0^1 2 D(c) dc` of the Charlie distribution ([`charlie_d`]): the weight an error in an
+/// integral over `c` of `D` times a bounded factor carries (the sheen albedo's inner integrals,
+/// [`crate::integrate::sheen`]). With `k = 1 / (2 alpha)`,
+/// `∫_0^1 (1 - c^2)^k dc = (sqrt(pi) / 2) Γ(k + 1) / Γ(k + 3/2)` (the Beta function
+/// `B(1/2, k + 1) / 2`), so the integral is `(2 + 1/alpha) / pi` times that; about
+/// `1 / sqrt(pi alpha)` for small `alpha`, where `D` peaks at `c = 0`.
+#[must_use]
+pub fn charlie_weight(alpha: f64) -> f64 {
+    use std::f64::consts::PI;
+    let k = 0.5 / alpha;
+    let beta_half = 0.5 * PI.sqrt() * (libm::lgamma(k + 1.0) - libm::lgamma(k + 1.5)).exp();
+    (2.0 + 1.0 / alpha) / PI * beta_half
+}
+
 /// Ashikhmin's visibility `1 / (4 (mu_i + mu_o - mu_i mu_o))` for cosines in `[0, 1]`, not both 0.
 #[must_use]
 #[inline]
