@@ -7,6 +7,7 @@
 #   TARGETS="--lib --test containers" scripts/mutants.sh src/format/f16.rs   # fewer test binaries
 #   TARGETS=--lib TESTS="-- model::" scripts/mutants.sh src/model/special.rs  # and fewer tests
 #   RE="cody_rational|beckmann_lambda_of_a" scripts/mutants.sh src/model/special.rs   # some functions
+#   ITERATE=1 scripts/mutants.sh src/table   # again, skipping the mutants the last runs caught
 #   TIMEOUT=60 scripts/mutants.sh ...  # seconds a mutant's tests may take (default 300; a mutant
 #                                      # can make a test run far longer than it does)
 # Needs cargo-mutants (`cargo install cargo-mutants --locked`). Results in target/mutants.out/:
@@ -32,6 +33,9 @@ for f in "${files[@]}"; do
 done
 if [ -n "${SHARD:-}" ]; then
     args+=(--shard "$SHARD")
+fi
+if [ -n "${ITERATE:-}" ]; then
+    args+=(--iterate)
 fi
 if [ -n "${RE:-}" ]; then
     args+=(--re "$RE")

@@ -177,3 +177,83 @@ impl std::fmt::Display for RoughnessConvention {
         f.write_str(self.name())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn model(ndf: Ndf, masking: Masking) -> Model {
+        Model { ndf, masking }
+    }
+
+    /// Below `SMOOTH_ALPHA` a point moves along `mu / alpha = const` to `alpha = 1e-7`, capped
+    /// at the mirror's `mu = 1`; from it up, nothing moves.
+    #[test]
+    fn a_smooth_point_keeps_mu_over_alpha() {
+        assert_eq!(smooth_point(1e-7, 0.3), (1e-7, 0.3));
+        assert_eq!(smooth_point(0.5, 1e-9), (0.5, 1e-9));
+        assert_eq!(smooth_point(1e-9, 0.0), (1e-7, 0.0));
+        let (alpha, mu) = smooth_point(1e-9, 2e-11);
+        assert_eq!(alpha, 1e-7);
+        assert!((mu / 2e-9 - 1.0).abs() < 1e-15, "{mu}");
+        assert_eq!(smooth_point(1e-9, 0.5), (1e-7, 1.0));
+        assert_eq!(smooth_point(0.0, 0.3), (1e-7, 1.0));
+        assert_eq!(smooth_point(0.0, 0.0), (1e-7, 0.0));
+    }
+
+    /// `E = 1` exactly: the mirror off the horizon for every masking, and the grazing limit of
+    /// the height-correlated form only (separable GGX's is 0.936).
+    #[test]
+    fn the_albedo_is_exactly_one_only_for_the_mirror_and_the_correlated_grazing_limit() {
+        let correlated = model(Ndf::Ggx, Masking::HeightCorrelated);
+        let separable = model(Ndf::Ggx, Masking::Separable);
+        assert!(albedo_is_exactly_one(correlated, 0.0, 0.5));
+        assert!(albedo_is_exactly_one(separable, 0.0, 0.5));
+        assert!(albedo_is_exactly_one(correlated, 0.3, 0.0));
+        assert!(albedo_is_exactly_one(correlated, 0.0, 0.0));
+        assert!(!albedo_is_exactly_one(separable, 0.3, 0.0));
+        assert!(!albedo_is_exactly_one(separable, 0.0, 0.0));
+        assert!(!albedo_is_exactly_one(correlated, 0.3, 0.5));
+        assert!(!albedo_is_exactly_one(correlated, 1e-9, 0.5));
+    }
+
+    /// Names as serde writes and reads them, the roughness conventions both ways, and the one
+    /// model combination refused.
+    #[test]
+    fn models_and_conventions_are_named_as_files_read_them() {
+        let serde_name = |v: serde_json::Value| v.as_str().unwrap().to_string();
+        for ndf in Ndf::ALL {
+            assert_eq!(serde_name(serde_json::to_value(ndf).unwrap()), ndf.name());
+            assert_eq!(ndf.to_string(), ndf.name());
+        }
+        assert_eq!(Ndf::ALL, [Ndf::Ggx, Ndf::Beckmann]);
+        assert_eq!(
+            model(Ndf::Beckmann, Masking::Separable).to_string(),
+            "beckmann separable"
+        );
+        for convention in [RoughnessConvention::Perceptual, RoughnessConvention::Alpha] {
+            let name = serde_name(serde_json::to_value(convention).unwrap());
+            assert_eq!(name, convention.name());
+            assert_eq!(convention.to_string(), name);
+            assert_eq!(convention.from_alpha(convention.to_alpha(0.3)), 0.3);
+        }
+        assert_eq!(RoughnessConvention::Perceptual.to_alpha(0.5), 0.25);
+        assert_eq!(RoughnessConvention::Perceptual.from_alpha(0.25), 0.5);
+        assert_eq!(RoughnessConvention::Alpha.to_alpha(0.5), 0.5);
+        assert_eq!(RoughnessConvention::Alpha.from_alpha(0.25), 0.25);
+        assert!(
+            RoughnessConvention::Perceptual
+                .describe()
+                .contains("alpha = r^2")
+        );
+        assert!(RoughnessConvention::Alpha.describe().starts_with("alpha"));
+        let refused = model(Ndf::Beckmann, Masking::SchlickGgx).validate();
+        assert!(
+            refused
+                .unwrap_err()
+                .contains("--ndf ggx only (got beckmann)")
+        );
+        assert_eq!(model(Ndf::Ggx, Masking::SchlickGgx).validate(), Ok(()));
+        assert_eq!(model(Ndf::Beckmann, Masking::Separable).validate(), Ok(()));
+    }
+}

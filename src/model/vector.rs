@@ -76,3 +76,48 @@ impl Mul<f64> for Vec3 {
         Self::new(self.x * s, self.y * s, self.z * s)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each operation on vectors whose results are exact in binary (the 3-4-5 triangles), or
+    /// within rounding of it.
+    #[test]
+    fn vector_operations_on_exact_values() {
+        assert_eq!(Vec3::from_mu(0.6), Vec3::new(0.8, 0.0, 0.6));
+        assert_eq!(Vec3::from_mu(1.0), Vec3::new(0.0, 0.0, 1.0));
+        assert_eq!(Vec3::from_mu(0.0), Vec3::new(1.0, 0.0, 0.0));
+        let (a, b) = (Vec3::new(1.0, 2.0, 3.0), Vec3::new(4.0, -5.0, 6.0));
+        assert_eq!(a.dot(b), 12.0);
+        assert_eq!(a.length_squared(), 14.0);
+        assert_eq!(a + b, Vec3::new(5.0, -3.0, 9.0));
+        assert_eq!(a - b, Vec3::new(-3.0, 7.0, -3.0));
+        assert_eq!(a * 2.0, Vec3::new(2.0, 4.0, 6.0));
+        let unit = Vec3::new(0.0, 3.0, 4.0).normalize();
+        assert!(
+            (unit - Vec3::new(0.0, 0.6, 0.8)).length_squared() < 1e-30,
+            "{unit:?}"
+        );
+        assert_eq!(
+            Vec3::new(0.0, 0.0, -4.0).normalize(),
+            Vec3::new(0.0, 0.0, -1.0)
+        );
+        // tan^2 of a direction at 45 degrees, of one at tan = 2 towards y, and on the horizon.
+        assert_eq!(Vec3::new(3.0, 4.0, 5.0).tan2_theta(), 1.0);
+        assert_eq!(Vec3::new(0.0, 0.6, 0.3).tan2_theta(), 4.0);
+        assert_eq!(Vec3::new(1.0, 0.0, 0.0).tan2_theta(), f64::INFINITY);
+        // Reflected about the normal, and about a facet tilted 45 degrees towards x.
+        let o = Vec3::new(0.6, 0.0, 0.8);
+        assert_eq!(
+            o.reflect(Vec3::new(0.0, 0.0, 1.0)),
+            Vec3::new(-0.6, 0.0, 0.8)
+        );
+        let m = Vec3::new(1.0, 0.0, 1.0).normalize();
+        let i = Vec3::new(0.0, 0.0, 1.0).reflect(m);
+        assert!(
+            (i - Vec3::new(1.0, 0.0, 0.0)).length_squared() < 1e-30,
+            "{i:?}"
+        );
+    }
+}

@@ -407,6 +407,13 @@ mod tests {
             grid: Grid::Nodes,
         };
         assert_eq!(mu.listed_values(), [0.0, 1.0 / 9.0, 4.0 / 9.0, 1.0]);
+        // An adaptive axis lists its texture coordinates: its mu moves from row to row.
+        let adaptive = Axis::Mu {
+            size: 4,
+            mapping: MuMapping::Adaptive,
+            grid: Grid::Nodes,
+        };
+        assert_eq!(adaptive.listed_values(), [0.0, 1.0 / 3.0, 2.0 / 3.0, 1.0]);
         let r = Axis::Roughness {
             size: 2,
             convention: RoughnessConvention::Perceptual,
@@ -414,6 +421,68 @@ mod tests {
         };
         assert_eq!(r.listed_values(), [0.25, 0.75]);
         assert_eq!(r.alpha(1), 0.5625);
+    }
+
+    /// The names on the command line and in metadata are serde's, which files are read by;
+    /// each formula names its own variables.
+    #[test]
+    fn conventions_are_named_as_files_read_them() {
+        let serde_name = |v: serde_json::Value| v.as_str().unwrap().to_string();
+        for grid in [Grid::Centers, Grid::Nodes] {
+            assert_eq!(serde_name(serde_json::to_value(grid).unwrap()), grid.name());
+        }
+        for mapping in [MuMapping::Linear, MuMapping::Sqrt, MuMapping::Adaptive] {
+            assert_eq!(
+                serde_name(serde_json::to_value(mapping).unwrap()),
+                mapping.name()
+            );
+            assert!(mapping.formula().contains("mu = "), "{}", mapping.formula());
+        }
+        for mapping in [IorMapping::Linear, IorMapping::Cycles, IorMapping::Blender] {
+            assert_eq!(
+                serde_name(serde_json::to_value(mapping).unwrap()),
+                mapping.name()
+            );
+            assert!(
+                mapping.formula().contains("eta = "),
+                "{}",
+                mapping.formula()
+            );
+        }
+        assert!(Grid::Centers.formula().contains("(i + 0.5) / N"));
+        assert!(Grid::Nodes.formula().contains("i / (N - 1)"));
+        // A single node sits at the start of the axis.
+        assert_eq!(Grid::Nodes.coordinate(0, 1), 0.0);
+        let axes = [
+            Axis::Mu {
+                size: 2,
+                mapping: MuMapping::Sqrt,
+                grid: Grid::Nodes,
+            },
+            Axis::Roughness {
+                size: 2,
+                convention: RoughnessConvention::Perceptual,
+                grid: Grid::Centers,
+            },
+            Axis::Roughness {
+                size: 2,
+                convention: RoughnessConvention::Alpha,
+                grid: Grid::Nodes,
+            },
+            Axis::Ior {
+                size: 2,
+                mapping: IorMapping::Cycles,
+                max: IorBound(3.0),
+                grid: Grid::Nodes,
+            },
+        ];
+        let names: Vec<_> = axes.iter().map(Axis::name).collect();
+        assert_eq!(names, ["mu", "r", "alpha", "eta"]);
+        let formulas: Vec<_> = axes.iter().map(Axis::formula).collect();
+        assert!(formulas[0].starts_with("t_i = i / (N - 1), mu = t^2"));
+        assert!(formulas[1].starts_with("t_i = (i + 0.5) / N, r = t_i, alpha = r^2"));
+        assert!(formulas[2].starts_with("t_i = i / (N - 1), alpha = t_i"));
+        assert!(formulas[3].ends_with("eta_max = 3"), "{}", formulas[3]);
     }
 
     #[test]
@@ -438,6 +507,33 @@ mod tests {
         let eta = IorMapping::Cycles.eta(0.5, 1.5);
         let z = 0.5 * (0.5f64 / 2.5).sqrt();
         assert!((((eta - 1.0) / (eta + 1.0)).powi(2) - z.powi(4)).abs() < 1e-15);
+    }
+
+    /// Blender's glass axis: `z = clamp(t, 1e-4, 0.99)`, `eta = (1 + z^2) / (1 - z^2)` whatever
+    /// `eta_max` (`precompute.cpp`), worked by hand: `t = 0.5` is `eta = 1.25 / 0.75 = 5/3`,
+    /// the ends are `1 + 2e-8` and `1.9801 / 0.0199`; the lookup reads `t = z` unclamped.
+    #[test]
+    fn blenders_ior_axis_is_its_clamped_z() {
+        let blender = IorMapping::Blender;
+        assert!((blender.eta(0.5, 3.0) - 5.0 / 3.0).abs() < 1e-15);
+        assert!((blender.eta(0.0, 3.0) - (1.0 + 2e-8)).abs() < 1e-15);
+        assert!((blender.eta(1.0, 3.0) / (1.9801 / 0.0199) - 1.0).abs() < 1e-13);
+        assert!((blender.coordinate(5.0 / 3.0, 3.0) - 0.5).abs() < 1e-15);
+        assert!((blender.coordinate(0.6, 3.0) - 0.5).abs() < 1e-15);
+        // Bounds compare and hash by their bits: two axes to different ends are two keys.
+        let axis = |max: f64| Axis::Ior {
+            size: 16,
+            mapping: blender,
+            max: IorBound(max),
+            grid: Grid::Nodes,
+        };
+        let keys: std::collections::HashSet<Axis> = [axis(3.0), axis(2.0), axis(3.0)].into();
+        assert_eq!(keys.len(), 2);
+        let hash = |a: Axis| {
+            use std::hash::{BuildHasher, BuildHasherDefault};
+            BuildHasherDefault::<std::collections::hash_map::DefaultHasher>::default().hash_one(a)
+        };
+        assert_ne!(hash(axis(3.0)), hash(axis(2.0)));
     }
 
     #[test]

@@ -139,3 +139,297 @@ impl Table {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::integrate::QmcSettings;
+    use crate::model::dielectric::TransmissionConvention;
+    use crate::model::{Fresnel, Masking, Model, Ndf, RoughnessConvention};
+    use crate::table::Method;
+    use crate::table::axis::{Grid, IorBound, IorMapping, MuMapping};
+
+    const ROUGHNESS: Axis = Axis::Roughness {
+        size: 4,
+        convention: RoughnessConvention::Perceptual,
+        grid: Grid::Nodes,
+    };
+    const MU: Axis = Axis::Mu {
+        size: 3,
+        mapping: MuMapping::Adaptive,
+        grid: Grid::Nodes,
+    };
+
+    fn ior(max: f64) -> Axis {
+        Axis::Ior {
+            size: 2,
+            mapping: IorMapping::Cycles,
+            max: IorBound(max),
+            grid: Grid::Nodes,
+        }
+    }
+
+    /// A 4 x 3 E table's spec.
+    fn e_spec() -> TableSpec {
+        TableSpec {
+            model: Model {
+                ndf: Ndf::Ggx,
+                masking: Masking::HeightCorrelated,
+            },
+            quantity: Quantity::E,
+            ior: None,
+            roughness: Some(ROUGHNESS),
+            mu: Some(MU),
+            fresnel: None,
+            method: Method::Reference,
+            qmc: QmcSettings::default(),
+            reference_digits: None,
+            lookup_of: None,
+            transmission: TransmissionConvention::SingleScattering,
+        }
+    }
+
+    fn refused(spec: &TableSpec, words: &str) {
+        match spec.check() {
+            Err(message) => assert!(message.contains(words), "{message}: wanted {words:?}"),
+            Ok(()) => panic!("accepted, wanted {words:?}: {spec:?}"),
+        }
+    }
+
+    /// Each axis in its place, of a size kiln reads; each rule both ways.
+    #[test]
+    fn a_spec_needs_its_quantitys_axes_in_their_places() {
+        assert_eq!(e_spec().check(), Ok(()));
+        let swapped = TableSpec {
+            roughness: Some(MU),
+            mu: Some(ROUGHNESS),
+            ..e_spec()
+        };
+        refused(&swapped, "its roughness axis is a mu axis (axes swapped?)");
+        refused(
+            &TableSpec {
+                mu: None,
+                ..e_spec()
+            },
+            "E needs a mu axis",
+        );
+        let e_avg = TableSpec {
+            quantity: Quantity::EAvg,
+            ..e_spec()
+        };
+        refused(&e_avg, "E_avg has no mu axis");
+        assert_eq!(TableSpec { mu: None, ..e_avg }.check(), Ok(()));
+        refused(
+            &TableSpec {
+                ior: Some(ior(3.0)),
+                ..e_spec()
+            },
+            "E has no eta axis",
+        );
+        let empty = Axis::Mu {
+            size: 0,
+            mapping: MuMapping::Linear,
+            grid: Grid::Nodes,
+        };
+        refused(
+            &TableSpec {
+                mu: Some(empty),
+                ..e_spec()
+            },
+            "its mu axis has 0 samples",
+        );
+        // One axis may hold every texel kiln reads, not one more.
+        let long = |size| Axis::Mu {
+            size,
+            mapping: MuMapping::Linear,
+            grid: Grid::Nodes,
+        };
+        let one_row = Axis::Roughness {
+            size: 1,
+            convention: RoughnessConvention::Perceptual,
+            grid: Grid::Nodes,
+        };
+        let widest = TableSpec {
+            roughness: Some(one_row),
+            mu: Some(long(super::super::MAX_TEXELS)),
+            ..e_spec()
+        };
+        assert_eq!(widest.check(), Ok(()));
+        refused(
+            &TableSpec {
+                mu: Some(long(super::super::MAX_TEXELS + 1)),
+                ..widest
+            },
+            "its mu axis has 67108865 samples",
+        );
+    }
+
+    /// The IOR axis ends in `(1, MAX_INDEX]`.
+    #[test]
+    fn an_ior_axis_ends_above_1_and_at_most_at_the_largest_index() {
+        let glass = |max: f64| TableSpec {
+            quantity: Quantity::EDielectric,
+            ior: Some(ior(max)),
+            ..e_spec()
+        };
+        for max in [1.0001, 3.0, crate::model::fresnel::MAX_INDEX] {
+            assert_eq!(glass(max).check(), Ok(()), "{max}");
+        }
+        for max in [1.0, 0.5, 100.5, f64::NAN, f64::INFINITY] {
+            refused(&glass(max), "its eta axis ends at");
+        }
+        refused(
+            &TableSpec {
+                ior: None,
+                ..glass(3.0)
+            },
+            "needs a eta axis",
+        );
+    }
+
+    /// Transmission conventions, Fresnel models and source tables belong to the quantities
+    /// that use them, and only to those.
+    #[test]
+    fn conventions_belong_to_the_quantities_that_use_them() {
+        let cycles = TransmissionConvention::Cycles;
+        let glass = TableSpec {
+            quantity: Quantity::EDielectric,
+            ior: Some(ior(3.0)),
+            transmission: cycles,
+            ..e_spec()
+        };
+        assert_eq!(glass.check(), Ok(()));
+        refused(
+            &TableSpec {
+                transmission: cycles,
+                ..e_spec()
+            },
+            "a transmission convention belongs to the dielectric tables, not E",
+        );
+        let f_avg = TableSpec {
+            quantity: Quantity::FAvg,
+            roughness: None,
+            mu: None,
+            ..glass
+        };
+        refused(&f_avg, "not F_avg");
+        let schlick = Some(Fresnel::Dielectric { eta: 1.5 });
+        refused(
+            &TableSpec {
+                fresnel: schlick,
+                ..e_spec()
+            },
+            "a Fresnel model belongs to E_F tables",
+        );
+        let e_f = TableSpec {
+            quantity: Quantity::EF,
+            ..e_spec()
+        };
+        refused(&e_f, "a Fresnel model belongs to E_F tables");
+        assert_eq!(
+            TableSpec {
+                fresnel: schlick,
+                ..e_f
+            }
+            .check(),
+            Ok(())
+        );
+        let norm = TableSpec {
+            quantity: Quantity::FMsNorm,
+            mu: None,
+            ..e_spec()
+        };
+        refused(&norm, "f_ms_norm needs lookup_of");
+        let of = |source: TableSpec| TableSpec {
+            lookup_of: Some(Box::new(source)),
+            ..norm.clone()
+        };
+        assert_eq!(of(e_spec()).check(), Ok(()));
+        refused(
+            &of(TableSpec {
+                quantity: Quantity::EAvg,
+                mu: None,
+                ..e_spec()
+            }),
+            "derived from an E table, not E_avg",
+        );
+        refused(
+            &of(TableSpec {
+                mu: None,
+                ..e_spec()
+            }),
+            "its E table: E needs a mu axis",
+        );
+        refused(
+            &TableSpec {
+                lookup_of: Some(Box::new(e_spec())),
+                ..e_spec()
+            },
+            "E is not derived from another table",
+        );
+    }
+
+    /// A 4 x 3 table whose channels are `value`, `1 - value` and `error` at every texel.
+    fn table(value: f64, error: f64) -> Table {
+        Table {
+            spec: e_spec(),
+            value: vec![value; 12],
+            one_minus_value: vec![1.0 - value; 12],
+            std_error: vec![error; 12],
+            command: String::new(),
+            node_errors: None,
+            requested_max_error: None,
+        }
+    }
+
+    /// Channels as long as the spec, values in `[0, 1]` to within `RANGE_TOLERANCE`, value and
+    /// one-minus value adding up to 1, errors finite and not negative.
+    #[test]
+    fn a_tables_channels_hold_what_its_spec_promises() {
+        assert_eq!(table(0.5, 1e-6).check(), Ok(()));
+        assert_eq!(table(1.0 + 0.9e-3, 0.0).check(), Ok(()));
+        assert_eq!(table(-0.9e-3, 0.0).check(), Ok(()));
+        let mut t = table(0.5, 0.0);
+        t.value.pop();
+        match t.check() {
+            Err(m) => assert_eq!(m, "E has 11 values for shape [4, 3] (12 texels)"),
+            Ok(()) => panic!("a short channel passed"),
+        }
+        let mut t = table(0.5, 0.0);
+        t.std_error.push(0.0);
+        assert!(
+            t.check()
+                .unwrap_err()
+                .starts_with("std_error has 13 values")
+        );
+        let mut t = table(0.5, 0.0);
+        t.value[7] = 1.0 + 1.1e-3;
+        assert_eq!(
+            t.check(),
+            Err("E at texel 7 is 1.0011, outside [0, 1]".into())
+        );
+        let mut t = table(0.5, 0.0);
+        t.one_minus_value[2] = -1.1e-3;
+        assert_eq!(
+            t.check(),
+            Err("one_minus_E at texel 2 is -0.0011, outside [0, 1]".into())
+        );
+        let mut t = table(0.5, 0.0);
+        t.value[4] = f64::NAN;
+        assert!(t.check().unwrap_err().starts_with("E at texel 4 is NaN"));
+        // Each in range, not adding up to 1 (0.4 + 0.6 = 1; 0.4 + 0.5 = 0.9).
+        let mut t = table(0.5, 0.0);
+        t.value[3] = 0.4;
+        assert!(t.check().unwrap_err().contains("at texel 3, E = 0.4"));
+        // A difference from 1 of 1.9e-3, within twice the tolerance, passes.
+        let mut t = table(0.5, 0.0);
+        t.value[3] = 0.5 + 0.95e-3;
+        t.one_minus_value[3] = 0.5 + 0.95e-3;
+        assert_eq!(t.check(), Ok(()));
+        for bad in [f64::NAN, f64::INFINITY, -1e-300] {
+            let mut t = table(0.5, 0.0);
+            t.std_error[11] = bad;
+            assert_eq!(t.check(), Err(format!("std_error at texel 11 is {bad}")));
+        }
+    }
+}

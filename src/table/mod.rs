@@ -13,8 +13,8 @@ use serde::{Deserialize, Serialize};
 pub use crate::integrate::quantity::{Quantity, schlick_weight};
 
 /// The most texels kiln reads from any file or accepts in any metadata (checked by
-/// [`TableSpec::check`]): 2^26, a 4096 x 4096
-/// table (the largest 2-D table kiln bakes, [`crate::BakeOptions::MAX_SIZE`]). A header that
+/// [`TableSpec::check`]): 2^26, four times a 4096 x 4096 table (the largest 2-D table kiln
+/// bakes, [`crate::BakeOptions::MAX_SIZE`]). A header that
 /// claims more is refused before anything is allocated or decompressed.
 pub const MAX_TEXELS: usize = 1 << 26;
 
@@ -567,6 +567,204 @@ mod tests {
         // Halfway along every axis: index positions 1.5, 2.5 and 0.5.
         let got = t.lookup_eta(0.5 / 3.0, 2.5 / 4.0, 2.5);
         assert!((got - 175.5).abs() < 1e-9, "{got}");
+    }
+
+    /// `synthetic`'s table with an IOR axis of 3 nodes in front: shape 3 x 5 x 4.
+    fn synthetic_over_ior(quantity: Quantity) -> TableSpec {
+        let mut spec = synthetic(Grid::Nodes, MuMapping::Linear).spec;
+        spec.quantity = quantity;
+        spec.ior = Some(Axis::Ior {
+            size: 3,
+            mapping: IorMapping::Linear,
+            max: axis::IorBound(3.0),
+            grid: Grid::Nodes,
+        });
+        spec
+    }
+
+    /// Texel indices by hand: row-major, the IOR axis slowest and `mu` fastest, so texel
+    /// `20 e + 4 row + col` is `[e, row, col]`.
+    #[test]
+    fn a_spec_counts_and_splits_its_texels_slowest_axis_first() {
+        let spec = synthetic_over_ior(Quantity::EDielectric);
+        assert_eq!(spec.shape(), [3, 5, 4]);
+        assert_eq!(spec.len(), 60);
+        assert!(!spec.is_empty());
+        assert_eq!(spec.texel_indices(0), [Some(0), Some(0), Some(0)]);
+        assert_eq!(spec.texel_indices(37), [Some(1), Some(4), Some(1)]);
+        assert_eq!(spec.texel_indices(59), [Some(2), Some(4), Some(3)]);
+        let flat = synthetic(Grid::Nodes, MuMapping::Linear).spec;
+        assert_eq!(flat.texel_indices(13), [None, Some(3), Some(1)]);
+        let mut average = flat.clone();
+        average.mu = None;
+        assert_eq!(average.len(), 5);
+        assert_eq!(average.texel_indices(3), [None, Some(3), None]);
+        let mut empty = flat;
+        empty.mu = Some(Axis::Mu {
+            size: 0,
+            mapping: MuMapping::Linear,
+            grid: Grid::Nodes,
+        });
+        assert_eq!(empty.len(), 0);
+        assert!(empty.is_empty());
+    }
+
+    /// Where each texel is computed, from the axis formulas in `axis`'s docs worked by hand:
+    /// rows on nodes of `r` with `alpha = r^2`, columns `mu = t` or the adaptive
+    /// `mu = s k / (1 + k - s)`, `s = t^2.5`, `k = 4 alpha`, and at `alpha = 0` the boundary
+    /// layer's limit at `alpha = 1e-7`, except the mirror at `t = 1`.
+    #[test]
+    fn texels_are_computed_where_the_axis_formulas_put_them() {
+        let linear = synthetic(Grid::Nodes, MuMapping::Linear).spec;
+        // Texel 9: row 2 of 5 nodes (r = 0.5, alpha = 0.25), column 1 of 4 (mu = 1/3).
+        let (alpha, mu) = linear.texel_coordinates(9);
+        assert_eq!(alpha, 0.25);
+        assert!((mu.unwrap() - 1.0 / 3.0).abs() < 1e-15);
+        // A linear axis has no layer: alpha = 0 stays 0.
+        assert_eq!(linear.point(0.0, 0.5), (0.0, Some(0.5)));
+        let mut average = linear.clone();
+        average.mu = None;
+        assert_eq!(average.texel_coordinates(3), (0.5625, None));
+        let mut f_avg = average;
+        f_avg.roughness = None;
+        assert_eq!(f_avg.texel_coordinates(0), (0.0, None));
+
+        let adaptive = synthetic(Grid::Nodes, MuMapping::Adaptive).spec;
+        let mu_of = |t: f64, alpha: f64| {
+            let (s, k) = (t.powf(2.5), 4.0 * alpha);
+            s * k / (1.0 + k - s)
+        };
+        let (alpha, mu) = adaptive.point(0.5, 0.5);
+        assert_eq!(alpha, 0.25);
+        assert!((mu.unwrap() - mu_of(0.5, 0.25)).abs() < 1e-15);
+        let (alpha, mu) = adaptive.point(0.0, 0.5);
+        assert_eq!(alpha, 1e-7);
+        assert!((mu.unwrap() / mu_of(0.5, 1e-7) - 1.0).abs() < 1e-12);
+        assert_eq!(adaptive.point(0.0, 1.0), (0.0, Some(1.0)));
+    }
+
+    /// The IOR axis lists `eta = 1, 2, 3`; light from inside is computed at `1 / eta`.
+    #[test]
+    fn a_texel_of_light_from_inside_is_computed_at_the_inverse_index() {
+        let outside = synthetic_over_ior(Quantity::EDielectric);
+        let inside = synthetic_over_ior(Quantity::EDielectricInside);
+        assert_eq!(outside.texel_eta(37), Some(2.0));
+        assert_eq!(inside.texel_eta(37), Some(0.5));
+        assert_eq!(inside.texel_eta(59), Some(1.0 / 3.0));
+        assert_eq!(outside.relative_eta(1.5), 1.5);
+        assert_eq!(inside.relative_eta(1.5), 1.0 / 1.5);
+        assert_eq!(
+            synthetic(Grid::Nodes, MuMapping::Linear).spec.texel_eta(3),
+            None
+        );
+    }
+
+    /// File names: the default layout adds no tag; every other convention adds its own, in
+    /// the documented order (`TableSpec::id`).
+    #[test]
+    fn a_table_is_named_by_its_model_quantity_and_layout() {
+        let default = synthetic(Grid::Nodes, MuMapping::Adaptive).spec;
+        assert_eq!(default.id(), "ggx-height-correlated-E");
+        let mut other = synthetic(Grid::Centers, MuMapping::Linear).spec;
+        other.roughness = Some(Axis::Roughness {
+            size: 5,
+            convention: RoughnessConvention::Alpha,
+            grid: Grid::Centers,
+        });
+        assert_eq!(
+            other.id(),
+            "ggx-height-correlated-E-alpha-mu-linear-centers"
+        );
+        let sqrt = synthetic(Grid::Nodes, MuMapping::Sqrt).spec;
+        assert_eq!(sqrt.id(), "ggx-height-correlated-E-mu-sqrt");
+        let mut glass = synthetic_over_ior(Quantity::EDielectric);
+        glass.mu = default.mu;
+        assert!(glass.id().ends_with("-ior-linear"), "{}", glass.id());
+        if let Some(Axis::Ior { mapping, .. }) = &mut glass.ior {
+            *mapping = IorMapping::Blender;
+        }
+        assert!(glass.id().ends_with("-ior-blender"), "{}", glass.id());
+        if let Some(Axis::Ior { mapping, .. }) = &mut glass.ior {
+            *mapping = IorMapping::Cycles;
+        }
+        assert!(!glass.id().contains("ior"), "{}", glass.id());
+        let mut f_avg = glass;
+        f_avg.quantity = Quantity::FAvg;
+        assert!(f_avg.base_id() == "dielectric-F_avg", "{}", f_avg.base_id());
+        // A derived table takes the layout of its source.
+        let mut norm = default.clone();
+        norm.lookup_of = Some(Box::new(sqrt));
+        assert_eq!(norm.layout_tags(), ["mu-sqrt"]);
+    }
+
+    /// The error summaries of `std_error = [3, 4, 0, 0]`: max 4, root-mean-square
+    /// `sqrt(25 / 4) = 2.5`.
+    #[test]
+    fn the_error_summaries_are_the_max_and_the_root_mean_square() {
+        let mut t = synthetic(Grid::Nodes, MuMapping::Linear);
+        t.std_error = vec![3.0, 4.0, 0.0, 0.0];
+        assert_eq!(t.max_std_error(), 4.0);
+        assert_eq!(t.rms_std_error(), 2.5);
+        t.std_error[2] = f64::NAN;
+        assert!(t.max_std_error().is_nan());
+    }
+
+    /// The names on the command line and in files are serde's (the names files are read by),
+    /// and the reference's tolerance is `10^-digits`, its own 1e-11 without digits.
+    #[test]
+    fn methods_are_named_as_files_read_them_and_digits_set_the_tolerance() {
+        for method in [Method::Qmc, Method::Reference] {
+            assert_eq!(serde_json::to_value(method).unwrap(), method.name());
+        }
+        assert!(Method::Qmc.describe().contains("Sobol"));
+        assert!(Method::Reference.describe().contains("Gauss-Kronrod"));
+        let mut spec = synthetic(Grid::Nodes, MuMapping::Linear).spec;
+        assert_eq!(spec.reference_settings().tolerance, 1e-11);
+        spec.reference_digits = Some(7);
+        assert!((spec.reference_settings().tolerance / 1e-7 - 1.0).abs() < 1e-15);
+        assert_eq!(spec.roughness_convention(), RoughnessConvention::Perceptual);
+        spec.roughness = Some(Axis::Roughness {
+            size: 5,
+            convention: RoughnessConvention::Alpha,
+            grid: Grid::Nodes,
+        });
+        assert_eq!(spec.roughness_convention(), RoughnessConvention::Alpha);
+    }
+
+    /// The channels in the order the files store them, each named, and the one-minus lookup
+    /// reading its own channel (`synthetic` stores `1 - value` there).
+    #[test]
+    fn channels_come_in_storage_order_and_each_lookup_reads_its_own() {
+        let mut t = synthetic(Grid::Nodes, MuMapping::Linear);
+        t.std_error = vec![0.5; 20];
+        assert_eq!(t.channel_names(), ["E", "one_minus_E", "std_error"]);
+        let [value, one_minus, error] = t.channels();
+        assert_eq!((value[5], one_minus[5], error[5]), (11.0, -10.0, 0.5));
+        assert_eq!(value.len() + one_minus.len() + error.len(), 60);
+        // Halfway between rows 1 and 2 and columns 2 and 3: 1 - 17.5.
+        assert!((t.lookup_one_minus(2.5 / 3.0, 0.375) + 16.5).abs() < 1e-9);
+    }
+
+    /// A 4096 x 4096 table, the largest the bake makes, passes the size check; a spec of more
+    /// than 2^26 texels does not.
+    #[test]
+    fn the_size_check_admits_the_largest_bake_and_refuses_more_than_2_to_the_26() {
+        let mut spec = synthetic(Grid::Nodes, MuMapping::Linear).spec;
+        let axes = |spec: &mut TableSpec, rows: usize, columns: usize| {
+            if let Some(Axis::Roughness { size, .. }) = &mut spec.roughness {
+                *size = rows;
+            }
+            if let Some(Axis::Mu { size, .. }) = &mut spec.mu {
+                *size = columns;
+            }
+        };
+        axes(&mut spec, 4096, 4096);
+        assert_eq!(spec.check(), Ok(()));
+        axes(&mut spec, 4 * 4096, 4096);
+        assert_eq!(spec.check(), Ok(()));
+        axes(&mut spec, 4 * 4096 + 1, 4096);
+        let message = spec.check().unwrap_err();
+        assert!(message.contains("67112960 texels"), "{message}");
     }
 
     #[test]

@@ -168,3 +168,151 @@ pub fn normalisation_lookup(norm: &Table, roughness: f64) -> f64 {
         g
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::integrate::QmcSettings;
+    use crate::model::dielectric::TransmissionConvention;
+    use crate::model::{Masking, Model, Ndf, RoughnessConvention};
+    use crate::table::Method;
+    use crate::table::axis::MuMapping;
+
+    /// A 5 x 4 E table over `r` and `mu` whose one-minus channel is `loss(r, t)` at each texel,
+    /// `t` the column's texture coordinate.
+    fn e_table(grid: Grid, mapping: MuMapping, loss: impl Fn(f64, f64) -> f64) -> Table {
+        let spec = TableSpec {
+            model: Model {
+                ndf: Ndf::Ggx,
+                masking: Masking::HeightCorrelated,
+            },
+            quantity: Quantity::E,
+            ior: None,
+            roughness: Some(Axis::Roughness {
+                size: 5,
+                convention: RoughnessConvention::Perceptual,
+                grid,
+            }),
+            mu: Some(Axis::Mu {
+                size: 4,
+                mapping,
+                grid,
+            }),
+            fresnel: None,
+            method: Method::Reference,
+            qmc: QmcSettings::default(),
+            reference_digits: None,
+            lookup_of: None,
+            transmission: TransmissionConvention::SingleScattering,
+        };
+        let one_minus_value: Vec<f64> = (0..20)
+            .map(|k| loss(grid.coordinate(k / 4, 5), grid.coordinate(k % 4, 4)))
+            .collect();
+        Table {
+            value: one_minus_value.iter().map(|w| 1.0 - w).collect(),
+            one_minus_value,
+            std_error: vec![0.0; 20],
+            spec,
+            command: String::new(),
+            node_errors: None,
+            requested_max_error: None,
+        }
+    }
+
+    /// On rows and columns at nodes of a linear or square-root `mu` axis, a loss linear in the
+    /// texture coordinates is what the bilinear lookup returns everywhere, so its average is a
+    /// closed form: `2 ∫ (a + b mu) mu dmu = a + 2b/3`, and with `t = sqrt(mu)`,
+    /// `2 ∫ (a + b sqrt(mu)) mu dmu = a + 4b/5`.
+    #[test]
+    fn the_lookups_average_loss_is_the_closed_form_of_a_linear_lookup() {
+        let a = |r: f64| 0.1 + 0.4 * r;
+        let loss = |r: f64, t: f64| a(r) + 0.2 * t;
+        let linear = e_table(Grid::Nodes, MuMapping::Linear, loss);
+        let sqrt = e_table(Grid::Nodes, MuMapping::Sqrt, loss);
+        for r in [0.0, 0.3, 0.5, 0.9, 1.0] {
+            let (value, error) = one_minus_lookup_average(&linear, r);
+            assert!((value - (a(r) + 0.4 / 3.0)).abs() < 1e-14, "{r}: {value}");
+            assert!((0.0..1e-14).contains(&error), "{error}");
+            let (value, _) = one_minus_lookup_average(&sqrt, r);
+            assert!((value - (a(r) + 0.16)).abs() < 1e-14, "{r}: {value}");
+        }
+        // Neither is derived per roughness: the lookup of the derived table is exact between
+        // its nodes too, since the average is linear in r.
+        let norm = derive(&linear, String::new());
+        assert!(!stores_per_roughness(&norm.spec));
+        for r in [0.0, 0.01, 0.3, 0.77, 1.0] {
+            let got = normalisation_lookup(&norm, r);
+            assert!((got - (a(r) + 0.4 / 3.0)).abs() < 1e-13, "{r}: {got}");
+        }
+        assert!(norm.max_std_error() < 1e-14);
+        // The one-minus channel the files store beside it.
+        for (v, w) in norm.value.iter().zip(&norm.one_minus_value) {
+            assert!((v + w - 1.0).abs() < 1e-15, "{v} {w}");
+        }
+    }
+
+    /// The normalisation table's axis: every cell of the E table's rows subdivided 16 times,
+    /// on nodes, in the E table's convention (`5` rows on nodes: 65 entries; on centres, whose
+    /// rows sit half a cell in: 81).
+    #[test]
+    fn the_normalisation_subdivides_every_cell_of_the_rows() {
+        let loss = |_: f64, _: f64| 0.5;
+        let nodes = spec_for(&e_table(Grid::Nodes, MuMapping::Adaptive, loss).spec);
+        let centers = spec_for(&e_table(Grid::Centers, MuMapping::Adaptive, loss).spec);
+        assert_eq!(nodes.shape(), [65]);
+        assert_eq!(centers.shape(), [81]);
+        assert_eq!(nodes.roughness_axis().grid(), Grid::Nodes);
+        assert_eq!(centers.roughness_axis().grid(), Grid::Nodes);
+        assert_eq!(nodes.quantity, Quantity::FMsNorm);
+        assert_eq!(nodes.check(), Ok(()));
+        // Row 1 of 5 centres, t = 0.3, is node 0.3 * 80 = 24 of 81.
+        assert_eq!(
+            Grid::Nodes.coordinate(24, 81),
+            Grid::Centers.coordinate(1, 5)
+        );
+    }
+
+    /// Only the adaptive `mu` axis with rows on nodes stores `(1 - Ē) / x`; its lookup
+    /// multiplies back by `x`, so at every node but the first it returns `1 - Ē` itself (a
+    /// loss of 0.3 at every texel: `1 - Ē = 0.3` at every `r > 0`, 0 at the mirror).
+    #[test]
+    fn only_the_adaptive_axis_on_nodes_is_stored_per_roughness() {
+        let loss = |_: f64, _: f64| 0.3;
+        let adaptive = e_table(Grid::Nodes, MuMapping::Adaptive, loss);
+        assert!(divides_by_roughness(&adaptive.spec));
+        assert!(!divides_by_roughness(
+            &e_table(Grid::Centers, MuMapping::Adaptive, loss).spec
+        ));
+        assert!(!divides_by_roughness(
+            &e_table(Grid::Nodes, MuMapping::Linear, loss).spec
+        ));
+        let norm = derive(&adaptive, String::new());
+        assert!(stores_per_roughness(&norm.spec));
+        for i in [1, 2, 16, 33, 64] {
+            let x = Grid::Nodes.coordinate(i, 65);
+            assert!(
+                (norm.value[i] * x - 0.3).abs() < 1e-13,
+                "{i}: {}",
+                norm.value[i]
+            );
+            let got = normalisation_lookup(&norm, x);
+            assert!((got - 0.3).abs() < 1e-13, "{i}: {got}");
+        }
+        assert_eq!(normalisation_lookup(&norm, 0.0), 0.0);
+        // Its error estimates are divided by x as well (a loss that varies along the row,
+        // which the quadrature does not integrate exactly).
+        let varying = e_table(Grid::Nodes, MuMapping::Adaptive, |r, t| 0.2 + 0.1 * r * t);
+        let varying_norm = derive(&varying, String::new());
+        for i in [1, 7, 64] {
+            let x = Grid::Nodes.coordinate(i, 65);
+            let (_, error) = one_minus_lookup_average(&varying, x);
+            assert!(error > 0.0, "{i}");
+            assert!(
+                (varying_norm.std_error[i] * x / error - 1.0).abs() < 1e-12,
+                "{i}"
+            );
+        }
+        // The first entry is the slope at 1e-4 of the first cell: 0.3 / (1e-4 / 64).
+        assert!((norm.value[0] / (0.3 * 64e4) - 1.0).abs() < 1e-12);
+    }
+}
