@@ -315,6 +315,8 @@ mod tests {
             let cos_t = -t.dot(m);
             let sin_t = (1.0 - cos_t * cos_t).sqrt();
             assert!((sin_i - eta * sin_t).abs() < 1e-14, "{eta}");
+            // Through the facet, not mirrored back off it: i_t.m = -cos_t < 0.
+            assert!(cos_t > 0.0, "{eta}: {t:?}");
             // o, m and t lie in one plane.
             let normal = Vec3::new(
                 o.y * m.z - o.z * m.y,
@@ -347,5 +349,116 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// A view from inside (`eta = 1 / 1.5`) at `mu = 0.3` on a facet tilted 31 degrees
+    /// towards it refracts upwards, to `z = 0.42`: single scattering loses that light, Cycles'
+    /// convention keeps it with `(1 - F) G2(o, i_t) / G1(o)`, here worked from GGX's `Lambda`
+    /// in closed form, `(sqrt(1 + alpha^2 tan^2) - 1) / 2`, and height-correlated masking.
+    #[test]
+    fn cycles_keeps_a_refraction_that_ends_above_and_single_scattering_loses_it() {
+        let (alpha, eta) = (0.5, 1.0 / 1.5);
+        let ndf = Ggx { alpha };
+        let o = Vec3::from_mu(0.3);
+        let t = 31f64.to_radians();
+        let m = Vec3::new(t.sin(), 0.0, t.cos());
+        let c = o.dot(m);
+        let i_t = refract(o, m, c, eta).unwrap();
+        assert!(i_t.z > 0.4, "{i_t:?}");
+        let lambda = |v: Vec3| ((1.0 + alpha * alpha * v.tan2_theta()).sqrt() - 1.0) / 2.0;
+        let transmitted = 1.0 - super::super::fresnel::dielectric(eta, c);
+        let kept = transmitted * (1.0 + lambda(o)) / (1.0 + lambda(o) + lambda(i_t));
+        let masking = Masking::HeightCorrelated;
+        let lambda_o = lambda(o);
+        let single = scattering_with(ndf, masking, o, lambda_o, m, eta, Default::default());
+        let cycles = scattering_with(
+            ndf,
+            masking,
+            o,
+            lambda_o,
+            m,
+            eta,
+            TransmissionConvention::Cycles,
+        );
+        assert_eq!(single.transmission, 0.0);
+        assert!(
+            (cycles.transmission - kept).abs() < 1e-14,
+            "{cycles:?} vs {kept}"
+        );
+        assert!(kept > 0.2, "{kept}");
+        assert_eq!(single.reflection, cycles.reflection);
+        assert!((cycles.loss - (single.loss - kept)).abs() < 1e-14);
+    }
+
+    /// Names as serde writes them; only Cycles' convention keeps refractions above the surface
+    /// and treats an index within 1e-4 of 1 as smooth.
+    #[test]
+    fn the_conventions_differ_where_their_docs_say() {
+        use TransmissionConvention::{Cycles, SingleScattering};
+        for convention in [SingleScattering, Cycles] {
+            let name = serde_json::to_value(convention).unwrap();
+            assert_eq!(name.as_str(), Some(convention.name()));
+        }
+        assert!(SingleScattering.is_default() && !Cycles.is_default());
+        assert!(SingleScattering.describe().starts_with("single scattering"));
+        assert!(Cycles.describe().starts_with("Cycles' sampler"));
+        assert!(Cycles.keeps_refraction_above() && !SingleScattering.keeps_refraction_above());
+        for eta in [1.0, 1.00005, 0.99995] {
+            assert!(Cycles.smooth_at(eta), "{eta}");
+            assert!(!SingleScattering.smooth_at(eta), "{eta}");
+        }
+        for eta in [1.0002, 0.9998, 1.5, 1.0 / 1.5] {
+            assert!(!Cycles.smooth_at(eta), "{eta}");
+        }
+    }
+
+    /// Every contribution against the formulas worked independently: the reflection
+    /// `F G2(o, i_r) / G1(o)` about `m`, the refraction `(1 - F) G2(o, i_t) / G1(o)` with `i_t`
+    /// from the scalar [`refract`] (Snell's law, tested above) when it goes below the surface,
+    /// nothing under total internal reflection; GGX's `Lambda` in closed form and
+    /// height-correlated masking, `G2 / G1(o) = (1 + Lambda(o)) / (1 + Lambda(o) + Lambda(i))`.
+    #[test]
+    fn each_contribution_is_the_masked_fresnel_share_of_its_direction() {
+        let alpha = 0.4;
+        let ndf = Ggx { alpha };
+        let lambda = |v: Vec3| ((1.0 + alpha * alpha * v.tan2_theta()).sqrt() - 1.0) / 2.0;
+        let kept = |o: Vec3, i: Vec3| (1.0 + lambda(o)) / (1.0 + lambda(o) + lambda(i));
+        let (mut refractions, mut reflections_lost, mut total_internal) = (0, 0, 0);
+        for mu in [0.15, 0.6, 0.97] {
+            let o = Vec3::from_mu(mu);
+            for eta in [1.5, 1.0 / 1.5, 2.4, 1.0 / 1.33, 1.0] {
+                for k in 0..40 {
+                    let u = [(k as f64 + 0.5) / 40.0, ((k * 17) % 40) as f64 / 40.0];
+                    let m = ndf.sample_visible_normal(o, u);
+                    let c = o.dot(m);
+                    let f = super::super::fresnel::dielectric(eta, c);
+                    let s = scattering(ndf, Masking::HeightCorrelated, o, lambda(o), m, eta);
+                    let i_r = o.reflect(m);
+                    let reflection = if i_r.z > 0.0 {
+                        f * kept(o, i_r)
+                    } else {
+                        reflections_lost += 1;
+                        0.0
+                    };
+                    let transmission = match refract(o, m, c, eta) {
+                        Some(i_t) if i_t.z < 0.0 => {
+                            refractions += 1;
+                            (1.0 - f) * kept(o, i_t)
+                        }
+                        Some(_) => 0.0,
+                        None => {
+                            total_internal += 1;
+                            assert_eq!(f, 1.0);
+                            0.0
+                        }
+                    };
+                    let at = format!("mu {mu}, eta {eta}, m {m:?}: {s:?}");
+                    assert!((s.reflection - reflection).abs() < 1e-13, "{at}");
+                    assert!((s.transmission - transmission).abs() < 1e-13, "{at}");
+                }
+            }
+        }
+        // The grid reaches every case.
+        assert!(refractions > 300 && reflections_lost > 0 && total_internal > 0);
     }
 }

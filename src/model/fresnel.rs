@@ -444,4 +444,187 @@ mod tests {
         );
         assert!(Fresnel::Dielectric { eta: 1.5 }.validate().is_ok());
     }
+
+    /// Conductors at oblique incidence, against the same Fresnel equations evaluated in
+    /// mpmath's complex arithmetic at 30 digits (`r_s = (c - n cos_t) / (c + n cos_t)`,
+    /// `r_p = (n c - cos_t) / (n c + cos_t)`, `cos_t = sqrt(1 - (1 - c^2) / n^2)`, principal
+    /// root): gold-like, aluminium-like, and indices either side of 1 with small `k`.
+    #[test]
+    fn conductors_at_oblique_incidence_match_mpmath() {
+        for (eta, k, c, mpmath) in [
+            (0.18, 3.0, 0.5, 0.926_132_736_478_432_334_67),
+            (0.18, 3.0, 0.1, 0.963_043_616_893_336_204_54),
+            (1.2, 7.0, 0.3, 0.868_975_211_294_149_671_59),
+            (2.5, 0.5, 0.7, 0.208_727_737_149_524_532_15),
+            (0.5, 0.3, 0.2, 0.809_009_508_207_126_390_13),
+        ] {
+            let got = conductor(eta, k, c);
+            assert!((got - mpmath).abs() < 1e-14, "{eta} {k} {c}: {got}");
+            // Channel by channel: the middle one is glass (k = 0).
+            let model = Fresnel::Conductor {
+                eta: [eta, 1.5, eta],
+                k: [k, 0.0, k],
+            };
+            let [first, glass, last] = model.reflectance(c);
+            assert_eq!([first, last], [got, got]);
+            assert!((glass - dielectric(1.5, c)).abs() < 1e-13, "{glass}");
+        }
+    }
+
+    /// Names, tags and flags as files and the command line spell them, greyness channel by
+    /// channel, each range check with its message, and hashing by value.
+    #[test]
+    fn models_are_named_tagged_and_checked() {
+        let schlick = Fresnel::Schlick {
+            f0: [0.04; 3],
+            f90: [1.0; 3],
+        };
+        let glass = Fresnel::Dielectric { eta: 1.5 };
+        let metal = Fresnel::Conductor {
+            eta: [0.2; 3],
+            k: [3.1; 3],
+        };
+        let none = Fresnel::None;
+        let names: Vec<_> = [none, schlick, glass, metal]
+            .iter()
+            .map(Fresnel::name)
+            .collect();
+        assert_eq!(names, ["none", "schlick", "dielectric", "conductor"]);
+        let tags: Vec<_> = [none, schlick, glass, metal]
+            .iter()
+            .map(Fresnel::tag)
+            .collect();
+        assert_eq!(
+            tags,
+            [
+                "none",
+                "schlick-0.04-1",
+                "dielectric-1.5",
+                "conductor-0.2-3.1"
+            ]
+        );
+        let flags: Vec<_> = [none, schlick, glass, metal]
+            .iter()
+            .map(Fresnel::flags)
+            .collect();
+        assert_eq!(
+            flags,
+            [
+                "--fresnel none",
+                "--f0 0.04 --f90 1",
+                "--ior 1.5",
+                "--eta 0.2 --k 3.1"
+            ]
+        );
+        assert!([none, schlick, glass, metal].iter().all(Fresnel::is_grey));
+        for j in 0..3 {
+            let mut v = [0.5; 3];
+            v[j] = 0.6;
+            let tinted = Fresnel::Schlick {
+                f0: v,
+                f90: [1.0; 3],
+            };
+            assert!(!tinted.is_grey(), "{j}");
+            let tinted = Fresnel::Schlick {
+                f0: [0.5; 3],
+                f90: v,
+            };
+            assert!(!tinted.is_grey(), "{j}");
+            let tinted = Fresnel::Conductor {
+                eta: v,
+                k: [1.0; 3],
+            };
+            assert!(!tinted.is_grey(), "{j}");
+            let tinted = Fresnel::Conductor {
+                eta: [1.0; 3],
+                k: v,
+            };
+            assert!(!tinted.is_grey(), "{j}");
+        }
+        let refused = |model: Fresnel, words: &str| {
+            let message = model.validate().unwrap_err();
+            assert!(message.contains(words), "{message}: wanted {words}");
+        };
+        for good in [none, schlick, glass, metal] {
+            assert_eq!(good.validate(), Ok(()));
+        }
+        for eta in [0.01, 100.0] {
+            assert_eq!(Fresnel::Dielectric { eta }.validate(), Ok(()));
+        }
+        refused(Fresnel::Dielectric { eta: f64::NAN }, "ior must be finite");
+        refused(
+            Fresnel::Dielectric { eta: 0.009 },
+            "ior must be between 0.01 and 100",
+        );
+        refused(
+            Fresnel::Dielectric { eta: 101.0 },
+            "ior must be between 0.01 and 100",
+        );
+        let schlick_with = |f0: f64, f90: f64| Fresnel::Schlick {
+            f0: [0.5, f0, 0.5],
+            f90: [1.0, 1.0, f90],
+        };
+        assert_eq!(schlick_with(0.0, 1.0).validate(), Ok(()));
+        refused(schlick_with(-0.1, 1.0), "f0 must be in [0, 1] (got -0.1)");
+        refused(schlick_with(0.5, 1.1), "f90 must be in [0, 1] (got 1.1)");
+        refused(
+            schlick_with(f64::INFINITY, 1.0),
+            "f0 must be finite (got inf)",
+        );
+        refused(schlick_with(0.5, f64::NAN), "f90 must be finite (got NaN)");
+        let metal_with = |eta: f64, k: f64| Fresnel::Conductor {
+            eta: [1.0, eta, 1.0],
+            k: [1.0, 1.0, k],
+        };
+        assert_eq!(metal_with(100.0, 0.0).validate(), Ok(()));
+        assert_eq!(metal_with(0.01, 100.0).validate(), Ok(()));
+        refused(metal_with(0.001, 1.0), "eta must be between 0.01 and 100");
+        refused(metal_with(1.0, -0.5), "k must be between 0 and 100");
+        refused(metal_with(1.0, 101.0), "k must be between 0 and 100");
+        refused(metal_with(f64::NAN, 1.0), "eta must be finite");
+        refused(metal_with(1.0, f64::INFINITY), "k must be finite");
+        // Hashing follows the parameters of every channel.
+        let hash = |model: Fresnel| {
+            use std::hash::{BuildHasher, BuildHasherDefault};
+            BuildHasherDefault::<std::collections::hash_map::DefaultHasher>::default()
+                .hash_one(model)
+        };
+        assert_ne!(hash(glass), hash(Fresnel::Dielectric { eta: 1.33 }));
+        assert_ne!(hash(schlick), hash(schlick_with(0.0, 1.0)));
+        assert_ne!(hash(schlick_with(0.5, 1.0)), hash(schlick_with(0.5, 0.9)));
+        assert_ne!(hash(metal), hash(metal_with(0.2, 3.1)));
+        assert_ne!(hash(metal_with(1.0, 1.0)), hash(metal_with(1.0, 2.0)));
+        assert_ne!(hash(none), hash(glass));
+        assert_eq!(hash(glass), hash(Fresnel::Dielectric { eta: 1.5 }));
+    }
+
+    /// How each average was made: closed forms spend nothing; Schlick's is `(20 F0 + F90) / 21`
+    /// per channel; a dielectric from inside is split at its critical angle (`sqrt(1 - eta^2)`),
+    /// which a kink-blind quadrature would miss.
+    #[test]
+    fn averages_report_their_method() {
+        let none = Fresnel::None.average_report();
+        assert_eq!(
+            (none.value, none.error, none.evaluations),
+            ([1.0; 3], 0.0, 0)
+        );
+        assert_eq!(none.method, "closed-form");
+        let schlick = Fresnel::Schlick {
+            f0: [0.0, 0.21, 1.0],
+            f90: [0.0, 1.0, 0.0],
+        }
+        .average_report();
+        assert_eq!(schlick.method, "closed-form");
+        assert_eq!(schlick.evaluations, 0);
+        assert_eq!(schlick.value[0], 0.0);
+        assert!((schlick.value[1] - 5.2 / 21.0).abs() < 1e-15);
+        assert!((schlick.value[2] - 20.0 / 21.0).abs() < 1e-15);
+        let inside = Fresnel::Dielectric { eta: 0.5 }.average_report();
+        assert_eq!(inside.method, "quadrature");
+        assert!(inside.evaluations > 0 && inside.error < 1e-13);
+        // F_avg(1/2) = 1 - (1 - F_avg(2)) / 4 (reciprocity) with F_avg(2) = 0.2227...:
+        // checked against its own quadrature from outside, which has no kink.
+        let outside = Fresnel::Dielectric { eta: 2.0 }.average()[0];
+        assert!((inside.value[0] - (1.0 - (1.0 - outside) / 4.0)).abs() < 1e-13);
+    }
 }
