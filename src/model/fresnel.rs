@@ -446,17 +446,17 @@ mod tests {
     }
 
     /// Conductors at oblique incidence, against the same Fresnel equations evaluated in
-    /// mpmath's complex arithmetic at 30 digits (`r_s = (c - n cos_t) / (c + n cos_t)`,
+    /// mpmath's complex arithmetic at 30 digits (rounded to 16) (`r_s = (c - n cos_t) / (c + n cos_t)`,
     /// `r_p = (n c - cos_t) / (n c + cos_t)`, `cos_t = sqrt(1 - (1 - c^2) / n^2)`, principal
     /// root): gold-like, aluminium-like, and indices either side of 1 with small `k`.
     #[test]
     fn conductors_at_oblique_incidence_match_mpmath() {
         for (eta, k, c, mpmath) in [
-            (0.18, 3.0, 0.5, 0.926_132_736_478_432_334_67),
-            (0.18, 3.0, 0.1, 0.963_043_616_893_336_204_54),
-            (1.2, 7.0, 0.3, 0.868_975_211_294_149_671_59),
-            (2.5, 0.5, 0.7, 0.208_727_737_149_524_532_15),
-            (0.5, 0.3, 0.2, 0.809_009_508_207_126_390_13),
+            (0.18, 3.0, 0.5, 0.926_132_736_478_432_3),
+            (0.18, 3.0, 0.1, 0.963_043_616_893_336_2),
+            (1.2, 7.0, 0.3, 0.868_975_211_294_149_7),
+            (2.5, 0.5, 0.7, 0.208_727_737_149_524_5),
+            (0.5, 0.3, 0.2, 0.809_009_508_207_126_4),
         ] {
             let got = conductor(eta, k, c);
             assert!((got - mpmath).abs() < 1e-14, "{eta} {k} {c}: {got}");
