@@ -143,10 +143,8 @@ impl Table {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::integrate::QmcSettings;
     use crate::model::dielectric::TransmissionConvention;
-    use crate::model::{Fresnel, Masking, Model, Ndf, RoughnessConvention};
-    use crate::table::Method;
+    use crate::model::{Fresnel, RoughnessConvention};
     use crate::table::axis::{Grid, IorBound, IorMapping, MuMapping};
 
     const ROUGHNESS: Axis = Axis::Roughness {
@@ -171,22 +169,7 @@ mod tests {
 
     /// A 4 x 3 E table's spec.
     fn e_spec() -> TableSpec {
-        TableSpec {
-            model: Model {
-                ndf: Ndf::Ggx,
-                masking: Masking::HeightCorrelated,
-            },
-            quantity: Quantity::E,
-            ior: None,
-            roughness: Some(ROUGHNESS),
-            mu: Some(MU),
-            fresnel: None,
-            method: Method::Reference,
-            qmc: QmcSettings::default(),
-            reference_digits: None,
-            lookup_of: None,
-            transmission: TransmissionConvention::SingleScattering,
-        }
+        crate::table::test_e_spec(4, 3, Grid::Nodes, MuMapping::Adaptive)
     }
 
     fn refused(spec: &TableSpec, words: &str) {

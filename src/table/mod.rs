@@ -491,38 +491,48 @@ pub struct NodeErrors {
     pub unconverged: usize,
 }
 
+/// A GGX height-correlated `E` spec of `rows` x `columns` on perceptual roughness, for the
+/// unit tests of the table modules.
+#[cfg(test)]
+pub(crate) fn test_e_spec(
+    rows: usize,
+    columns: usize,
+    grid: Grid,
+    mapping: MuMapping,
+) -> TableSpec {
+    TableSpec {
+        model: Model {
+            ndf: crate::model::Ndf::Ggx,
+            masking: crate::model::Masking::HeightCorrelated,
+        },
+        quantity: Quantity::E,
+        ior: None,
+        roughness: Some(Axis::Roughness {
+            size: rows,
+            convention: RoughnessConvention::Perceptual,
+            grid,
+        }),
+        mu: Some(Axis::Mu {
+            size: columns,
+            mapping,
+            grid,
+        }),
+        fresnel: None,
+        method: Method::Qmc,
+        qmc: QmcSettings::default(),
+        reference_digits: None,
+        lookup_of: None,
+        transmission: TransmissionConvention::SingleScattering,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::integrate::QmcSettings;
-    use crate::model::{Masking, Ndf};
     use axis::{Grid, MuMapping};
 
     fn synthetic(grid: Grid, mapping: MuMapping) -> Table {
-        let spec = TableSpec {
-            reference_digits: None,
-            lookup_of: None,
-            transmission: TransmissionConvention::SingleScattering,
-            model: Model {
-                ndf: Ndf::Ggx,
-                masking: Masking::HeightCorrelated,
-            },
-            quantity: Quantity::E,
-            method: Method::Qmc,
-            ior: None,
-            fresnel: None,
-            roughness: Some(Axis::Roughness {
-                size: 5,
-                convention: RoughnessConvention::Perceptual,
-                grid,
-            }),
-            mu: Some(Axis::Mu {
-                size: 4,
-                mapping,
-                grid,
-            }),
-            qmc: QmcSettings::default(),
-        };
+        let spec = test_e_spec(5, 4, grid, mapping);
         // value = 10 * row + column, so that interpolation is easy to predict.
         let value: Vec<f64> = (0..20).map(|k| (10 * (k / 4) + k % 4) as f64).collect();
         Table {

@@ -172,39 +172,12 @@ pub fn normalisation_lookup(norm: &Table, roughness: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::integrate::QmcSettings;
-    use crate::model::dielectric::TransmissionConvention;
-    use crate::model::{Masking, Model, Ndf, RoughnessConvention};
-    use crate::table::Method;
     use crate::table::axis::MuMapping;
 
     /// A 5 x 4 E table over `r` and `mu` whose one-minus channel is `loss(r, t)` at each texel,
     /// `t` the column's texture coordinate.
     fn e_table(grid: Grid, mapping: MuMapping, loss: impl Fn(f64, f64) -> f64) -> Table {
-        let spec = TableSpec {
-            model: Model {
-                ndf: Ndf::Ggx,
-                masking: Masking::HeightCorrelated,
-            },
-            quantity: Quantity::E,
-            ior: None,
-            roughness: Some(Axis::Roughness {
-                size: 5,
-                convention: RoughnessConvention::Perceptual,
-                grid,
-            }),
-            mu: Some(Axis::Mu {
-                size: 4,
-                mapping,
-                grid,
-            }),
-            fresnel: None,
-            method: Method::Reference,
-            qmc: QmcSettings::default(),
-            reference_digits: None,
-            lookup_of: None,
-            transmission: TransmissionConvention::SingleScattering,
-        };
+        let spec = crate::table::test_e_spec(5, 4, grid, mapping);
         let one_minus_value: Vec<f64> = (0..20)
             .map(|k| loss(grid.coordinate(k / 4, 5), grid.coordinate(k % 4, 4)))
             .collect();
