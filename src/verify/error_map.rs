@@ -110,3 +110,122 @@ pub fn error_maps(spec: &TableSpec, report: &Report) -> Vec<ErrorMap> {
         ),
     ]
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::table::axis::{Grid, MuMapping};
+    use crate::table::test_e_spec;
+    use crate::verify::tests::{e_avg_spec, table};
+    use crate::verify::{Against, AuditSettings, audit};
+
+    /// The audit of a 3 x 4 table against one that differs by `1e-3 (k + 1)` at texel `k`.
+    fn report(spec: &TableSpec) -> Report {
+        let n = spec.len();
+        let ours = table(
+            spec.clone(),
+            (0..n).map(|k| 0.5 + 0.01 * k as f64).collect(),
+        );
+        let theirs = table(
+            spec.clone(),
+            (0..n)
+                .map(|k| 0.5 + 0.01 * k as f64 - 1e-3 * (k + 1) as f64)
+                .collect(),
+        );
+        audit(
+            &ours,
+            &Against::Table(&theirs),
+            &AuditSettings::default(),
+            &|_| {},
+        )
+    }
+
+    #[test]
+    fn points_sit_at_their_texture_coordinates() {
+        let spec = test_e_spec(3, 4, Grid::Nodes, MuMapping::Sqrt);
+        let at = |mu: Option<f64>, roughness: f64| Point {
+            mu,
+            eta: None,
+            roughness,
+            alpha: roughness * roughness,
+            table: 0.0,
+            reference: 0.0,
+            error: 0.0,
+        };
+        // A square-root axis puts mu = 1/4 at t = 1/2.
+        assert_eq!(map_position(&spec, &at(Some(0.25), 0.3)), (0.5, 0.3));
+        assert_eq!(map_position(&spec, &at(Some(1.0), 1.5)), (1.0, 1.0));
+        assert_eq!(map_position(&spec, &at(Some(0.0), -0.5)), (0.0, 0.0));
+        // No mu: the roughness across.
+        assert_eq!(map_position(&spec, &at(None, 0.3)), (0.3, 0.0));
+        assert_eq!(
+            map_position(&e_avg_spec(5), &at(Some(0.25), 0.7)),
+            (0.7, 0.0)
+        );
+    }
+
+    #[test]
+    fn each_node_has_its_cell_and_each_lookup_cell_its_worst() {
+        let spec = test_e_spec(3, 4, Grid::Nodes, MuMapping::Linear);
+        let mut report = report(&spec);
+        let maps = error_maps(&spec, &report);
+        let nodes = &maps[0];
+        assert_eq!((nodes.group, nodes.columns, nodes.rows), ("nodes", 4, 3));
+        for (k, cell) in nodes.cells.iter().enumerate() {
+            let e = cell.expect("every node has a cell");
+            assert!((e - 1e-3 * (k + 1) as f64).abs() < 1e-12, "{k}: {e}");
+        }
+        assert_eq!((nodes.worst.0, nodes.worst.1), (1.0, 1.0));
+        assert!((nodes.worst.2 - 12e-3).abs() < 1e-12);
+        assert_eq!(nodes.eta, None);
+        assert_eq!(nodes.x_axis, "mu's texture coordinate (linear)");
+        assert_eq!(nodes.y_axis, "roughness r");
+        let lookups = &maps[1];
+        assert_eq!(
+            (lookups.group, lookups.columns, lookups.rows),
+            ("lookups", 9, 7)
+        );
+        // The ladder puts one point in each cell; each cell is the largest error there.
+        let cells: Vec<f64> = lookups.cells.iter().map(|c| c.expect("filled")).collect();
+        let max = cells.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        assert!((max - report.lookup_max_error).abs() < 1e-15);
+        assert_eq!(cells.last(), Some(&max));
+        // The lowest row is roughness 0, where the differences run `1e-3 + 3e-3 mu`. Each cell
+        // holds its largest: the first has the grazing probes up to mu = 0.1, the middle one
+        // the ladder's mu = 1/2 alone, the last mu = 1.
+        assert!((cells[0] - 1.3e-3).abs() < 1e-12, "{}", cells[0]);
+        assert!((cells[8] - 4e-3).abs() < 1e-12, "{}", cells[8]);
+        assert!((cells[4] - 2.5e-3).abs() < 1e-12, "{}", cells[4]);
+        // A NaN error marks its cell, whatever else is there.
+        report.node_points[5].error = f64::NAN;
+        report.lookup_points_compared[0].error = f64::NAN;
+        let maps = error_maps(&spec, &report);
+        assert!(maps[0].cells[5].unwrap().is_nan());
+        assert!(maps[0].cells[4].unwrap() > 0.0);
+        assert!(maps[1].cells[0].unwrap().is_nan());
+        assert!(!maps[1].cells[1].unwrap().is_nan());
+    }
+
+    #[test]
+    fn a_table_without_mu_is_one_row_along_the_roughness() {
+        let spec = e_avg_spec(5);
+        let maps = error_maps(&spec, &report(&spec));
+        assert_eq!((maps[0].columns, maps[0].rows), (5, 1));
+        assert_eq!((maps[1].columns, maps[1].rows), (11, 1));
+        for (k, cell) in maps[0].cells.iter().enumerate() {
+            assert!((cell.unwrap() - 1e-3 * (k + 1) as f64).abs() < 1e-12);
+        }
+        assert_eq!(maps[0].x_axis, "roughness r");
+        assert_eq!(maps[0].y_axis, "error");
+        assert_eq!((maps[0].worst.0, maps[0].worst.1), (1.0, 0.0));
+    }
+
+    #[test]
+    fn large_tables_share_cells() {
+        let spec = test_e_spec(100, 3, Grid::Centers, MuMapping::Linear);
+        let maps = error_maps(&spec, &report(&spec));
+        assert_eq!((maps[0].columns, maps[0].rows), (3, MAX_MAP_CELLS));
+        assert_eq!((maps[1].columns, maps[1].rows), (7, MAX_MAP_CELLS));
+        assert!(maps[0].cells.iter().all(Option::is_some));
+    }
+}

@@ -510,3 +510,216 @@ pub fn furnace_maps(
     }
     Ok(maps)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::table::TableSpec;
+    use crate::table::axis::{Grid, MuMapping};
+    use crate::table::normalisation::derive;
+    use crate::table::test_e_spec;
+    use crate::verify::tests::{e_avg_spec, table};
+
+    /// A 5 x 4 E table (rows on nodes) whose loss `1 - E` is `loss(r)` on every column, and the
+    /// E_avg table of the same model whose `1 - E_avg` is `avg(r)`.
+    fn tables(loss: impl Fn(f64) -> f64, avg: impl Fn(f64) -> f64) -> (Table, Table) {
+        let spec = test_e_spec(5, 4, Grid::Nodes, MuMapping::Linear);
+        let e = table(
+            spec,
+            (0..20).map(|k| 1.0 - loss((k / 4) as f64 / 4.0)).collect(),
+        );
+        let e_avg = table(
+            e_avg_spec(5),
+            (0..5).map(|k| 1.0 - avg(k as f64 / 4.0)).collect(),
+        );
+        (e, e_avg)
+    }
+
+    #[test]
+    fn the_lobe_adds_the_mismatch_of_its_normalisation() {
+        let close = |a: f64, b: f64| (a - b).abs() < 1e-12;
+        // The E lookup loses 0.1 r at every mu, so its average loss is 0.1 r; an E_avg table that
+        // says half that doubles the lobe, which then adds 0.1 r too much at every mu.
+        let (e, e_avg) = tables(|r| 0.1 * r, |r| 0.05 * r);
+        let report = furnace(&e, &e_avg, 2).unwrap();
+        assert_eq!(report.normalisation, "E_avg");
+        assert_eq!(report.rows.len(), roughness_ladder(5, 2).len());
+        for row in &report.rows {
+            let r = row.roughness;
+            assert!(close(row.alpha, r * r));
+            assert!(close(row.one_minus_e_avg_of_e, 0.1 * r), "{row:?}");
+            assert!(close(row.one_minus_e_avg, 0.05 * r), "{row:?}");
+            if r == 0.0 {
+                assert_eq!((row.relative_mismatch, row.deviation), (0.0, 0.0));
+            } else {
+                assert!(close(row.relative_mismatch, 1.0), "{row:?}");
+                assert!(close(row.deviation, 0.1 * r), "{row:?}");
+            }
+        }
+        assert!(close(report.max_deviation, 0.1));
+        assert_eq!(report.worst.roughness, 1.0);
+        // Six bands, each with its largest roughness: below 1/2 that is the midpoint of the
+        // normalisation's last cell there, 31.5 / 64.
+        assert_eq!(report.bands.len(), 6);
+        let band = report.bands[4];
+        assert_eq!((band.from, band.to), (0.25, 0.5));
+        assert_eq!(band.worst_roughness, 31.5 / 64.0);
+        assert!(close(band.max_deviation, 0.1 * 31.5 / 64.0));
+        let last = report.bands[5];
+        assert_eq!((last.from, last.to, last.worst_roughness), (0.5, 1.0, 1.0));
+        assert!(close(last.max_deviation, 0.1));
+        assert!(report.bands[0].max_deviation < 1e-3);
+        assert_eq!(FormReport::of_kulla_conty(&report).worst_roughness, 1.0);
+        assert!(close(FormReport::of_kulla_conty(&report).deviation, 0.1));
+
+        // The exact average closes the furnace.
+        let (e, e_avg) = tables(|r| 0.1 * r, |r| 0.1 * r);
+        assert!(furnace(&e, &e_avg, 2).unwrap().max_deviation < 1e-12);
+    }
+
+    /// Where the normalisation says nothing is lost (`1 - E_avg = 0`) the lobe is 0: the
+    /// single-scattering loss stays lost, whatever the ratio would be.
+    #[test]
+    fn a_mirror_normalisation_gives_no_lobe() {
+        let (e, e_avg) = tables(|_| 0.1, |r| 0.1 * r);
+        let report = furnace(&e, &e_avg, 2).unwrap();
+        let mirror = report.rows[0];
+        assert_eq!(mirror.roughness, 0.0);
+        assert!((mirror.deviation + 0.1).abs() < 1e-12, "{mirror:?}");
+        assert!((mirror.relative_mismatch + 1.0).abs() < 1e-12);
+        // The next rung, r = 1/4000: the lobe is 4000 times too strong.
+        assert_eq!(report.worst.roughness, 0.1 / 400.0);
+        assert!((report.max_deviation / 399.9 - 1.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn the_lobes_deviation_is_the_loss_times_the_mismatch() {
+        assert_eq!(lobe_deviation(0.0, 5.0), 0.0);
+        assert_eq!(lobe_deviation(0.0, f64::INFINITY), 0.0);
+        assert!((lobe_deviation(0.1, 1.5) - 0.05).abs() < 1e-15);
+        assert!((lobe_deviation(0.2, 0.5) + 0.1).abs() < 1e-15);
+    }
+
+    #[test]
+    fn the_ladder_holds_the_texels_the_grazing_decade_and_the_midpoints() {
+        let ladder = roughness_ladder(5, 2);
+        assert!(ladder.windows(2).all(|w| w[0] < w[1]));
+        assert_eq!((ladder[0], *ladder.last().unwrap()), (0.0, 1.0));
+        let has = |ladder: &[f64], x: f64| ladder.iter().any(|&y| (y - x).abs() < 1e-15);
+        // Four steps a texel (density 2 is raised to 4) over 4 texels.
+        assert!((0..=16).all(|j| has(&ladder, j as f64 / 16.0)));
+        assert!((1..400).all(|j| has(&ladder, 0.1 * j as f64 / 400.0)));
+        assert!((0..64).all(|j| has(&ladder, (j as f64 + 0.5) / 64.0)));
+        // 17 + 399 + 64, less 1/16, which the grazing decade holds too.
+        assert_eq!(ladder.len(), 479);
+        assert!(!has(&ladder, 17.0 / 32.0));
+        assert!(has(&roughness_ladder(5, 8), 17.0 / 32.0));
+        // One row is taken as two.
+        assert!(has(&roughness_ladder(1, 4), 0.25));
+    }
+
+    #[test]
+    fn the_furnace_needs_an_e_table_and_its_normalisation() {
+        let (e, e_avg) = tables(|r| 0.1 * r, |r| 0.1 * r);
+        let message = |r: Result<FurnaceReport>| r.unwrap_err().to_string();
+        assert!(message(furnace(&e_avg, &e, 2)).contains("needs an E table and its E_avg"));
+        assert!(message(furnace(&e, &e, 2)).contains("(got E and E)"));
+        let beckmann = Table {
+            spec: TableSpec {
+                model: crate::model::Model {
+                    ndf: crate::model::Ndf::Beckmann,
+                    ..e_avg.spec.model
+                },
+                ..e_avg.spec.clone()
+            },
+            ..e_avg.clone()
+        };
+        assert!(message(furnace(&e, &beckmann, 2)).contains("the E table is for"));
+    }
+
+    #[test]
+    fn a_normalisation_table_is_audited_against_its_e_tables_lookup() {
+        let (e, _) = tables(|r| 0.1 * r, |r| r);
+        let mut norm = derive(&e, String::new());
+        let audit = audit_normalisation(&e, &norm).unwrap();
+        let n = norm.spec.len();
+        assert_eq!((audit.nodes, audit.lookup_points), (n - 1, n - 1));
+        assert_eq!(audit.quantity, "f_ms_norm");
+        assert!(audit.node_max_relative_error < 1e-12, "{audit:?}");
+        assert!(audit.lookup_max_relative_error < 1e-12, "{audit:?}");
+        // One node 1% high: 1% there, and halfway to its lower neighbour 1% of its share.
+        assert_eq!(n, 65);
+        norm.value[33] *= 1.01;
+        let audit = audit_normalisation(&e, &norm).unwrap();
+        assert!(
+            (audit.node_max_relative_error - 0.01).abs() < 1e-12,
+            "{audit:?}"
+        );
+        let share = 33.0 / 65.0;
+        assert!((audit.lookup_max_relative_error - 0.01 * share).abs() < 1e-12);
+        assert_eq!(audit.worst_roughness, 32.5 / 64.0);
+        // Another E table's normalisation is refused.
+        let other = table(
+            test_e_spec(5, 8, Grid::Nodes, MuMapping::Linear),
+            vec![0.5; 40],
+        );
+        assert!(
+            audit_normalisation(&other, &norm)
+                .unwrap_err()
+                .to_string()
+                .contains("was not derived from the E table")
+        );
+    }
+
+    #[test]
+    fn forms_are_named_as_serde_names_them() {
+        for form in [Form::KullaConty, Form::Turquin] {
+            assert_eq!(
+                serde_json::to_string(&form).unwrap(),
+                format!("\"{}\"", form.name())
+            );
+        }
+    }
+
+    #[test]
+    fn turquins_form_needs_e_and_leaves_a_zero_lookup_alone() {
+        let (e, e_avg) = tables(|_| 1.0, |r| r);
+        let message = turquin(&e_avg, &crate::verify::AuditSettings::default(), &|| {})
+            .unwrap_err()
+            .to_string();
+        assert!(message.contains("needs an E or E_dielectric table (got E_avg)"));
+        // E = 0 everywhere: nothing to divide by, no deviation (not infinity).
+        let settings = crate::verify::AuditSettings {
+            density: 1,
+            ..crate::verify::AuditSettings::default()
+        };
+        let report = turquin(&e, &settings, &|| {}).unwrap();
+        assert_eq!(report.max_deviation, 0.0);
+        assert_eq!(report.form, Form::Turquin);
+        assert!(report.eta_bands.is_empty());
+    }
+
+    #[test]
+    fn furnace_maps_lay_the_deviation_over_roughness_and_mu() {
+        let (e, e_avg) = tables(|r| 0.1 * r, |r| 0.05 * r);
+        let maps = furnace_maps(&e, Some(&e_avg), &[Form::KullaConty], 3, 4).unwrap();
+        assert_eq!(maps.len(), 1);
+        assert_eq!((maps[0].rows, maps[0].columns), (3, 4));
+        for (j, row) in maps[0].deviation.iter().enumerate() {
+            assert_eq!(row.len(), 4);
+            for &d in row {
+                assert!((d - 0.05 * j as f64).abs() < 1e-12, "{j}: {d}");
+            }
+        }
+        let message = |r: Result<Vec<FurnaceMap>>| r.unwrap_err().to_string();
+        assert!(
+            message(furnace_maps(&e, None, &[Form::KullaConty], 3, 4))
+                .contains("needs the lobe's normalisation")
+        );
+        assert!(message(furnace_maps(&e_avg, None, &[Form::Turquin], 3, 4)).contains("E table"));
+        // E = 0: Turquin's map is 0 (no division by zero).
+        let (zero, _) = tables(|_| 1.0, |r| r);
+        let maps = furnace_maps(&zero, None, &[Form::Turquin], 2, 2).unwrap();
+        assert_eq!(maps[0].deviation, vec![vec![0.0; 2]; 2]);
+    }
+}

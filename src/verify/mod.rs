@@ -641,3 +641,371 @@ pub fn summarise_node_errors(measured: &[(f64, bool)]) -> NodeErrors {
 
 /// The node errors `kiln bake` measures and records (a table's own record).
 pub use crate::table::NodeErrors;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Quantity;
+    use crate::table::axis::{Grid, MuMapping};
+    use crate::table::test_e_spec;
+
+    /// A compared point with only its error (and `mu`, to tell points apart) set.
+    fn point(mu: f64, error: f64) -> Point {
+        Point {
+            mu: Some(mu),
+            eta: None,
+            roughness: 0.5,
+            alpha: 0.25,
+            table: 0.0,
+            reference: 0.0,
+            error,
+        }
+    }
+
+    fn measured(errors: &[f64]) -> Measured {
+        Measured {
+            points: errors
+                .iter()
+                .enumerate()
+                .map(|(k, &e)| (point(k as f64, e), 0.0, true))
+                .collect(),
+            tolerance: 0.0,
+        }
+    }
+
+    pub(super) fn table(spec: TableSpec, value: Vec<f64>) -> Table {
+        Table {
+            spec,
+            one_minus_value: value.iter().map(|v| 1.0 - v).collect(),
+            std_error: vec![0.0; value.len()],
+            value,
+            command: String::new(),
+            node_errors: None,
+            requested_max_error: None,
+        }
+    }
+
+    #[test]
+    fn a_groups_figures_are_worked_by_hand() {
+        let m = measured(&[3.0, 0.0, 4.0, 0.0]);
+        assert_eq!(m.max(), 4.0);
+        assert_eq!(m.rms(), 2.5);
+        assert_eq!(m.worst().mu, Some(2.0));
+        // Sorted [0, 0, 3, 4]: the 99th percentile of four is the fourth.
+        assert_eq!(m.p99(), 4.0);
+        assert_eq!(m.smallest_figure(false), 2.5);
+        assert_eq!(m.smallest_figure(true), 2.5);
+        // 1, 2, ..., 200: the 99th percentile is the 198th.
+        let ramp: Vec<f64> = (1..=200).map(f64::from).collect();
+        assert_eq!(measured(&ramp).p99(), 198.0);
+        // 99 zeros and 100: max 100, rms 10, p99 0.
+        let mut spike = vec![0.0; 99];
+        spike.push(100.0);
+        let m = measured(&spike);
+        assert_eq!((m.max(), m.rms(), m.p99()), (100.0, 10.0, 0.0));
+        assert_eq!(m.smallest_figure(false), 10.0);
+        assert_eq!(m.smallest_figure(true), 0.0);
+        assert!(measured(&[1.0, f64::NAN]).max().is_nan());
+    }
+
+    #[test]
+    fn the_reference_tolerance_is_a_hundredth_of_the_figure_within_its_bounds() {
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-15 * b;
+        assert!(close(tolerance_for(1e-6, 1e-11), 1e-8));
+        assert!(close(tolerance_for(3e-7, 1e-11), 3e-9));
+        // Coarser than the scout's: the scout's.
+        assert_eq!(tolerance_for(1e-3, 1e-11), SCOUT_TOLERANCE);
+        // Finer than the finest allowed, or 0: the finest.
+        assert_eq!(tolerance_for(1e-9, 1e-10), 1e-10);
+        assert_eq!(tolerance_for(0.0, 1e-11), 1e-11);
+        // A finest coarser than the scout's wins.
+        assert_eq!(tolerance_for(1e-3, 1e-5), 1e-5);
+        assert_eq!(tolerance_for(1e-12, 1e-5), 1e-5);
+    }
+
+    #[test]
+    fn spread_indices_take_both_ends_and_even_steps() {
+        assert_eq!(spread_indices(10, 5), vec![0, 2, 5, 7, 9]);
+        assert_eq!(spread_indices(17, 5), vec![0, 4, 8, 12, 16]);
+        assert_eq!(spread_indices(100, 2), vec![0, 99]);
+        assert_eq!(spread_indices(5, 5), vec![0, 1, 2, 3, 4]);
+        assert_eq!(spread_indices(3, 5), vec![0, 1, 2]);
+        // Every texel of an E table; five of seventeen E_avg entries.
+        let e = test_e_spec(3, 4, Grid::Nodes, MuMapping::Linear);
+        assert_eq!(node_error_indices(&e), (0..12).collect::<Vec<_>>());
+        let e_avg = e_avg_spec(17);
+        assert_eq!(node_error_indices(&e_avg), vec![0, 4, 8, 12, 16]);
+    }
+
+    pub(super) fn e_avg_spec(rows: usize) -> TableSpec {
+        TableSpec {
+            quantity: Quantity::EAvg,
+            mu: None,
+            ..test_e_spec(rows, 2, Grid::Nodes, MuMapping::Linear)
+        }
+    }
+
+    #[test]
+    fn grazing_probes_reach_zero_and_climb_in_quarter_decades() {
+        let probes = grazing_probes();
+        assert_eq!(probes.len(), 27);
+        assert_eq!(&probes[..3], &[0.0, 1e-12, 1e-6]);
+        for (k, decade) in [
+            (6, 1e-5),
+            (10, 1e-4),
+            (14, 1e-3),
+            (18, 1e-2),
+            (22, 0.1),
+            (26, 1.0),
+        ] {
+            assert!(
+                (probes[k] / decade - 1.0).abs() < 1e-14,
+                "{k}: {}",
+                probes[k]
+            );
+        }
+        assert!((probes[3] / 10f64.powf(-5.75) - 1.0).abs() < 1e-14);
+        assert!(probes.windows(2).all(|w| w[0] < w[1]));
+    }
+
+    #[test]
+    fn lookup_coordinates_are_the_ladders_and_the_probes() {
+        let spec = test_e_spec(3, 4, Grid::Nodes, MuMapping::Linear);
+        let settings = AuditSettings::default();
+        let points = lookup_coordinates(&spec, &settings);
+        // Roughness: 2 x 3 steps, 7 rungs; each 2 x 4 steps of mu (9 points) and 27 probes.
+        assert_eq!(points.len(), 7 * (9 + 27));
+        assert_eq!(audit_points(&spec, &settings), 12 + 7 * 36);
+        // The rung t = 1/2 of a perceptual axis is alpha = 1/4; its mu ladder is linear in t.
+        let rung = &points[3 * 36..4 * 36];
+        assert!(rung.iter().all(|p| p.alpha == 0.25 && p.eta.is_none()));
+        let mus: Vec<f64> = rung.iter().map(|p| p.mu.unwrap()).collect();
+        assert_eq!(
+            mus[..9],
+            [0.0, 0.125, 0.25, 0.375, 0.5, 0.625, 0.75, 0.875, 1.0]
+        );
+        assert_eq!(mus[9..], grazing_probes()[..]);
+        assert_eq!(points[0].alpha, 0.0);
+        assert_eq!(points.last().unwrap().alpha, 1.0);
+        // Density 3 and density 0 (taken as 1).
+        let dense = AuditSettings {
+            density: 3,
+            ..settings
+        };
+        assert_eq!(lookup_coordinates(&spec, &dense).len(), 10 * (13 + 27));
+        let sparse = AuditSettings {
+            density: 0,
+            ..settings
+        };
+        assert_eq!(lookup_coordinates(&spec, &sparse).len(), 4 * (5 + 27));
+        // A table without mu: the roughness ladder alone, with no mu.
+        let points = lookup_coordinates(&e_avg_spec(5), &settings);
+        assert_eq!(points.len(), 11);
+        assert!(points.iter().all(|p| p.mu.is_none()));
+        assert_eq!(points[5].alpha, 0.25);
+    }
+
+    #[test]
+    fn node_errors_are_summarised_with_nan_and_unconverged_kept() {
+        let s = summarise_node_errors(&[(3.0, true), (4.0, false), (0.0, true)]);
+        assert_eq!(s.max, 4.0);
+        assert!((s.rms - (25.0f64 / 3.0).sqrt()).abs() < 1e-15);
+        assert_eq!((s.texels, s.unconverged), (3, 1));
+        assert!(
+            summarise_node_errors(&[(1.0, true), (f64::NAN, true)])
+                .max
+                .is_nan()
+        );
+    }
+
+    /// The stored values against the reference worked separately: `1 - E` for E, the value
+    /// for a split-sum channel, and an unconverged reference's estimate added on.
+    #[test]
+    fn node_error_terms_compare_the_channel_that_carries_the_quantity() {
+        let settings = ReferenceSettings {
+            tolerance: 1e-10,
+            ..ReferenceSettings::default()
+        };
+        let truth = |spec: &TableSpec, k: usize, settings: &ReferenceSettings| {
+            let (alpha, mu) = spec.texel_coordinates(k);
+            spec.integral().reference(
+                Coordinates {
+                    alpha,
+                    mu,
+                    eta: None,
+                },
+                settings,
+            )
+        };
+        let e = test_e_spec(2, 3, Grid::Centers, MuMapping::Linear);
+        let indices = [0, 4, 5];
+        // E: an error in `1 - E` counts, one in E alone does not.
+        let terms = node_error_terms(
+            &e,
+            &indices,
+            &|k| {
+                let r = truth(&e, k, &settings);
+                (r.value + 0.5, r.one_minus_value + 1e-3 * k as f64)
+            },
+            &settings,
+        );
+        for (term, k) in terms.iter().zip(indices) {
+            assert!(term.1);
+            assert!((term.0 - 1e-3 * k as f64).abs() < 1e-12, "{k}: {term:?}");
+        }
+        // A split-sum channel: the value counts.
+        let scale = TableSpec {
+            quantity: Quantity::EScale,
+            ..e.clone()
+        };
+        let terms = node_error_terms(
+            &scale,
+            &indices,
+            &|k| {
+                let r = truth(&scale, k, &settings);
+                (r.value - 1e-3 * k as f64, r.one_minus_value + 0.5)
+            },
+            &settings,
+        );
+        for (term, k) in terms.iter().zip(indices) {
+            assert!((term.0 - 1e-3 * k as f64).abs() < 1e-12, "{k}: {term:?}");
+        }
+        // A reference out of budget: the difference plus its own estimate, flagged.
+        let starved = ReferenceSettings {
+            tolerance: 1e-15,
+            max_intervals: 1,
+        };
+        let terms = node_error_terms(
+            &e,
+            &[0],
+            &|k| (0.0, truth(&e, k, &starved).one_minus_value + 1e-3),
+            &starved,
+        );
+        let r = truth(&e, 0, &starved);
+        assert!(!r.converged && r.error > 0.0);
+        assert!(!terms[0].1);
+        assert!(
+            (terms[0].0 - (1e-3 + r.error)).abs() < 1e-15,
+            "{terms:?} {r:?}"
+        );
+        assert_eq!(
+            summarise_node_errors(&terms).unconverged,
+            1,
+            "counted as unconverged"
+        );
+    }
+
+    /// Two tables of the same layout a known amount apart: every figure of the audit follows.
+    #[test]
+    fn an_audit_against_a_table_reports_the_differences_node_by_node() {
+        let spec = test_e_spec(3, 4, Grid::Nodes, MuMapping::Linear);
+        let base: Vec<f64> = (0..12).map(|k| 0.5 + 0.01 * k as f64).collect();
+        let ours = table(spec.clone(), base.clone());
+        // Theirs: ours less 1e-3 (k + 1) at texel k.
+        let theirs = table(
+            spec.clone(),
+            base.iter()
+                .enumerate()
+                .map(|(k, v)| v - 1e-3 * (k + 1) as f64)
+                .collect(),
+        );
+        let storage = Storage {
+            name: "plus",
+            round: |x| x + 2e-3,
+        };
+        let settings = AuditSettings {
+            storage: Some(storage),
+            ..AuditSettings::default()
+        };
+        let planned = std::sync::Mutex::new(Vec::new());
+        let compared = std::sync::atomic::AtomicU64::new(0);
+        let report = audit(&ours, &Against::Table(&theirs), &settings, &|p| match p {
+            Progress::Planned(n) => planned.lock().unwrap().push(n),
+            Progress::Compared => {
+                compared.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            }
+        });
+        // Against a table: one pass per group, no scouting.
+        assert_eq!(*planned.lock().unwrap(), vec![12, 7 * 36]);
+        assert_eq!(compared.into_inner(), 12 + 7 * 36);
+        assert_eq!(report.nodes, 12);
+        assert!((report.node_max_error - 12e-3).abs() < 1e-12);
+        let rms = 1e-3 * ((1..=12).map(|k| k * k).sum::<i32>() as f64 / 12.0).sqrt();
+        assert!((report.node_rms_error - rms).abs() < 1e-12);
+        // The worst node is the last: roughness 1, mu 1.
+        assert_eq!(report.worst_node.mu, Some(1.0));
+        assert_eq!(
+            (report.worst_node.roughness, report.worst_node.alpha),
+            (1.0, 1.0)
+        );
+        assert!((report.worst_node.table - 0.61).abs() < 1e-12);
+        assert!((report.worst_node.reference - 0.598).abs() < 1e-12);
+        // Lookups interpolate the differences; the largest is at the corner.
+        assert_eq!(report.lookup_points, 7 * 36);
+        assert!((report.lookup_max_error - 12e-3).abs() < 1e-12);
+        assert!(report.lookup_rms_error < report.lookup_max_error);
+        assert!(report.lookup_rms_error > 1e-3);
+        assert!(report.lookup_p99_error <= report.lookup_max_error);
+        assert_eq!(
+            (
+                report.node_reference_tolerance,
+                report.lookup_reference_tolerance
+            ),
+            (0.0, 0.0)
+        );
+        assert_eq!(report.reference_error_estimate, 0.0);
+        assert!(report.reference_converged);
+        assert_eq!(report.against, format!("table {}", theirs.spec.id()));
+        assert_eq!(report.shape, vec![3, 4]);
+        assert_eq!(report.mu_axis.as_deref(), Some("linear"));
+        assert_eq!(report.roughness_axis, "r");
+        assert_eq!(report.grid, "nodes");
+        assert_eq!(report.node_points.len(), 12);
+        assert_eq!(report.lookup_points_compared.len(), 7 * 36);
+        for (k, p) in report.node_points.iter().enumerate() {
+            assert!((p.error - 1e-3 * (k + 1) as f64).abs() < 1e-12);
+        }
+        // The storage adds 2e-3 to the truth (their values) everywhere.
+        let cost = report.storage_cost.expect("a storage was named");
+        assert_eq!(cost.storage, "plus");
+        for figure in [
+            cost.node_max_error,
+            cost.node_rms_error,
+            cost.lookup_max_error,
+            cost.lookup_rms_error,
+        ] {
+            assert!((figure - 2e-3).abs() < 1e-12, "{cost:?}");
+        }
+    }
+
+    /// Against a table of another layout, nodes are compared through its lookup.
+    #[test]
+    fn an_audit_against_another_layout_looks_the_other_table_up() {
+        let ours_spec = test_e_spec(3, 4, Grid::Nodes, MuMapping::Linear);
+        let theirs_spec = test_e_spec(2, 2, Grid::Nodes, MuMapping::Linear);
+        // Theirs is bilinear in (mu, r): E = 0.2 + 0.3 mu + 0.4 r, reproduced exactly by any
+        // lookup; ours holds the same plane less 1e-3 everywhere.
+        let plane = |spec: &TableSpec, k: usize| {
+            let (alpha, mu) = spec.texel_coordinates(k);
+            0.2 + 0.3 * mu.unwrap() + 0.4 * alpha.sqrt()
+        };
+        let theirs = table(
+            theirs_spec.clone(),
+            (0..4).map(|k| plane(&theirs_spec, k)).collect(),
+        );
+        let ours = table(
+            ours_spec.clone(),
+            (0..12).map(|k| plane(&ours_spec, k) - 1e-3).collect(),
+        );
+        let report = audit(
+            &ours,
+            &Against::Table(&theirs),
+            &AuditSettings::default(),
+            &|_| {},
+        );
+        for p in &report.node_points {
+            assert!((p.error - 1e-3).abs() < 1e-12, "{p:?}");
+        }
+        assert!((report.lookup_max_error - 1e-3).abs() < 1e-12);
+    }
+}
