@@ -572,7 +572,508 @@ fn spec_and_values(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::format::Format;
     use crate::model::{Masking, Ndf};
+    use crate::table::test_e_spec;
+    use std::path::PathBuf;
+
+    /// A directory of its own for one test, removed when the test ends.
+    struct Scratch(PathBuf);
+
+    impl Scratch {
+        fn new(name: &str) -> Self {
+            let dir =
+                std::env::temp_dir().join(format!("kiln-input-{name}-{}", std::process::id()));
+            let _ = std::fs::remove_dir_all(&dir);
+            std::fs::create_dir_all(&dir).unwrap();
+            Scratch(dir)
+        }
+
+        fn write(&self, name: &str, bytes: &[u8]) -> PathBuf {
+            let path = self.0.join(name);
+            std::fs::write(&path, bytes).unwrap();
+            path
+        }
+    }
+
+    impl Drop for Scratch {
+        fn drop(&mut self) {
+            let _ = std::fs::remove_dir_all(&self.0);
+        }
+    }
+
+    /// A 3 x 4 E table whose texel k holds `0.9 - 0.01 k` (and a std_error of `1e-6 k`).
+    fn e_table(mapping: MuMapping, columns: usize) -> Table {
+        let spec = test_e_spec(3, columns, Grid::Nodes, mapping);
+        let n = spec.len();
+        let mut table = table_from_channel(
+            spec,
+            (0..n).map(|k| 0.9 - 0.01 * k as f64).collect(),
+            "kiln bake".into(),
+        );
+        table.std_error = (0..n).map(|k| 1e-6 * k as f64).collect();
+        table
+    }
+
+    /// Every kiln file of `table` in `dir`, by extension.
+    fn write_kiln_files(dir: &Scratch, table: &Table) -> Vec<PathBuf> {
+        let formats = [
+            Format::Exr,
+            Format::Bin,
+            Format::Rs,
+            Format::H,
+            Format::Ktx2,
+            Format::Dds,
+            Format::Json,
+        ];
+        crate::format::encode_all(std::slice::from_ref(table), &formats, Precision::F32)
+            .unwrap()
+            .into_iter()
+            .map(|(name, bytes)| dir.write(&name, &bytes))
+            .collect()
+    }
+
+    #[track_caller]
+    fn error(result: Result<Option<Table>>) -> String {
+        result.expect_err("an error").to_string()
+    }
+
+    /// A sidecar's JSON with `edit` applied.
+    fn edited_sidecar(table: &Table, edit: impl Fn(&mut serde_json::Value)) -> Vec<u8> {
+        let sidecar = crate::format::json::sidecar(table, "f32", Default::default());
+        let mut value: serde_json::Value =
+            serde_json::from_slice(&crate::format::json::encode(&sidecar).unwrap()).unwrap();
+        edit(&mut value);
+        serde_json::to_vec_pretty(&value).unwrap()
+    }
+
+    #[test]
+    fn every_kiln_format_reads_back_as_written() {
+        let dir = Scratch::new("formats");
+        let table = e_table(MuMapping::Sqrt, 4);
+        let paths = write_kiln_files(&dir, &table);
+        assert_eq!(paths.len(), 7);
+        for path in &paths {
+            let read = read_kiln(path)
+                .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+                .unwrap_or_else(|| panic!("{}: not read as kiln's", path.display()));
+            assert_eq!(read.spec, table.spec, "{}", path.display());
+            assert_eq!(read.command, table.command, "{}", path.display());
+            // As the f32 the file stores (the sidecar: f64).
+            let extension = path.extension().unwrap().to_str().unwrap();
+            let stored = |v: f64| {
+                if extension == "json" {
+                    v
+                } else {
+                    f64::from(v as f32)
+                }
+            };
+            for k in 0..12 {
+                let stored_value = stored(table.value[k]);
+                assert_eq!(read.value[k], stored_value, "{} value {k}", path.display());
+                let one_minus = stored(table.one_minus_value[k]);
+                assert_eq!(
+                    read.one_minus_value[k],
+                    one_minus,
+                    "{} 1 - E {k}",
+                    path.display()
+                );
+            }
+            // Only the sidecar, the EXR, the binary and the sources carry std_error.
+            if !matches!(extension, "ktx2" | "dds") {
+                let e = stored(1e-6 * 11.0);
+                assert_eq!(read.std_error[11], e, "{}", path.display());
+            }
+        }
+    }
+
+    #[test]
+    fn other_files_are_not_kilns() {
+        let dir = Scratch::new("others");
+        let table = e_table(MuMapping::Linear, 4);
+        for (name, bytes) in [
+            ("numbers.txt", b"0.5 0.25".as_slice()),
+            (
+                "other.json",
+                br#"{"kind": "something-else", "x": 1}"#.as_slice(),
+            ),
+            ("array.json", b"[1, 2, 3]".as_slice()),
+            ("broken.json", b"{ not json".as_slice()),
+            (
+                "plain.h",
+                b"static const float X[2] = { 1.0f, 2.0f };".as_slice(),
+            ),
+            ("binary.rs", [0xff, 0xfe, 0x00].as_slice()),
+        ] {
+            let path = dir.write(name, bytes);
+            assert!(read_kiln(&path).unwrap().is_none(), "{name}");
+        }
+        // A sidecar whose kind is kiln's: read as kiln's even when the name says otherwise.
+        let sidecar = edited_sidecar(&table, |_| {});
+        let path = dir.write("renamed.json", &sidecar);
+        assert!(read_kiln(&path).unwrap().is_some());
+    }
+
+    #[test]
+    fn a_damaged_sidecar_says_what_is_wrong() {
+        let dir = Scratch::new("sidecars");
+        let table = e_table(MuMapping::Linear, 4);
+        let read = |name: &str, bytes: &[u8]| error(read_kiln(&dir.write(name, bytes)));
+        // Valid JSON, kiln's kind, another structure.
+        let message = read("a.json", br#"{"kind": "kiln-table", "metadata": 3}"#);
+        assert!(message.contains("unreadable kiln sidecar"), "{message}");
+        // Cut short (as kiln writes it: its kind first).
+        let sidecar = crate::format::json::sidecar(&table, "f32", Default::default());
+        let whole = crate::format::json::encode(&sidecar).unwrap();
+        let message = read("b.json", &whole[..whole.len() / 2]);
+        assert!(
+            message.contains("a damaged kiln sidecar, not valid JSON"),
+            "{message}"
+        );
+        // The metadata's quantity and the spec's disagree.
+        let message = read(
+            "c.json",
+            &edited_sidecar(&table, |v| v["quantity"] = "E_avg".into()),
+        );
+        assert!(
+            message.contains("its metadata names quantity E_avg but its spec E"),
+            "{message}"
+        );
+        // The quantity's channel is missing.
+        let message = read(
+            "d.json",
+            &edited_sidecar(&table, |v| {
+                v["data"].as_object_mut().unwrap().remove("E");
+            }),
+        );
+        assert!(
+            message.contains("no channel 'E' (it has one_minus_E, std_error)"),
+            "{message}"
+        );
+        // One value short.
+        let message = read(
+            "e.json",
+            &edited_sidecar(&table, |v| {
+                v["data"]["E"].as_array_mut().unwrap().pop();
+            }),
+        );
+        assert!(message.contains("11 values for shape [3, 4]"), "{message}");
+        // A value out of range: the table's own check.
+        let message = read(
+            "f.json",
+            &edited_sidecar(&table, |v| v["data"]["E"][2] = 1.5.into()),
+        );
+        assert!(
+            message.contains("E at texel 2 is 1.5, outside [0, 1]"),
+            "{message}"
+        );
+        // The spec's own check.
+        let message = read(
+            "g.json",
+            &edited_sidecar(&table, |v| v["spec"]["mu"] = serde_json::Value::Null),
+        );
+        assert!(
+            message.contains("its metadata: E needs a mu axis"),
+            "{message}"
+        );
+        // The one-minus channel is optional: without it, it is 1 - E.
+        let path = dir.write(
+            "h.json",
+            &edited_sidecar(&table, |v| {
+                v["data"].as_object_mut().unwrap().remove("one_minus_E");
+                v["data"].as_object_mut().unwrap().remove("std_error");
+            }),
+        );
+        let read = read_kiln(&path).unwrap().unwrap();
+        assert_eq!(read.one_minus_value[3], 1.0 - read.value[3]);
+        assert_eq!(read.std_error, vec![0.0; 12]);
+    }
+
+    #[test]
+    fn a_binary_needs_its_own_sidecar() {
+        let dir = Scratch::new("binary");
+        let table = e_table(MuMapping::Linear, 4);
+        let paths = write_kiln_files(&dir, &table);
+        let bin = paths
+            .iter()
+            .find(|p| p.extension().unwrap() == "bin")
+            .unwrap();
+        let sidecar = bin.with_extension("json");
+        let bytes = std::fs::read(&sidecar).unwrap();
+        // Without it.
+        std::fs::remove_file(&sidecar).unwrap();
+        assert!(error(read_kiln(bin)).contains("a kiln binary holds no model"));
+        // Beside the sidecar of a table of other values.
+        let mut other = e_table(MuMapping::Linear, 4);
+        other.value[5] = 0.5;
+        other.one_minus_value[5] = 0.5;
+        std::fs::write(&sidecar, edited_sidecar(&other, |_| {})).unwrap();
+        assert!(error(read_kiln(bin)).contains("does not hold the values of its sidecar"));
+        // Beside the sidecar of another shape, or other axes.
+        std::fs::write(
+            &sidecar,
+            edited_sidecar(&e_table(MuMapping::Linear, 5), |_| {}),
+        )
+        .unwrap();
+        assert!(error(read_kiln(bin)).contains("shape differs from its sidecar's"));
+        std::fs::write(
+            &sidecar,
+            edited_sidecar(&e_table(MuMapping::Sqrt, 4), |_| {}),
+        )
+        .unwrap();
+        assert!(error(read_kiln(bin)).contains("axis descriptors differ"));
+        // A sidecar whose spec is broken.
+        std::fs::write(
+            &sidecar,
+            edited_sidecar(&table, |v| v["spec"]["mu"] = serde_json::Value::Null),
+        )
+        .unwrap();
+        assert!(error(read_kiln(bin)).contains("its sidecar's spec: E needs a mu axis"));
+        // Its own again.
+        std::fs::write(&sidecar, bytes).unwrap();
+        assert!(read_kiln(bin).unwrap().is_some());
+    }
+
+    #[test]
+    fn a_dds_file_needs_its_own_sidecar() {
+        let dir = Scratch::new("dds");
+        let table = e_table(MuMapping::Linear, 4);
+        let paths = write_kiln_files(&dir, &table);
+        let dds = paths
+            .iter()
+            .find(|p| p.extension().unwrap() == "dds")
+            .unwrap();
+        let sidecar = dds.with_extension("json");
+        let mut other = e_table(MuMapping::Linear, 4);
+        other.value[5] = 0.5;
+        other.one_minus_value[5] = 0.5;
+        std::fs::write(&sidecar, edited_sidecar(&other, |_| {})).unwrap();
+        assert!(error(read_kiln(dds)).contains("does not hold the values of its sidecar"));
+        std::fs::remove_file(&sidecar).unwrap();
+        assert!(error(read_kiln(dds)).contains("a DDS file holds no metadata"));
+    }
+
+    #[test]
+    fn values_agree_with_a_sidecar_to_the_precision_stored() {
+        let path = Path::new("t.bin");
+        let table = e_table(MuMapping::Linear, 4);
+        let sidecar = |edit: &dyn Fn(&mut Vec<f64>)| {
+            let mut s = crate::format::json::sidecar(&table, "f32", Default::default());
+            edit(s.data.get_mut("E").unwrap());
+            s
+        };
+        let agrees = |s: &Sidecar| agrees_with_sidecar(path, s, &table).is_ok();
+        assert!(agrees(&sidecar(&|_| {})));
+        // Within 1e-3 relative (plus 1e-7): the rounding of half floats.
+        assert!(agrees(&sidecar(&|v| v[0] *= 1.0 + 0.9e-3)));
+        assert!(!agrees(&sidecar(&|v| v[0] *= 1.0 + 1.1e-3)));
+        assert!(!agrees(&sidecar(&|v| v[11] *= 1.0 - 1.1e-3)));
+        assert!(agrees(&sidecar(&|v| v[11] += 0.9e-7 + 1e-3 * v[11])));
+        assert!(!agrees(&sidecar(&|v| {
+            v.pop();
+        })));
+        // A sidecar without the values cannot disagree.
+        let mut s = sidecar(&|_| {});
+        s.data.clear();
+        assert!(agrees(&s));
+    }
+
+    #[test]
+    fn arrays_are_read_from_generated_sources() {
+        let c = "static const float T[3] = { 1.0f, 2.5f,\n -3e-2f };\nstatic const float T_ONE_MINUS[1] = { 0.5f };";
+        assert_eq!(
+            source_array(c, "T", true).unwrap().unwrap(),
+            vec![1.0, 2.5, f64::from(-3e-2f32)]
+        );
+        assert_eq!(
+            source_array(c, "T_ONE_MINUS", true).unwrap().unwrap(),
+            vec![0.5]
+        );
+        assert!(source_array(c, "U", true).is_none());
+        let rust = "pub const T: [f32; 3] = [1.0, 2.5, -3e-2];\npub const T_STD_ERROR: [[f32; 1]; 1] = [[0.25]];";
+        assert_eq!(
+            source_array(rust, "T", false).unwrap().unwrap(),
+            vec![1.0, 2.5, f64::from(-3e-2f32)]
+        );
+        assert_eq!(
+            source_array(rust, "T_STD_ERROR", false).unwrap().unwrap(),
+            vec![0.25]
+        );
+        // The shortest f32 literal is read as that f32: 0.1 is 0.1f32 widened.
+        let tenth = source_array("pub const A: [f32; 1] = [0.1];", "A", false);
+        assert_eq!(tenth.unwrap().unwrap(), vec![f64::from(0.1f32)]);
+        let open = source_array("static const float T[2] = { 1.0f, 2.0f", "T", true);
+        assert!(
+            open.unwrap()
+                .unwrap_err()
+                .contains("the array T is not closed")
+        );
+        let bad = source_array("pub const T: [f32; 2] = [1.0, x2];", "T", false);
+        assert!(
+            bad.unwrap()
+                .unwrap_err()
+                .contains("the array T holds 'x2', not a number")
+        );
+    }
+
+    fn layout(quantity: Quantity, shape: Vec<usize>, order: Vec<AxisName>) -> Layout {
+        Layout {
+            model: Model {
+                ndf: Ndf::Ggx,
+                masking: Masking::HeightCorrelated,
+            },
+            quantity,
+            fresnel: None,
+            shape,
+            order,
+            grid: Grid::Nodes,
+            roughness: RoughnessConvention::Perceptual,
+            mu_mapping: MuMapping::Linear,
+        }
+    }
+
+    #[test]
+    fn external_numbers_are_read_as_text_or_raw_floats() {
+        let dir = Scratch::new("external");
+        let e = layout(Quantity::E, vec![2, 3], vec![AxisName::R, AxisName::Mu]);
+        let text = dir.write(
+            "e.txt",
+            b"# a comment\n0.5, 0.25 0.125 # more\n\n1,0.75,\t0.625\n",
+        );
+        let table = read_external(&text, &Encoding::Text, &e).unwrap();
+        assert_eq!(table.value, vec![0.5, 0.25, 0.125, 1.0, 0.75, 0.625]);
+        assert_eq!(table.one_minus_value[1], 0.75);
+        assert_eq!(table.spec.shape(), vec![2, 3]);
+        assert_eq!(table.command, format!("external table {}", text.display()));
+        // Raw little-endian f32 and f16.
+        let values = [0.5f32, 0.25, 0.125, 1.0, 0.75, 0.625];
+        let f32s: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
+        let raw = dir.write("e.f32", &f32s);
+        let table = read_external(&raw, &Encoding::Raw(Precision::F32), &e).unwrap();
+        assert_eq!(table.value, vec![0.5, 0.25, 0.125, 1.0, 0.75, 0.625]);
+        let f16s: Vec<u8> = values
+            .iter()
+            .flat_map(|&v| half::f16::from_f32(v).to_le_bytes())
+            .collect();
+        let raw = dir.write("e.f16", &f16s);
+        let table = read_external(&raw, &Encoding::Raw(Precision::F16), &e).unwrap();
+        assert_eq!(table.value, vec![0.5, 0.25, 0.125, 1.0, 0.75, 0.625]);
+        // 0.1 as a half float is 0.0999755859375.
+        let raw = dir.write("tenth.f16", &[0x66, 0x2e].repeat(6));
+        let table = read_external(&raw, &Encoding::Raw(Precision::F16), &e).unwrap();
+        assert_eq!(table.value[0], 0.0999755859375);
+    }
+
+    #[test]
+    fn external_numbers_that_do_not_fit_are_refused_with_the_reason() {
+        let dir = Scratch::new("external-errors");
+        let e = layout(Quantity::E, vec![2, 3], vec![AxisName::R, AxisName::Mu]);
+        let read = |name: &str, bytes: &[u8], encoding: Encoding| {
+            read_external(&dir.write(name, bytes), &encoding, &e)
+                .unwrap_err()
+                .to_string()
+        };
+        let message = read("a.txt", b"0.5 0.5\n0.5 abc", Encoding::Text);
+        assert!(
+            message.contains("line 2: 'abc' is not a number"),
+            "{message}"
+        );
+        let message = read("b.txt", &[0xff, 0xfe, 0x30], Encoding::Text);
+        assert!(
+            message.contains("not text (use --dtype for raw floats)"),
+            "{message}"
+        );
+        let message = read("c.txt", b"0.5 0.5 0.5 0.5 0.5", Encoding::Text);
+        assert!(
+            message.contains("holds 5 values but the layout [2, 3] needs 6"),
+            "{message}"
+        );
+        let message = read("d.txt", b"0.5 0.5 0.5 NaN 0.5 inf", Encoding::Text);
+        assert!(
+            message.contains("value 3 is NaN, not a finite number"),
+            "{message}"
+        );
+        let message = read("e.f32", &[0; 7], Encoding::Raw(Precision::F32));
+        assert!(
+            message.contains("7 bytes is not a whole number of 4-byte floats"),
+            "{message}"
+        );
+        let message = read("f.f16", &[0; 13], Encoding::Raw(Precision::F16));
+        assert!(message.contains("13 bytes is not a whole number of 2-byte floats"));
+        let message = read("g.txt", b"0.5 0.5 0.5 0.5 0.5 1.5", Encoding::Text);
+        assert!(
+            message.contains("E at texel 5 is 1.5, outside [0, 1]"),
+            "{message}"
+        );
+        // An EXR channel that is not there.
+        let table = e_table(MuMapping::Linear, 4);
+        let exr = crate::format::exr::encode(&table, Precision::F32).unwrap();
+        let message = read("h.exr", &exr, Encoding::ExrChannel("G".into()));
+        assert!(
+            message.contains("no channel 'G' (it has E, one_minus_E"),
+            "{message}"
+        );
+    }
+
+    #[test]
+    fn an_exr_channel_is_read_by_name() {
+        let dir = Scratch::new("exr-channel");
+        let table = e_table(MuMapping::Linear, 4);
+        let path = dir.write(
+            "t.exr",
+            &crate::format::exr::encode(&table, Precision::F32).unwrap(),
+        );
+        let e = layout(Quantity::E, vec![3, 4], vec![AxisName::R, AxisName::Mu]);
+        let read = read_external(&path, &Encoding::ExrChannel("one_minus_E".into()), &e).unwrap();
+        assert_eq!(read.value[4], f64::from((1.0 - (0.9 - 0.04)) as f32));
+    }
+
+    #[test]
+    fn layouts_are_checked_against_their_quantity() {
+        let values = |n: usize| vec![0.5; n];
+        let fails = |l: Layout, n: usize| spec_and_values(&l, values(n)).unwrap_err();
+        let (r, mu) = (AxisName::R, AxisName::Mu);
+        assert!(
+            fails(layout(Quantity::E, vec![2, 3], vec![r]), 6)
+                .contains("--shape has 2 sizes but --order names 1 axes")
+        );
+        assert!(
+            fails(layout(Quantity::E, vec![1, 3], vec![r, mu]), 3)
+                .contains("every axis needs at least 2 samples (shape [1, 3])")
+        );
+        assert!(
+            fails(layout(Quantity::EDielectric, vec![2, 3], vec![r, mu]), 6)
+                .contains("--quantity e-dielectric: only kiln's own dielectric")
+        );
+        assert!(
+            fails(layout(Quantity::E, vec![6], vec![r]), 6).contains("an E table needs two axes")
+        );
+        assert!(
+            fails(layout(Quantity::E, vec![2, 3], vec![r, r]), 6)
+                .contains("an E table needs two axes")
+        );
+        assert!(
+            fails(layout(Quantity::EAvg, vec![2, 3], vec![r, mu]), 6)
+                .contains("an E_avg table has one roughness axis")
+        );
+        let mut bad_model = layout(Quantity::E, vec![2, 3], vec![r, mu]);
+        bad_model.model = Model {
+            ndf: Ndf::Beckmann,
+            masking: Masking::SchlickGgx,
+        };
+        assert!(fails(bad_model, 6).contains("goes with --ndf ggx only"));
+        // The forms that work: E_avg over r, E over (r, mu) as stored.
+        let (spec, v) =
+            spec_and_values(&layout(Quantity::EAvg, vec![4], vec![r]), values(4)).unwrap();
+        assert_eq!((spec.shape(), spec.mu, v.len()), (vec![4], None, 4));
+        let stored: Vec<f64> = (0..6).map(f64::from).collect();
+        let (spec, v) = spec_and_values(
+            &layout(Quantity::E, vec![2, 3], vec![r, mu]),
+            stored.clone(),
+        )
+        .unwrap();
+        assert_eq!((spec.shape(), v), (vec![2, 3], stored));
+    }
 
     #[test]
     fn mu_major_tables_are_transposed_into_roughness_major_order() {
