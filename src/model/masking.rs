@@ -236,4 +236,102 @@ mod tests {
             1.0
         );
     }
+
+    /// GGX's `Lambda` in closed form (Heitz 2014, eq. 72), written here apart from the model.
+    fn ggx_lambda(alpha: f64, mu: f64) -> f64 {
+        let tan2 = (1.0 - mu * mu) / (mu * mu);
+        0.5 * (-1.0 + (1.0 + alpha * alpha * tan2).sqrt())
+    }
+
+    #[test]
+    fn names_are_serdes_and_only_schlick_is_not_smith() {
+        for m in [
+            Masking::HeightCorrelated,
+            Masking::Separable,
+            Masking::SchlickGgx,
+        ] {
+            let serde_name = serde_json::to_string(&m).unwrap();
+            assert_eq!(serde_name, format!("\"{}\"", m.name()));
+            assert_eq!(m.to_string(), m.name());
+            assert_eq!(m.is_smith(), m != Masking::SchlickGgx);
+        }
+    }
+
+    /// Schlick-GGX's loss is `1 - G1_S(o) G1_S(i) / G1_Smith(o)`, worked from the closed forms;
+    /// at a view on the horizon, its limit `1 - G1_S(i)`.
+    #[test]
+    fn schlick_ggx_loss_against_its_closed_form() {
+        let g1_s = |mu: f64, alpha: f64| {
+            let k = alpha / 2.0;
+            mu / (mu * (1.0 - k) + k)
+        };
+        for alpha in [0.1, 0.5, 1.3] {
+            for (mu_o, mu_i) in [(0.2, 0.7), (0.9, 0.05), (0.5, 0.5)] {
+                let (lo, li) = (ggx_lambda(alpha, mu_o), ggx_lambda(alpha, mu_i));
+                let smith_g1_o = 1.0 / (1.0 + lo);
+                let expected = 1.0 - g1_s(mu_o, alpha) * g1_s(mu_i, alpha) / smith_g1_o;
+                let loss = Masking::SchlickGgx.loss_at(alpha, mu_o, mu_i, lo, li);
+                assert!((loss - expected).abs() < 1e-15, "{alpha} {mu_o} {mu_i}");
+                // The Smith forms take no notice of the cosines.
+                for m in Masking::ALL {
+                    assert_eq!(m.loss_at(alpha, mu_o, mu_i, lo, li), m.loss(lo, li));
+                }
+            }
+            let horizon = Masking::SchlickGgx.loss_at(alpha, 0.0, 0.3, f64::INFINITY, 0.1);
+            assert!((horizon - (1.0 - g1_s(0.3, alpha))).abs() < 1e-15);
+            let matched =
+                Masking::SchlickGgx.loss_index_matched(alpha, 0.4, ggx_lambda(alpha, 0.4));
+            let expected =
+                1.0 - g1_s(0.4, alpha) * g1_s(0.4, alpha) * (1.0 + ggx_lambda(alpha, 0.4));
+            assert!((matched - expected).abs() < 1e-15);
+        }
+        // Separable G2 and height-correlated G2 by their formulas.
+        assert!((Masking::Separable.g2(0.5, 3.0) - 1.0 / (1.5 * 4.0)).abs() < 1e-16);
+        assert!((Masking::HeightCorrelated.g2(0.5, 3.0) - 1.0 / 4.5).abs() < 1e-16);
+    }
+
+    #[test]
+    #[should_panic(expected = "needs the directions")]
+    fn schlick_ggx_has_no_g2_of_lambdas_alone() {
+        let _ = Masking::SchlickGgx.g2(0.1, 0.2);
+    }
+
+    #[test]
+    #[should_panic(expected = "needs the directions")]
+    fn schlick_ggx_has_no_loss_of_lambdas_alone() {
+        let _ = Masking::SchlickGgx.loss(0.1, 0.2);
+    }
+
+    /// Reflected about the normal, `o` stays above and loses what the masking says; reflected
+    /// about a facet that sends it below the horizon, it is lost.
+    #[test]
+    fn reflection_loss_by_the_side_the_light_leaves_on() {
+        use crate::model::{Ggx, Vec3};
+        let alpha = 0.6;
+        let ndf = Ggx { alpha };
+        let mu = 0.5;
+        let o = Vec3::from_mu(mu);
+        let lo = ggx_lambda(alpha, mu);
+        let up = Vec3 {
+            x: 0.0,
+            y: 0.0,
+            z: 1.0,
+        };
+        // The mirror direction: Lambda(i) = Lambda(o), so the height-correlated loss is
+        // L / (1 + 2 L).
+        let loss = reflection_loss(ndf, Masking::HeightCorrelated, o, lo, up);
+        assert!((loss - lo / (1.0 + 2.0 * lo)).abs() < 1e-14, "{loss}");
+        let loss = reflection_loss(ndf, Masking::SchlickGgx, o, lo, up);
+        let k = alpha / 2.0;
+        let g1_s = mu / (mu * (1.0 - k) + k);
+        assert!((loss - (1.0 - g1_s * g1_s * (1.0 + lo))).abs() < 1e-14);
+        // A facet tilted 60 degrees away from o sends it straight down: all lost.
+        let tilted = Vec3 {
+            x: -(0.75f64.sqrt()),
+            y: 0.0,
+            z: 0.5,
+        };
+        assert!(o.reflect(tilted).z < 0.0);
+        assert_eq!(reflection_loss(ndf, Masking::Separable, o, lo, tilted), 1.0);
+    }
 }
