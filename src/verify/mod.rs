@@ -1008,4 +1008,81 @@ mod tests {
         }
         assert!((report.lookup_max_error - 1e-3).abs() < 1e-12);
     }
+
+    /// A 4 x 8 E table (32 nodes: the smallest group that is scouted) holding the reference at
+    /// 1e-12 plus `offset` at every node.
+    fn offset_table(offset: f64) -> Table {
+        let spec = test_e_spec(4, 8, Grid::Nodes, MuMapping::Linear);
+        let fine = ReferenceSettings {
+            tolerance: 1e-12,
+            ..ReferenceSettings::default()
+        };
+        let values = (0..spec.len())
+            .map(|k| {
+                let (alpha, mu) = spec.texel_coordinates(k);
+                let at = Coordinates {
+                    alpha,
+                    mu,
+                    eta: None,
+                };
+                spec.integral().reference(at, &fine).value - offset
+            })
+            .collect();
+        table(spec, values)
+    }
+
+    /// The passes an audit plans, and its report.
+    fn planned(table: &Table, against: &Against) -> (Vec<u64>, Report) {
+        let planned = std::sync::Mutex::new(Vec::new());
+        let report = audit(table, against, &AuditSettings::default(), &|p| {
+            if let Progress::Planned(n) = p {
+                planned.lock().unwrap().push(n);
+            }
+        });
+        (planned.into_inner().unwrap(), report)
+    }
+
+    /// Node errors of 1e-3: the scout (4 of the 32 nodes, at 1e-6) already holds the truth
+    /// closely enough, so only the other 28 are compared, at the scout's tolerance. Errors of
+    /// 1e-7 call for 1e-9: all 32 again, once. A finest tolerance coarser than the scout's,
+    /// or a fixed one, is one pass.
+    #[test]
+    fn the_scout_sets_the_tolerance_of_each_group() {
+        let coarse = offset_table(1e-3);
+        let (passes, report) = planned(&coarse, &Against::Reference(ReferenceSettings::default()));
+        assert_eq!(passes[..2], [4, 28], "{passes:?}");
+        assert_eq!(report.node_reference_tolerance, SCOUT_TOLERANCE);
+        assert!((report.node_max_error - 1e-3).abs() < 1e-8);
+        // The lookups too were measured at the scout's tolerance: their truth's error estimates
+        // are of that size (5.5e-7), not of the finest tolerance's.
+        assert!(report.reference_error_estimate > 1e-8);
+        assert_eq!(report.lookup_reference_tolerance, SCOUT_TOLERANCE);
+        let fine = offset_table(1e-7);
+        let (passes, report) = planned(&fine, &Against::Reference(ReferenceSettings::default()));
+        assert_eq!(passes[..2], [4, 32], "{passes:?}");
+        let tolerance = report.node_reference_tolerance;
+        assert!((0.9e-9..1.1e-9).contains(&tolerance), "{tolerance:e}");
+        assert!((report.node_max_error - 1e-7).abs() < 1e-10);
+        let loose = ReferenceSettings {
+            tolerance: 1e-5,
+            ..ReferenceSettings::default()
+        };
+        let (passes, report) = planned(&coarse, &Against::Reference(loose));
+        assert_eq!(passes[0], 32, "{passes:?}");
+        assert_eq!(report.node_reference_tolerance, 1e-5);
+        let fixed = ReferenceSettings {
+            tolerance: 1e-8,
+            ..ReferenceSettings::default()
+        };
+        let (passes, report) = planned(&coarse, &Against::ReferenceAt(fixed));
+        assert_eq!(passes, [32, report.lookup_points as u64]);
+        assert_eq!(
+            (
+                report.node_reference_tolerance,
+                report.lookup_reference_tolerance
+            ),
+            (1e-8, 1e-8)
+        );
+        assert_eq!(report.against, "reference");
+    }
 }
