@@ -7,6 +7,7 @@
 #   TARGETS="--lib --test containers" scripts/mutants.sh src/format/f16.rs   # fewer test binaries
 #   TARGETS=--lib TESTS="-- model::" scripts/mutants.sh src/model/special.rs  # and fewer tests
 #   RE="cody_rational|beckmann_lambda_of_a" scripts/mutants.sh src/model/special.rs   # some functions
+#   EXCLUDE_RE="cody_rational" scripts/mutants.sh src/model/special.rs   # all but some functions
 #   ITERATE=1 scripts/mutants.sh src/table   # again, skipping the mutants the last runs caught
 #   TIMEOUT=60 scripts/mutants.sh ...  # seconds a mutant's tests may take (default 300; a mutant
 #                                      # can make a test run far longer than it does)
@@ -39,6 +40,9 @@ if [ -n "${ITERATE:-}" ]; then
 fi
 if [ -n "${RE:-}" ]; then
     args+=(--re "$RE")
+fi
+if [ -n "${EXCLUDE_RE:-}" ]; then
+    args+=(--exclude-re "$EXCLUDE_RE")
 fi
 # Cargo.toml's `mutants` profile for the build and the test alike: the release build's code
 # (the tests' tolerances and run times are release's) without debug info and incremental, so a

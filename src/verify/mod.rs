@@ -1010,9 +1010,14 @@ mod tests {
     }
 
     /// A 4 x 8 E table (32 nodes: the smallest group that is scouted) holding the reference at
-    /// 1e-12 plus `offset` at every node.
+    /// 1e-12 less `offset` at every node.
     fn offset_table(offset: f64) -> Table {
-        let spec = test_e_spec(4, 8, Grid::Nodes, MuMapping::Linear);
+        offset_table_of(4, offset)
+    }
+
+    /// As [`offset_table`], with `rows` rows of 8.
+    fn offset_table_of(rows: usize, offset: f64) -> Table {
+        let spec = test_e_spec(rows, 8, Grid::Nodes, MuMapping::Linear);
         let fine = ReferenceSettings {
             tolerance: 1e-12,
             ..ReferenceSettings::default()
@@ -1070,6 +1075,18 @@ mod tests {
         let (passes, report) = planned(&coarse, &Against::Reference(loose));
         assert_eq!(passes[0], 32, "{passes:?}");
         assert_eq!(report.node_reference_tolerance, 1e-5);
+        // A finest tolerance of exactly the scout's: nothing to gain by scouting.
+        let scout = ReferenceSettings {
+            tolerance: SCOUT_TOLERANCE,
+            ..ReferenceSettings::default()
+        };
+        assert_eq!(planned(&coarse, &Against::Reference(scout)).0[0], 32);
+        // 24 nodes: too few to scout.
+        let few = offset_table_of(3, 1e-3);
+        assert_eq!(
+            planned(&few, &Against::Reference(ReferenceSettings::default())).0[0],
+            24
+        );
         let fixed = ReferenceSettings {
             tolerance: 1e-8,
             ..ReferenceSettings::default()
