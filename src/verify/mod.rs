@@ -798,6 +798,32 @@ mod tests {
             ..settings
         };
         assert_eq!(lookup_coordinates(&spec, &sparse).len(), 4 * (5 + 27));
+        // Over an IOR axis: the ladders at each rung of the IOR ladder, `eta = 1 + 2 t` on a
+        // linear axis to 3 (its reciprocal for light from inside).
+        for (quantity, at_half) in [
+            (Quantity::EDielectric, 2.0),
+            (Quantity::EDielectricInside, 0.5),
+        ] {
+            let glass = TableSpec {
+                quantity,
+                ior: Some(Axis::Ior {
+                    size: 3,
+                    mapping: crate::table::axis::IorMapping::Linear,
+                    max: crate::table::axis::IorBound(3.0),
+                    grid: Grid::Nodes,
+                }),
+                ..spec.clone()
+            };
+            let points = lookup_coordinates(&glass, &settings);
+            assert_eq!(points.len(), 7 * 7 * 36);
+            assert!(points[..7 * 36].iter().all(|p| p.eta == Some(1.0)));
+            assert!(
+                points[3 * 7 * 36..4 * 7 * 36]
+                    .iter()
+                    .all(|p| p.eta == Some(at_half))
+            );
+            assert_eq!(points[3 * 7 * 36 + 36 * 3 + 4].mu, Some(0.5));
+        }
         // A table without mu: the roughness ladder alone, with no mu.
         let points = lookup_coordinates(&e_avg_spec(5), &settings);
         assert_eq!(points.len(), 11);
@@ -1075,6 +1101,18 @@ mod tests {
         let (passes, report) = planned(&coarse, &Against::Reference(loose));
         assert_eq!(passes[0], 32, "{passes:?}");
         assert_eq!(report.node_reference_tolerance, 1e-5);
+        // Errors of 1e-5 on the scouted nodes only: the scout calls for 1e-7, where all 32 are
+        // measured; their RMS (1e-5 / sqrt(8)) calls for 3.5e-8, where all 32 are measured
+        // again.
+        let mut uneven = offset_table(0.0);
+        for k in (0..32).step_by(SCOUT_STRIDE) {
+            uneven.value[k] -= 1e-5;
+            uneven.one_minus_value[k] += 1e-5;
+        }
+        let (passes, report) = planned(&uneven, &Against::Reference(ReferenceSettings::default()));
+        assert_eq!(passes[..3], [4, 32, 32], "{passes:?}");
+        let tolerance = report.node_reference_tolerance;
+        assert!((3e-8..4e-8).contains(&tolerance), "{tolerance:e}");
         // A finest tolerance of exactly the scout's: nothing to gain by scouting.
         let scout = ReferenceSettings {
             tolerance: SCOUT_TOLERANCE,
