@@ -515,6 +515,7 @@ pub fn furnace_maps(
 mod tests {
     use super::*;
     use crate::table::TableSpec;
+    use crate::table::axis::Axis;
     use crate::table::axis::{Grid, MuMapping};
     use crate::table::normalisation::derive;
     use crate::table::test_e_spec;
@@ -721,5 +722,92 @@ mod tests {
         let (zero, _) = tables(|_| 1.0, |r| r);
         let maps = furnace_maps(&zero, None, &[Form::Turquin], 2, 2).unwrap();
         assert_eq!(maps[0].deviation, vec![vec![0.0; 2]; 2]);
+    }
+
+    /// Kulla-Conty's lobe normalised by kiln's `f_ms_norm` (the average of the E table's own
+    /// lookup) closes the furnace of any E table; read as an E_avg table it would not.
+    #[test]
+    fn the_lobe_normalised_by_f_ms_norm_closes_the_furnace() {
+        let (e, _) = tables(|r| 0.1 * r + 0.02, |r| r);
+        let norm = derive(&e, String::new());
+        let report = furnace(&e, &norm, 2).unwrap();
+        assert_eq!(report.normalisation, "f_ms_norm");
+        assert!(report.max_deviation < 1e-12, "{}", report.max_deviation);
+    }
+
+    /// Turquin's deviation is `E_true / E_lookup - 1`: against a table that looks up 1/2
+    /// everywhere, `2 E_true - 1` at every point of the audit's ladder, by IOR band for glass
+    /// (from inside, banded by `1 / eta`).
+    #[test]
+    fn turquins_deviation_is_the_truth_over_the_lookup() {
+        let settings = crate::verify::AuditSettings {
+            density: 1,
+            ..crate::verify::AuditSettings::default()
+        };
+        let reference = crate::integrate::reference::ReferenceSettings::default();
+        let expected = |spec: &TableSpec| {
+            crate::verify::lookup_coordinates(spec, &settings)
+                .into_iter()
+                .map(|at| {
+                    let truth = spec.integral().reference(at, &reference).value;
+                    (at, (2.0 * truth - 1.0).abs())
+                })
+                .collect::<Vec<_>>()
+        };
+        let e = table(
+            test_e_spec(2, 2, Grid::Nodes, MuMapping::Linear),
+            vec![0.5; 4],
+        );
+        let report = turquin(&e, &settings, &|| {}).unwrap();
+        let points = expected(&e.spec);
+        let worst = points.iter().map(|p| p.1).fold(0.0, f64::max);
+        assert!(
+            (report.max_deviation - worst).abs() < 1e-12,
+            "{report:?} {worst}"
+        );
+        assert!(report.max_deviation > 0.1);
+        assert!((report.deviation.abs() - worst).abs() < 1e-12);
+        // Glass seen from inside (the slowest reference: one side only).
+        for (quantity, index) in [(Quantity::EDielectricInside, -1.0)] {
+            let spec = TableSpec {
+                quantity,
+                ior: Some(Axis::Ior {
+                    size: 2,
+                    mapping: crate::table::axis::IorMapping::Linear,
+                    max: crate::table::axis::IorBound(3.0),
+                    grid: Grid::Nodes,
+                }),
+                ..test_e_spec(2, 2, Grid::Nodes, MuMapping::Linear)
+            };
+            let glass = table(spec.clone(), vec![0.5; 8]);
+            let report = turquin(&glass, &settings, &|| {}).unwrap();
+            // The ladder's indices are 1, 2 and 3: bands [1, 1.01), [2, inf).
+            let bands: Vec<(f64, f64)> = report
+                .eta_bands
+                .iter()
+                .map(|b| (b.lower, b.upper))
+                .collect();
+            assert_eq!(bands, [(1.0, 1.01), (2.0, f64::INFINITY)]);
+            let points = expected(&spec);
+            for band in &report.eta_bands {
+                let worst = points
+                    .iter()
+                    .filter(|p| {
+                        let eta = p.0.eta.unwrap().powf(index);
+                        (band.lower..band.upper).contains(&eta)
+                    })
+                    .map(|p| p.1)
+                    .fold(0.0, f64::max);
+                assert!(
+                    (band.max_deviation - worst).abs() < 1e-12,
+                    "{band:?} {worst}"
+                );
+                assert!((band.lower..band.upper).contains(&band.worst_eta.powf(index)));
+            }
+            assert_eq!(
+                report.worst_eta.map(|eta| eta.powf(index) >= 1.0),
+                Some(true)
+            );
+        }
     }
 }
