@@ -659,6 +659,12 @@ mod tests {
         let share = 33.0 / 65.0;
         assert!((audit.lookup_max_relative_error - 0.01 * share).abs() < 1e-12);
         assert_eq!(audit.worst_roughness, 32.5 / 64.0);
+        // The last node 1% high: its cell's midpoint is audited too.
+        norm.value[33] /= 1.01;
+        norm.value[64] *= 1.01;
+        let audit = audit_normalisation(&e, &norm).unwrap();
+        assert!((audit.lookup_max_relative_error - 0.01 * 64.0 / 127.0).abs() < 1e-12);
+        assert_eq!(audit.worst_roughness, 63.5 / 64.0);
         // Another E table's normalisation is refused.
         let other = table(
             test_e_spec(5, 8, Grid::Nodes, MuMapping::Linear),
@@ -809,5 +815,40 @@ mod tests {
                 Some(true)
             );
         }
+    }
+
+    /// The furnace's `mu` ladder: four steps a texel at least. A loss peaked at the column
+    /// `mu = 2/3` of a 4-column table is worst, on that ladder of sixteenths, at `mu = 11/16`,
+    /// where the lookup gives 15/16 of the peak.
+    #[test]
+    fn the_furnace_walks_mu_in_quarter_texels() {
+        let spec = test_e_spec(5, 4, Grid::Nodes, MuMapping::Linear);
+        let e = table(
+            spec,
+            (0..20)
+                .map(|k| {
+                    1.0 - if k % 4 == 2 {
+                        0.1 * (k / 4) as f64 / 4.0
+                    } else {
+                        0.0
+                    }
+                })
+                .collect(),
+        );
+        // The lookup's average loss is 2 x (area 0.1 r / 3) x (centroid 2/3) = 0.4 r / 9; an
+        // E_avg of half that doubles the lobe.
+        let e_avg = table(
+            e_avg_spec(5),
+            (0..5).map(|k| 1.0 - 0.2 * k as f64 / 36.0).collect(),
+        );
+        let report = furnace(&e, &e_avg, 2).unwrap();
+        let last = report.rows.last().unwrap();
+        assert_eq!(last.roughness, 1.0);
+        assert!((last.relative_mismatch - 1.0).abs() < 1e-12, "{last:?}");
+        assert_eq!(last.worst_mu, 11.0 / 16.0);
+        assert!(
+            (last.deviation - 0.1 * 15.0 / 16.0).abs() < 1e-12,
+            "{last:?}"
+        );
     }
 }

@@ -708,6 +708,13 @@ mod tests {
             let path = dir.write(name, bytes);
             assert!(read_kiln(&path).unwrap().is_none(), "{name}");
         }
+        // A sidecar's structure under another kind is not kiln's.
+        let foreign = edited_sidecar(&table, |v| v["kind"] = "other-table".into());
+        assert!(
+            read_kiln(&dir.write("foreign.json", &foreign))
+                .unwrap()
+                .is_none()
+        );
         // A sidecar whose kind is kiln's: read as kiln's even when the name says otherwise.
         let sidecar = edited_sidecar(&table, |_| {});
         let path = dir.write("renamed.json", &sidecar);
