@@ -700,6 +700,10 @@ mod tests {
             ("array.json", b"[1, 2, 3]".as_slice()),
             ("broken.json", b"{ not json".as_slice()),
             (
+                "long.json",
+                b"{ not json either, and longer than kiln's kind marker }".as_slice(),
+            ),
+            (
                 "plain.h",
                 b"static const float X[2] = { 1.0f, 2.0f };".as_slice(),
             ),
