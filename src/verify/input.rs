@@ -879,7 +879,13 @@ mod tests {
         assert!(agrees(&sidecar(&|v| v[0] *= 1.0 + 0.9e-3)));
         assert!(!agrees(&sidecar(&|v| v[0] *= 1.0 + 1.1e-3)));
         assert!(!agrees(&sidecar(&|v| v[11] *= 1.0 - 1.1e-3)));
-        assert!(agrees(&sidecar(&|v| v[11] += 0.9e-7 + 1e-3 * v[11])));
+        // 1e-3 of the sidecar's value and half the 1e-7 more: within, thanks to the 1e-7.
+        assert!(agrees(&sidecar(
+            &|v| v[11] += (1e-3 * v[11] + 0.5e-7) / (1.0 - 1e-3)
+        )));
+        assert!(!agrees(&sidecar(
+            &|v| v[11] += (1e-3 * v[11] + 1.5e-7) / (1.0 - 1e-3)
+        )));
         assert!(!agrees(&sidecar(&|v| {
             v.pop();
         })));
