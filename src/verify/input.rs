@@ -800,25 +800,37 @@ mod tests {
         assert_eq!(read.std_error, vec![0.0; 12]);
     }
 
+    /// The 3 x 4 test table's files in `dir`: the table, its file of `extension` and its
+    /// sidecar.
+    fn written(dir: &Scratch, extension: &str) -> (Table, PathBuf, PathBuf) {
+        let table = e_table(MuMapping::Linear, 4);
+        let file = write_kiln_files(dir, &table)
+            .into_iter()
+            .find(|p| p.extension().unwrap() == extension)
+            .unwrap();
+        let sidecar = file.with_extension("json");
+        (table, file, sidecar)
+    }
+
+    /// The sidecar of the same layout with one value changed.
+    fn other_values_sidecar() -> Vec<u8> {
+        let mut other = e_table(MuMapping::Linear, 4);
+        other.value[5] = 0.5;
+        other.one_minus_value[5] = 0.5;
+        edited_sidecar(&other, |_| {})
+    }
+
     #[test]
     fn a_binary_needs_its_own_sidecar() {
         let dir = Scratch::new("binary");
-        let table = e_table(MuMapping::Linear, 4);
-        let paths = write_kiln_files(&dir, &table);
-        let bin = paths
-            .iter()
-            .find(|p| p.extension().unwrap() == "bin")
-            .unwrap();
-        let sidecar = bin.with_extension("json");
+        let (table, bin, sidecar) = written(&dir, "bin");
+        let bin = &bin;
         let bytes = std::fs::read(&sidecar).unwrap();
         // Without it.
         std::fs::remove_file(&sidecar).unwrap();
         assert!(error(read_kiln(bin)).contains("a kiln binary holds no model"));
         // Beside the sidecar of a table of other values.
-        let mut other = e_table(MuMapping::Linear, 4);
-        other.value[5] = 0.5;
-        other.one_minus_value[5] = 0.5;
-        std::fs::write(&sidecar, edited_sidecar(&other, |_| {})).unwrap();
+        std::fs::write(&sidecar, other_values_sidecar()).unwrap();
         assert!(error(read_kiln(bin)).contains("does not hold the values of its sidecar"));
         // Beside the sidecar of another shape, or other axes.
         std::fs::write(
@@ -848,17 +860,9 @@ mod tests {
     #[test]
     fn a_dds_file_needs_its_own_sidecar() {
         let dir = Scratch::new("dds");
-        let table = e_table(MuMapping::Linear, 4);
-        let paths = write_kiln_files(&dir, &table);
-        let dds = paths
-            .iter()
-            .find(|p| p.extension().unwrap() == "dds")
-            .unwrap();
-        let sidecar = dds.with_extension("json");
-        let mut other = e_table(MuMapping::Linear, 4);
-        other.value[5] = 0.5;
-        other.one_minus_value[5] = 0.5;
-        std::fs::write(&sidecar, edited_sidecar(&other, |_| {})).unwrap();
+        let (_, dds, sidecar) = written(&dir, "dds");
+        let dds = &dds;
+        std::fs::write(&sidecar, other_values_sidecar()).unwrap();
         assert!(error(read_kiln(dds)).contains("does not hold the values of its sidecar"));
         std::fs::remove_file(&sidecar).unwrap();
         assert!(error(read_kiln(dds)).contains("a DDS file holds no metadata"));

@@ -737,6 +737,26 @@ mod tests {
         assert_eq!(node_error_indices(&e_avg), vec![0, 4, 8, 12, 16]);
     }
 
+    /// A glass table's spec: `quantity` over a linear IOR axis of `iors` nodes to 3, then
+    /// `rows` x `columns` as [`test_e_spec`]'s.
+    pub(super) fn glass_spec(
+        quantity: Quantity,
+        iors: usize,
+        rows: usize,
+        columns: usize,
+    ) -> TableSpec {
+        TableSpec {
+            quantity,
+            ior: Some(Axis::Ior {
+                size: iors,
+                mapping: crate::table::axis::IorMapping::Linear,
+                max: crate::table::axis::IorBound(3.0),
+                grid: Grid::Nodes,
+            }),
+            ..test_e_spec(rows, columns, Grid::Nodes, MuMapping::Linear)
+        }
+    }
+
     pub(super) fn e_avg_spec(rows: usize) -> TableSpec {
         TableSpec {
             quantity: Quantity::EAvg,
@@ -804,16 +824,7 @@ mod tests {
             (Quantity::EDielectric, 2.0),
             (Quantity::EDielectricInside, 0.5),
         ] {
-            let glass = TableSpec {
-                quantity,
-                ior: Some(Axis::Ior {
-                    size: 3,
-                    mapping: crate::table::axis::IorMapping::Linear,
-                    max: crate::table::axis::IorBound(3.0),
-                    grid: Grid::Nodes,
-                }),
-                ..spec.clone()
-            };
+            let glass = glass_spec(quantity, 3, 3, 4);
             let points = lookup_coordinates(&glass, &settings);
             assert_eq!(points.len(), 7 * 7 * 36);
             assert!(points[..7 * 36].iter().all(|p| p.eta == Some(1.0)));
