@@ -520,26 +520,26 @@ mod tests {
         for j in 0..3 {
             let mut v = [0.5; 3];
             v[j] = 0.6;
-            let tinted = Fresnel::Schlick {
-                f0: v,
-                f90: [1.0; 3],
-            };
-            assert!(!tinted.is_grey(), "{j}");
-            let tinted = Fresnel::Schlick {
-                f0: [0.5; 3],
-                f90: v,
-            };
-            assert!(!tinted.is_grey(), "{j}");
-            let tinted = Fresnel::Conductor {
-                eta: v,
-                k: [1.0; 3],
-            };
-            assert!(!tinted.is_grey(), "{j}");
-            let tinted = Fresnel::Conductor {
-                eta: [1.0; 3],
-                k: v,
-            };
-            assert!(!tinted.is_grey(), "{j}");
+            for tinted in [
+                Fresnel::Schlick {
+                    f0: v,
+                    f90: [1.0; 3],
+                },
+                Fresnel::Schlick {
+                    f0: [0.5; 3],
+                    f90: v,
+                },
+                Fresnel::Conductor {
+                    eta: v,
+                    k: [1.0; 3],
+                },
+                Fresnel::Conductor {
+                    eta: [1.0; 3],
+                    k: v,
+                },
+            ] {
+                assert!(!tinted.is_grey(), "{j}: {tinted:?}");
+            }
         }
         let refused = |model: Fresnel, words: &str| {
             let message = model.validate().unwrap_err();

@@ -508,8 +508,8 @@ impl VisibleSlopeX {
     /// Tabulates the solution at `nodes` evenly spaced `u` (worth it when one view is sampled many
     /// times): a linear interpolation of the table starts the solver so close (with 1025 nodes,
     /// about 1e-6 for `u` in [0.1, 0.9] and 1e-4 in [0.01, 0.99]; the end panels start from
-    /// Jakob's fit) that one Halley step usually finishes. The answer does not
-    /// depend on the starting point beyond the solver's tolerance.
+    /// Jakob's fit) that one Halley step usually finishes. The answer does not depend on the
+    /// starting point beyond the solver's tolerance.
     #[must_use]
     pub fn with_guess_table(mut self, nodes: usize) -> Self {
         let table: Box<[f64]> = (0..nodes)

@@ -116,22 +116,12 @@ mod tests {
     use super::*;
     use crate::table::axis::{Grid, MuMapping};
     use crate::table::test_e_spec;
-    use crate::verify::tests::{e_avg_spec, table};
+    use crate::verify::tests::{e_avg_spec, tables_apart};
     use crate::verify::{Against, AuditSettings, audit};
 
     /// The audit of a 3 x 4 table against one that differs by `1e-3 (k + 1)` at texel `k`.
     fn report(spec: &TableSpec) -> Report {
-        let n = spec.len();
-        let ours = table(
-            spec.clone(),
-            (0..n).map(|k| 0.5 + 0.01 * k as f64).collect(),
-        );
-        let theirs = table(
-            spec.clone(),
-            (0..n)
-                .map(|k| 0.5 + 0.01 * k as f64 - 1e-3 * (k + 1) as f64)
-                .collect(),
-        );
+        let (ours, theirs) = tables_apart(spec);
         audit(
             &ours,
             &Against::Table(&theirs),

@@ -68,7 +68,7 @@ fn check_finite(path: &Path, values: &[f64]) -> Result<()> {
     }
 }
 
-fn table_from_channel(spec: TableSpec, values: Vec<f64>, command: String) -> Table {
+pub(super) fn table_from_channel(spec: TableSpec, values: Vec<f64>, command: String) -> Table {
     Table {
         one_minus_value: values.iter().map(|v| 1.0 - v).collect(),
         std_error: vec![0.0; values.len()],

@@ -674,15 +674,19 @@ mod tests {
     }
 
     pub(super) fn table(spec: TableSpec, value: Vec<f64>) -> Table {
-        Table {
-            spec,
-            one_minus_value: value.iter().map(|v| 1.0 - v).collect(),
-            std_error: vec![0.0; value.len()],
-            value,
-            command: String::new(),
-            node_errors: None,
-            requested_max_error: None,
-        }
+        input::table_from_channel(spec, value, String::new())
+    }
+
+    /// Two tables of `spec`'s layout: ours holds `0.5 + 0.01 k` at texel `k`, theirs that less
+    /// `1e-3 (k + 1)`.
+    pub(super) fn tables_apart(spec: &TableSpec) -> (Table, Table) {
+        let ours: Vec<f64> = (0..spec.len()).map(|k| 0.5 + 0.01 * k as f64).collect();
+        let theirs = ours
+            .iter()
+            .enumerate()
+            .map(|(k, v)| v - 1e-3 * (k + 1) as f64)
+            .collect();
+        (table(spec.clone(), ours), table(spec.clone(), theirs))
     }
 
     #[test]
@@ -936,16 +940,7 @@ mod tests {
     #[test]
     fn an_audit_against_a_table_reports_the_differences_node_by_node() {
         let spec = test_e_spec(3, 4, Grid::Nodes, MuMapping::Linear);
-        let base: Vec<f64> = (0..12).map(|k| 0.5 + 0.01 * k as f64).collect();
-        let ours = table(spec.clone(), base.clone());
-        // Theirs: ours less 1e-3 (k + 1) at texel k.
-        let theirs = table(
-            spec.clone(),
-            base.iter()
-                .enumerate()
-                .map(|(k, v)| v - 1e-3 * (k + 1) as f64)
-                .collect(),
-        );
+        let (ours, theirs) = tables_apart(&spec);
         let storage = Storage {
             name: "plus",
             round: |x| x + 2e-3,
