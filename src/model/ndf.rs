@@ -132,8 +132,12 @@ impl MicrofacetDistribution for Ggx {
         a2 * ratio * ratio / PI
     }
 
-    /// `mu (1 + Lambda) = (mu + sqrt(mu^2 + alpha^2 (1 - mu^2))) / 2`.
+    /// `mu (1 + Lambda) = (mu + sqrt(mu^2 + alpha^2 (1 - mu^2))) / 2`; a mirror's is `mu`, also
+    /// where `mu^2` underflows (`mu < 1e-154`, where the formula would give `mu / 2`).
     fn projected_area(&self, mu: f64) -> f64 {
+        if self.alpha == 0.0 {
+            return mu;
+        }
         let so2 = (1.0 - mu) * (1.0 + mu);
         0.5 * (mu + (mu * mu + self.alpha * self.alpha * so2).sqrt())
     }
@@ -1077,6 +1081,34 @@ mod tests {
         // GGX: exact value at alpha tan = 1: (sqrt 2 - 1) / 2.
         let l = Ggx { alpha: 0.5 }.lambda_from_tan2(4.0);
         assert!((l - (2f64.sqrt() - 1.0) / 2.0).abs() < 1e-16);
+    }
+
+    /// The projected area `mu (1 + Lambda)` at its limits: a mirror's is `mu` at every `mu`, the
+    /// horizon and the normal included (no `0 / 0`); at the horizon a rough surface keeps the
+    /// area its facets show sideways, `alpha / 2` for GGX and `alpha / (2 sqrt(pi))` for
+    /// Beckmann (`mu Lambda` as `mu -> 0`, from Heitz 2014 eqs. 72 and 77); at the normal, 1.
+    #[test]
+    fn projected_areas_at_the_limits() {
+        for mu in [0.0, 1e-300, 0.3, 1.0] {
+            assert_eq!(Ggx { alpha: 0.0 }.projected_area(mu), mu, "GGX {mu}");
+            assert_eq!(
+                Beckmann { alpha: 0.0 }.projected_area(mu),
+                mu,
+                "Beckmann {mu}"
+            );
+        }
+        for alpha in [1e-3, 0.5, 2.0] {
+            let ggx = Ggx { alpha }.projected_area(0.0);
+            assert!((ggx - alpha / 2.0).abs() <= 1e-16 * alpha, "{alpha}: {ggx}");
+            let beckmann = Beckmann { alpha }.projected_area(0.0);
+            let expected = alpha * FRAC_1_SQRT_PI / 2.0;
+            assert!(
+                (beckmann - expected).abs() <= 1e-15 * alpha,
+                "{alpha}: {beckmann}"
+            );
+            assert_eq!(Ggx { alpha }.projected_area(1.0), 1.0);
+            assert_eq!(Beckmann { alpha }.projected_area(1.0), 1.0);
+        }
     }
 
     /// The visible-normal samplers reproduce the visible-normal density: the mean of a test function
