@@ -660,8 +660,8 @@ mod tests {
     use super::*;
 
     /// The upper share of the visible x-slopes against `∫_x^b (b - s) exp(-s^2) ds` over its
-    /// total, integrated in 30-digit arithmetic (mpmath `quad`), far into the tail; and the
-    /// inverse finds the slope again.
+    /// total, integrated in 30-digit arithmetic (mpmath `quad`), far into the tail, and at normal
+    /// incidence the Gaussian's `erfc(x) / 2`; and the inverse finds the slope again.
     #[test]
     fn visible_slope_upper_share_and_its_inverse() {
         for (b, x, share) in [
@@ -669,6 +669,10 @@ mod tests {
             (10.0, 8.0, 1.087_881_594_350_896_6e-30),
             (0.5, 0.2, 0.038_530_303_163_401_35),
             (3.0, -1.0, 0.886_758_168_344_858_9),
+            // Normal incidence: Gaussian slopes, erfc(x) / 2 (erfc(1) and erfc(5) from tables).
+            (f64::INFINITY, 1.0, 0.157_299_207_050_285_13 / 2.0),
+            (f64::INFINITY, -1.0, 1.0 - 0.157_299_207_050_285_13 / 2.0),
+            (f64::INFINITY, 5.0, 1.537_459_794_428_034_8e-12 / 2.0),
         ] {
             let slopes = VisibleSlopeX::new(b);
             let got = slopes.upper_share(x);
