@@ -497,6 +497,12 @@ fn tilted_end_integral(b: f64, w: f64) -> f64 {
     w * w * sum
 }
 
+/// Whether the slopes `width` below the end `b` are near it, where [`tilted_end_integral`]'s
+/// exponent stays in [-1, 1] and the CDF's closed form cancels: `width (2b + width) <= 1`.
+fn near_the_end(b: f64, width: f64) -> bool {
+    width * (2.0 * b + width) <= 1.0
+}
+
 /// Draws the x-slope of a visible normal on the unit-roughness Beckmann surface seen from a
 /// direction with `cot(theta) = b` (in the view's azimuthal frame); see [`VisibleSlopeX`].
 #[must_use]
@@ -574,7 +580,7 @@ impl VisibleSlopeX {
     /// The share of the visible x-slopes above `x`, `(C(b) - C(x)) / C(b)`, with the upper tail
     /// computed as `C(b) - C(x) = (b sqrt(pi) (erfc(x) - erfc(b)) + exp(-b^2) - exp(-x^2)) / 2`
     /// (the difference of the CDF's two terms, each from `erfc` of a positive argument where it
-    /// matters), and near the end `b`, where those terms cancel (`(b - x) (b + b - x) <= 1`), as
+    /// matters), and near the end `b`, where those terms cancel ([`near_the_end`]), as
     /// `exp(-b^2)` times [`tilted_end_integral`]; so shares far below f64's epsilon keep their
     /// relative precision (within 1e-13 of 80-digit values, tested). At normal incidence the slope
     /// is Gaussian: `erfc(x) / 2`.
@@ -588,7 +594,7 @@ impl VisibleSlopeX {
             return 0.5 * erfc(x);
         }
         let width = b - x;
-        if width * (2.0 * b + width) <= 1.0 {
+        if near_the_end(b, width) {
             // Near the end the two terms below cancel (at b = 0.01 the share 1e-16 came out 24 %
             // off): `C(b) - C(x) = exp(-b^2) ∫_0^width t exp(t (2b - t)) dt` (`s = b - t`)
             // instead, whose exponent stays in [-1, 1] here.
@@ -620,12 +626,12 @@ impl VisibleSlopeX {
             return (self.sample(1.0 - w), 0);
         }
         let (mut lo, mut hi) = ((-9.0_f64).min(b), b);
-        // Near the end `b`, start from the share's leading term there, `exp(-b^2) width^2 /
-        // (2 C(b))` (the tilt of [`tilted_end_integral`] moves it by a factor e at most), not
-        // from `1 - w`, which keeps too few of a small w's digits.
-        let near_end = (2.0 * w * self.total).sqrt() * (0.5 * b * b).exp();
-        let mut x = if near_end * (2.0 * b + near_end) <= 1.0 {
-            b - near_end
+        // Near the end `b`, start from the share's leading term there, `end_weight width^2 / 2`
+        // (the tilt of [`tilted_end_integral`] moves it by a factor e at most), not from
+        // `1 - w`, which keeps too few of a small w's digits.
+        let width = (2.0 * w / self.end_weight).sqrt();
+        let mut x = if near_the_end(b, width) {
+            b - width
         } else {
             self.sample(1.0 - w)
         }
@@ -648,8 +654,7 @@ impl VisibleSlopeX {
             // Newton on a function of the share nearly linear in x: near the end, where the
             // share grows as `(b - x)^2`, its square root; elsewhere its log (log-concave, as the
             // upper tail of a log-concave density is, so the steps approach from one side).
-            let width = b - x;
-            let mut next = if width * (2.0 * b + width) <= 1.0 {
+            let mut next = if near_the_end(b, b - x) {
                 let root = share.sqrt();
                 x + 2.0 * (root - w.sqrt()) * root / density
             } else {
