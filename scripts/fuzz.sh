@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Fuzzes every reader kiln has with cargo-fuzz (libFuzzer): kiln's own files, engine files,
-# external tables, scenes and cache entries (fuzz/fuzz_targets/). Needs a nightly toolchain and
-# `cargo install cargo-fuzz`. Seeds each target's corpus with valid files (a small bake, the
-# vendored engine files, every preset as kiln writes it, the example scene), then runs each
+# external tables, scenes, cache entries and sets of shards for `kiln merge`
+# (fuzz/fuzz_targets/). Needs a nightly toolchain and `cargo install cargo-fuzz`. Seeds each
+# target's corpus with valid files (a small bake, the vendored engine files, every preset as
+# kiln writes it, the example scene, a shard and edit lists), then runs each
 # target for SECONDS (default 600) under a 1 GiB allocation limit, a 2 GiB RSS limit and a 5 s
 # per-input timeout. Findings land in fuzz/artifacts/TARGET/. Leak detection is off: rayon's
 # worker threads live as long as the process and keep their thread-local buffers (and exr's),
@@ -18,7 +19,7 @@ seconds=${1:-600}
 shift || true
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
-    targets=(kiln_file preset_file external_table scene cache_entry)
+    targets=(kiln_file preset_file external_table scene cache_entry shard_merge)
 fi
 corpus=fuzz/corpus
 seeds=$(mktemp -d)
@@ -27,7 +28,7 @@ cargo build --release --quiet
 kiln=target/release/kiln
 "$kiln" bake --quantity e,e-avg --size 6 --max-error 1e-3 \
     --format json,exr,bin,ktx2,dds,h,rs -q --out "$seeds/kiln"
-mkdir -p "$corpus"/{kiln_file,preset_file,external_table,scene,cache_entry}
+mkdir -p "$corpus"/{kiln_file,preset_file,external_table,scene,cache_entry,shard_merge}
 # kiln_file: a selector byte (json 0, exr 1, bin 2, ktx2 3, dds 4, h 5, rs 6), then the file.
 i=0
 for ext in json exr bin ktx2 dds h rs; do
@@ -52,6 +53,12 @@ done
 # external_table: selector 0 (text, 4 x 4, r slowest).
 { printf '\x00'; printf '0.9 0.95 0.99 1\n%.0s' 1 2 3 4; } > "$corpus/external_table/text"
 cp examples/scene.toml "$corpus/scene/"
+# shard_merge: a few edit lists (mode byte 0: digests recomputed after the edits) and one shard
+# as JSON (mode 0xff).
+printf '\x00\x02\x03' > "$corpus/shard_merge/size"
+printf '\x00\x0a\xff\x00\x00\x00\x00\x00\x00\xe0\x3f\x0c\x00' > "$corpus/shard_merge/values"
+"$kiln" bake --quantity e,e-avg --size 6 --max-error 1e-3 --shard 0/3 -q --out "$seeds/shards"
+{ printf '\xff'; cat "$seeds/shards/kiln-shard-0-of-3.json"; } > "$corpus/shard_merge/json"
 cd fuzz
 for target in "${targets[@]}"; do
     echo "== $target: $seconds s"

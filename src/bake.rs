@@ -149,8 +149,9 @@ impl BakeOptions {
             && !(Self::MIN_MAX_ERROR..=0.5).contains(&x)
         {
             return Err(Error::InvalidInput(format!(
-                "max-error must be between {:e} and 0.5 (got {x})",
-                Self::MIN_MAX_ERROR
+                "max-error must be between {:e} and 0.5 (got {})",
+                Self::MIN_MAX_ERROR,
+                crate::error::shown(x)
             )));
         }
         if self.mu_mapping == MuMapping::Adaptive
@@ -221,6 +222,84 @@ impl BakeOptions {
             .validate()
             .map_err(|e| Error::InvalidInput(e.replacen("--samples", flag, 1)))?;
         }
+        self.check_bounds()
+    }
+
+    /// The most memory a bake may hold, in bytes: its tables' channels (three f64 a texel) and
+    /// the estimates of the largest table while it is integrated.
+    pub const MAX_BAKE_BYTES: u64 = 8 << 30;
+
+    /// The longest bake kiln starts, in estimated seconds of one core
+    /// ([`BakeOptions::estimated_core_seconds`]; about 116 core-days, a week on 16 cores):
+    /// a plan beyond it is almost always a typo in a size or a sample count. Shard it, or ask
+    /// for fewer texels or digits.
+    pub const MAX_CORE_SECONDS: f64 = 1e7;
+
+    /// Checks the product of the axes, not only each axis: every table within
+    /// [`crate::table::MAX_TEXELS`] (what every reader accepts), the whole bake within
+    /// [`BakeOptions::MAX_BAKE_BYTES`] of memory and [`BakeOptions::MAX_CORE_SECONDS`] of
+    /// estimated time, before anything is allocated. Sharded bakes and merges run it too.
+    fn check_bounds(&self) -> Result<()> {
+        let specs = self.resolved().specs();
+        let shape = |spec: &TableSpec| {
+            spec.shape()
+                .iter()
+                .map(ToString::to_string)
+                .collect::<Vec<_>>()
+                .join(" x ")
+        };
+        let mut stored: u64 = 0;
+        let mut largest: u64 = 0;
+        for spec in &specs {
+            let texels = spec
+                .shape()
+                .iter()
+                .fold(1_u64, |n, &s| n.saturating_mul(s as u64));
+            if texels > crate::table::MAX_TEXELS as u64 {
+                return Err(Error::InvalidInput(format!(
+                    "{}: {} = {texels} texels, more than the {} (2^26) a table may hold (every \
+                     reader refuses more); nothing was written: lower the size{}",
+                    spec.id(),
+                    shape(spec),
+                    crate::table::MAX_TEXELS,
+                    if spec.ior.is_some() {
+                        " or the ior-size"
+                    } else {
+                        ""
+                    }
+                )));
+            }
+            stored = stored.saturating_add(texels.saturating_mul(24));
+            largest = largest.max(texels);
+        }
+        let estimate = std::mem::size_of::<Estimate>() as u64;
+        let bytes = stored.saturating_add(largest.saturating_mul(estimate));
+        if bytes > Self::MAX_BAKE_BYTES {
+            return Err(Error::InvalidInput(format!(
+                "the bake's {} tables ({}) would hold {:.1} GiB, more than the {} GiB kiln \
+                 allows a bake; nothing was written: bake fewer quantities or models at once, \
+                 or lower the size",
+                specs.len(),
+                specs
+                    .iter()
+                    .map(|s| format!("{} {}", s.id(), shape(s)))
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                bytes as f64 / f64::from(1 << 30),
+                Self::MAX_BAKE_BYTES >> 30
+            )));
+        }
+        let seconds: f64 = specs.iter().map(estimated_core_seconds).sum();
+        if seconds > Self::MAX_CORE_SECONDS {
+            return Err(Error::InvalidInput(format!(
+                "the bake would take an estimated {:.1e} core-seconds ({:.0} core-days), more \
+                 than the {:.0e} kiln starts; nothing was written: ask for fewer samples, \
+                 digits (a larger max-error) or texels",
+                seconds,
+                seconds / 86_400.0,
+                Self::MAX_CORE_SECONDS
+            )));
+        }
         Ok(())
     }
 
@@ -229,7 +308,8 @@ impl BakeOptions {
 
     /// The options `bake` runs with: these, or for a `max_error` the cheapest method that meets
     /// it, by what `kiln study` measured (GGX, 32 x 32, kiln's axes; README "What accuracy
-    /// costs"): from 1e-3 up, QMC with visible-normal sampling, whose max error over a table
+    /// costs"): from 1e-3 up (glass excepted, [`BakeOptions::bakes_glass`]), QMC with
+    /// visible-normal sampling, whose max error over a table
     /// falls as about `N^-0.9`, at the smallest power of two `N >= (2 / max_error)^(1 / 0.9)`
     /// (twice the margin; 16 times that for `E_avg`); below 1e-3, where it is cheaper at every
     /// accuracy, the quadrature at tolerance `10^-d`, the largest power of ten at most
@@ -251,7 +331,7 @@ impl BakeOptions {
         };
         let mut options = self.clone();
         options.check_against_reference = true;
-        if max_error >= 1e-3 {
+        if max_error >= 1e-3 && !self.bakes_glass() {
             let needed = (2.0 / max_error).powf(1.0 / 0.9).ceil() as u64;
             let samples = needed.next_power_of_two().max(64);
             options.method = Method::Qmc;
@@ -263,12 +343,22 @@ impl BakeOptions {
         options
     }
 
-    /// With a `max_error` below 1e-3: the quadrature's tolerance `10^-digits` (see
-    /// [`BakeOptions::resolved`]).
+    /// With a `max_error` the quadrature bakes (below 1e-3, or any for glass): its tolerance
+    /// `10^-digits` (see [`BakeOptions::resolved`]).
     #[must_use]
     pub fn reference_digits(&self) -> Option<u32> {
-        let max_error = self.max_error.filter(|&x| x < 1e-3)?;
+        let max_error = self.max_error.filter(|&x| x < 1e-3 || self.bakes_glass())?;
         Some((-max_error.log10() - 1e-9).ceil() as u32)
+    }
+
+    /// Whether a dielectric table is among the quantities: [`BakeOptions::resolved`] bakes
+    /// those by the quadrature at every `max_error`, since QMC at the sample count of the
+    /// reflection tables' rule missed the bound from inside (measured node error 2.0e-3 at
+    /// `--max-error 1e-3`, 1.1e-2 at 1e-2 in Cycles' convention; issue 40).
+    fn bakes_glass(&self) -> bool {
+        self.quantities
+            .iter()
+            .any(|q| q.has_ior() && *q != Quantity::FAvg)
     }
 
     /// The models baked, in a fixed order.
@@ -716,8 +806,9 @@ pub const MAX_IOR: f64 = crate::model::fresnel::MAX_INDEX;
 
 /// Checks a computed table before anything is written or claimed about it: every value and
 /// one-minus value finite, every error estimate finite and not negative (an infinite one marks
-/// a quadrature that did not converge, [`estimate_texel`]). The error names the first texel
-/// that fails, where it is and what to do.
+/// a quadrature that did not converge, [`estimate_texel`]), and then everything a reader
+/// checks ([`Table::check`]: values in `[0, 1]`, value and one-minus value adding up to 1).
+/// The error names the first texel that fails, where it is and what to do.
 ///
 /// # Errors
 /// As above.
@@ -774,7 +865,11 @@ pub fn check_computed(table: &Table) -> Result<()> {
             )));
         }
     }
-    Ok(())
+    // What every reader checks (spec, ranges, sums): a table no reader would take is never
+    // written, whether baked here or merged from shards.
+    table.check().map_err(|message| {
+        Error::InvalidInput(format!("{}: {message}; nothing was written", spec.id()))
+    })
 }
 
 /// The estimated cost of baking `spec`, in seconds of one core (divide by the threads): for

@@ -182,13 +182,13 @@ pub fn texel_cost(spec: &TableSpec, k: usize) -> f64 {
 #[must_use]
 pub fn partition(spec: &TableSpec, count: usize) -> Vec<(usize, usize)> {
     let n = spec.len();
-    let costs: Vec<f64> = (0..n).map(|k| texel_cost(spec, k)).collect();
-    let total: f64 = costs.iter().sum();
+    // The costs are summed twice rather than kept: a table of 2^26 texels would need 512 MiB.
+    let total: f64 = (0..n).map(|k| texel_cost(spec, k)).sum();
     let mut bounds = vec![0];
     let mut running = 0.0;
     let mut next = 1;
-    for (k, c) in costs.iter().enumerate() {
-        running += c;
+    for k in 0..n {
+        running += texel_cost(spec, k);
         while next < count && running >= total * next as f64 / count as f64 {
             bounds.push(k + 1);
             next += 1;
@@ -219,7 +219,10 @@ pub struct ShardTable {
 }
 
 impl ShardTable {
-    fn compute_digest(&self) -> String {
+    /// The digest of the share's numbers, as [`ShardTable::digest`] should hold it (FNV-1a:
+    /// a check against damage, not a signature; anyone can recompute it).
+    #[must_use]
+    pub fn compute_digest(&self) -> String {
         let json = serde_json::to_vec(&(
             &self.spec,
             self.range,
@@ -424,6 +427,12 @@ pub fn merge(shards: &[(PathBuf, ShardFile)]) -> Result<(ShardedBake, Vec<Table>
         return Err(Error::InvalidInput("no shard files to merge".into()));
     };
     let count = first.count;
+    // Each shard's own index and count within what `--shard` accepts, before any is used to
+    // size anything.
+    for (path, shard) in shards {
+        ShardIndex::new(shard.index, shard.count)
+            .map_err(|e| Error::InvalidInput(format!("{}: index and count: {e}", name(path))))?;
+    }
     for (path, shard) in shards {
         if shard.bake_digest != first.bake_digest
             || shard.bake != first.bake
@@ -458,6 +467,15 @@ pub fn merge(shards: &[(PathBuf, ShardFile)]) -> Result<(ShardedBake, Vec<Table>
             )));
         }
     }
+    // The options are covered by the bake digest, which anyone can recompute: they get every
+    // check `kiln bake` applies (each axis, their product, memory, time) before anything is
+    // sized by them.
+    first.bake.options.validate().map_err(|e| {
+        Error::InvalidInput(format!(
+            "{}: its bake options are not a bake kiln runs: {e}",
+            name(first_path)
+        ))
+    })?;
     let specs = integrated_specs(&first.bake.options);
     let mut by_index: Vec<Option<&(PathBuf, ShardFile)>> = vec![None; count];
     for entry in shards {
@@ -511,13 +529,12 @@ pub fn merge(shards: &[(PathBuf, ShardFile)]) -> Result<(ShardedBake, Vec<Table>
             continue;
         }
         let ranges = partition(&spec, count);
-        let (mut value, mut one_minus_value, mut std_error, mut check) = (
-            Vec::with_capacity(spec.len()),
-            Vec::with_capacity(spec.len()),
-            Vec::with_capacity(spec.len()),
-            Vec::new(),
-        );
+        // Grown from the shards' own numbers, each checked against its range first: nothing is
+        // sized by what a shard claims.
+        let (mut value, mut one_minus_value, mut std_error, mut check) =
+            (Vec::new(), Vec::new(), Vec::new(), Vec::new());
         let plan = first.bake.options.check_plan(&options, &spec);
+        let mut shares = Vec::with_capacity(count);
         for (index, entry) in by_index.iter().enumerate() {
             let (path, shard) = entry.expect("checked above");
             let range = ranges[index];
@@ -582,7 +599,14 @@ pub fn merge(shards: &[(PathBuf, ShardFile)]) -> Result<(ShardedBake, Vec<Table>
             one_minus_value.extend(&piece.one_minus_value);
             std_error.extend(&piece.std_error);
             check.extend(&piece.check);
+            shares.push(Share {
+                path,
+                index,
+                range,
+                piece,
+            });
         }
+        confirm_shares(&spec, &shares, plan.as_ref())?;
         let table = Table {
             spec,
             value,
@@ -599,4 +623,137 @@ pub fn merge(shards: &[(PathBuf, ShardFile)]) -> Result<(ShardedBake, Vec<Table>
         t += 1;
     }
     Ok((first.bake.clone(), tables))
+}
+
+/// One shard's share of a table, as the merge found it.
+struct Share<'a> {
+    path: &'a Path,
+    index: usize,
+    range: (usize, usize),
+    piece: &'a ShardTable,
+}
+
+/// Texels and check terms the merge computes again per table, spread over the shards (at least
+/// one of each per shard): [`confirm_shares`].
+pub const MERGE_CONFIRMATIONS: usize = 16;
+
+/// `m` of the `n` positions `0..n`, evenly spread from an offset keyed by `key` (a shard's
+/// digest: an edit moves them).
+fn keyed_positions(n: usize, m: usize, key: &str) -> Vec<usize> {
+    let m = m.min(n);
+    let offset = (fnv1a(key.as_bytes()) % n.max(1) as u64) as usize;
+    (0..m).map(|j| (offset + j * n / m) % n).collect()
+}
+
+/// Whether `a` and `b` differ by at most `tolerance` (false if either is NaN).
+fn agrees(a: f64, b: f64, tolerance: f64) -> bool {
+    (a - b).abs() <= tolerance
+}
+
+/// Confirms what the shards claim about `spec` by computing part of it again, since a digest
+/// proves only that a file is as its writer left it, and anyone can recompute it: at
+/// [`MERGE_CONFIRMATIONS`] texels spread over the shards (positions keyed by each share's
+/// digest), the texel's estimate ([`estimate_texel`], deterministic) must be the stored value
+/// and error estimate; at as many of the check's texels, the check's term (the node error
+/// against the reference, [`crate::verify::node_error_terms`]) must be the one the shard
+/// states. Both agree to within a thousandth of their own error estimate (a last-digit
+/// difference of another machine's maths library passes; an edit does not). The error names
+/// the shard file, the table and the texel.
+fn confirm_shares(
+    spec: &TableSpec,
+    shares: &[Share<'_>],
+    plan: Option<&(Vec<usize>, crate::integrate::reference::ReferenceSettings)>,
+) -> Result<()> {
+    let per_share = MERGE_CONFIRMATIONS.div_ceil(shares.len().max(1));
+    let again = |share: &Share<'_>, what: &str, k: usize, stored: f64, computed: f64| {
+        Error::InvalidInput(format!(
+            "{}: {what} of {} at texel {k} is {stored:e}, but kiln computes {computed:e} there: \
+             the shard was edited, or baked by another build of kiln; nothing was written. Run \
+             shard {} of {} again",
+            share.path.display(),
+            spec.id(),
+            share.index,
+            shares.len()
+        ))
+    };
+    let texels: Vec<(usize, usize)> = shares
+        .iter()
+        .enumerate()
+        .flat_map(|(s, share)| {
+            let n = share.range.1 - share.range.0;
+            keyed_positions(n, per_share, &share.piece.digest)
+                .into_iter()
+                .map(move |j| (s, j))
+        })
+        .collect();
+    let estimates: Vec<_> = texels
+        .par_iter()
+        .map(|&(s, j)| estimate_texel(spec, shares[s].range.0 + j))
+        .collect();
+    for (&(s, j), computed) in texels.iter().zip(&estimates) {
+        let share = &shares[s];
+        let k = share.range.0 + j;
+        let tolerance = (1e-3 * computed.std_error).max(1e-13);
+        for (what, stored, computed) in [
+            ("the value", share.piece.value[j], computed.value),
+            (
+                "the one-minus value",
+                share.piece.one_minus_value[j],
+                computed.one_minus_value,
+            ),
+            (
+                "the error estimate",
+                share.piece.std_error[j],
+                computed.std_error,
+            ),
+        ] {
+            if !agrees(stored, computed, tolerance) {
+                return Err(again(share, what, k, stored, computed));
+            }
+        }
+    }
+    let Some((indices, settings)) = plan else {
+        return Ok(());
+    };
+    // The check's texels of each share, in order, and their terms in the share's list.
+    let mut terms = Vec::new();
+    for (s, share) in shares.iter().enumerate() {
+        let mine: Vec<usize> = indices
+            .iter()
+            .copied()
+            .filter(|k| (share.range.0..share.range.1).contains(k))
+            .collect();
+        for j in keyed_positions(mine.len(), per_share, &share.piece.digest) {
+            terms.push((s, j, mine[j]));
+        }
+    }
+    let at: Vec<usize> = terms.iter().map(|t| t.2).collect();
+    let computed = crate::verify::node_error_terms(
+        spec,
+        &at,
+        &|k| {
+            let share = shares
+                .iter()
+                .find(|s| (s.range.0..s.range.1).contains(&k))
+                .expect("a check texel lies in a share");
+            let j = k - share.range.0;
+            (share.piece.value[j], share.piece.one_minus_value[j])
+        },
+        settings,
+    );
+    let tolerance = (1e-3 * settings.tolerance).max(1e-13);
+    for (&(s, j, k), &(error, converged)) in terms.iter().zip(&computed) {
+        let share = &shares[s];
+        let (stated, stated_converged) = share.piece.check[j];
+        if !agrees(stated, error, tolerance) || stated_converged != converged {
+            return Err(again(
+                share,
+                "the stated node error against the reference",
+                k,
+                stated,
+                error,
+            ));
+        }
+    }
+    Ok(())
 }

@@ -152,7 +152,7 @@ fn glass_arrays_sit_where_blender_indexes_them_on_blender_s_axes() {
 
 /// Cycles includes `shader.tables` outside its namespace (the file opens and closes it), so
 /// kiln's must compile that way, declaring exactly Blender's arrays with Blender's sizes; with
-/// `--carry-over` the LTC table is Blender's declaration byte for byte.
+/// `--carry-over` the LTC table holds Blender's numbers.
 #[test]
 fn kiln_s_shader_tables_compiles_as_cycles_includes_it() {
     let blender = std::fs::read_to_string(engine_file("cycles/shader.tables")).unwrap();
@@ -165,10 +165,24 @@ fn kiln_s_shader_tables_compiles_as_cycles_includes_it() {
         .unwrap();
     let text = String::from_utf8(files[0].1.clone()).unwrap();
     assert_eq!(declarations(&text), declarations(&blender));
-    let ltc = |t: &str| {
-        let at = t.find("static const float table_sheen_ltc[").unwrap();
-        t[at..at + t[at..].find("};").unwrap()].to_string()
+    // The LTC numbers are Blender's, bit for bit as the compiler stores them (negative zeros
+    // included), re-emitted by kiln: nothing but the declaration and numbers between its braces.
+    let ltc = |t: &str| -> Vec<u32> {
+        let at = t
+            .find("static const float table_sheen_ltc[3072] = {")
+            .unwrap();
+        let body = &t[at + 45..at + t[at..].find("};").unwrap()];
+        body.split(',')
+            .map(|s| s.trim().trim_end_matches('f'))
+            .filter(|s| !s.is_empty())
+            .map(|s| {
+                s.parse::<f32>()
+                    .unwrap_or_else(|_| panic!("{s:?}"))
+                    .to_bits()
+            })
+            .collect()
     };
+    assert_eq!(ltc(&blender).len(), 3072);
     assert_eq!(ltc(&text), ltc(&blender));
     // A file whose array is not numbers of its declared size is refused, not copied.
     for bad in [

@@ -6,6 +6,7 @@
 
 pub mod binary;
 pub mod c_header;
+pub mod comment;
 #[cfg(feature = "containers")]
 pub mod dds;
 pub mod exr;
@@ -279,14 +280,17 @@ pub fn read_file(path: &Path) -> Result<Vec<u8>> {
 }
 
 /// Checks that `dir` exists or can be created, and that kiln can create files in it: called
-/// before long work so that a bad `--out` fails at once, not after the bake.
+/// before long work so that a bad `--out` fails at once, not after the bake. A folder it had to
+/// create for the check is removed again (the files' writer creates it when there is something
+/// to write), so a refusal or an interrupt later leaves no empty folder behind.
 pub fn check_output_dir(dir: &Path) -> Result<()> {
-    std::fs::create_dir_all(dir).map_err(|source| Error::Io {
-        path: dir.to_path_buf(),
-        action: "create the output directory",
-        source,
-    })?;
-    tempfile::Builder::new()
+    // The folders that do not exist yet, deepest first.
+    let missing: Vec<&Path> = dir
+        .ancestors()
+        .take_while(|a| !a.as_os_str().is_empty() && !a.exists())
+        .collect();
+    create_output_dir(dir)?;
+    let probe = tempfile::Builder::new()
         .prefix(".kiln-probe-")
         .tempfile_in(dir)
         .map(drop)
@@ -294,13 +298,26 @@ pub fn check_output_dir(dir: &Path) -> Result<()> {
             path: dir.to_path_buf(),
             action: "write to the output directory",
             source,
-        })
+        });
+    for created in missing {
+        // Fails, harmlessly, if another process has put something there meanwhile.
+        let _ = std::fs::remove_dir(created);
+    }
+    probe
+}
+
+fn create_output_dir(dir: &Path) -> Result<()> {
+    std::fs::create_dir_all(dir).map_err(|source| Error::Io {
+        path: dir.to_path_buf(),
+        action: "create the output directory",
+        source,
+    })
 }
 
 /// Writes `(file name, bytes)` pairs into `dir` all-or-nothing (as far as a file system allows):
 /// each goes to a temporary file first; only when all were written are they renamed into place.
 pub fn write_files(dir: &Path, files: &[(String, Vec<u8>)]) -> Result<Vec<PathBuf>> {
-    check_output_dir(dir)?;
+    create_output_dir(dir)?;
     remove_stale_temporaries(dir);
     let mut staged = Vec::with_capacity(files.len());
     for (name, bytes) in files {

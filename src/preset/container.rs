@@ -6,6 +6,7 @@ use super::layout::{Channel, Container, Layout, Normalisation};
 use super::{ExtraChannel, Files};
 use crate::error::{Error, Result};
 use crate::format::Precision;
+use crate::format::comment::safe;
 use crate::format::texture::Texture;
 use crate::model::dielectric::TransmissionConvention;
 use crate::table::{Quantity, Table};
@@ -178,7 +179,7 @@ pub(super) fn encode(
                      rounded to 8 bits; regenerate: {}",
                     crate::format::metadata::KILN_VERSION,
                     quantity.symbol(),
-                    table.command
+                    safe(&table.command)
                 );
                 let bytes =
                     crate::format::png::encode_grey8((n, n), &plane, &comment).map_err(invalid)?;
@@ -215,7 +216,7 @@ pub(super) fn encode_normalisation(form: Normalisation, norm: &Table) -> Result<
                  Regenerate: {}\n */\n",
                 crate::format::metadata::KILN_VERSION,
                 rows - 1,
-                norm.command
+                safe(&norm.command)
             );
             crate::format::c_header::float_array(&mut out, "table_ggx_f_ms_norm", &norm.value);
             Ok(out.into_bytes())
@@ -496,43 +497,42 @@ pub(super) fn decode(
     }
 }
 
-/// The engine's arrays that kiln does not compute ([`Layout::carried`]), taken from the engine's
-/// own file to be written back verbatim.
-#[derive(Clone, Debug, PartialEq, Eq)]
+/// The engine's arrays that kiln does not compute ([`Layout::carried`]), read from the engine's
+/// own file as numbers and written back by kiln: nothing of the file's text but the numbers'
+/// values reaches the output (no declaration, no comment, no token between the numbers).
+#[derive(Clone, Debug, PartialEq)]
 pub struct Carried {
-    /// Where they come from, for the file's header.
+    /// Where they come from, for the file's header (written through
+    /// [`crate::format::comment::safe`]).
     pub origin: String,
-    /// Each array's declaration, `static const float name[N] = { ... };`, as the file has it.
-    pub declarations: Vec<String>,
+    /// Each array: the layout's name for it and its numbers, as the C compiler stores them.
+    pub arrays: Vec<(&'static str, Vec<f32>)>,
 }
 
 impl Carried {
     /// The layout's carried arrays from the engine's file `bytes` (named `origin`).
     ///
     /// # Errors
-    /// If the file lacks one of them.
+    /// If the file lacks one of them, or its braces hold anything but its declared number of
+    /// finite numbers (C float literals, `f` suffixes allowed).
     pub fn from_file(layout: &Layout, bytes: &[u8], origin: &str) -> Result<Self> {
         let text = String::from_utf8_lossy(bytes);
-        let declarations = layout
+        let shown = crate::error::quoted(origin);
+        let arrays = layout
             .carried
             .iter()
-            .map(|name| {
-                let declaration = c_declaration(&text, name).ok_or_else(|| {
+            .map(|&name| {
+                let (declared, body) = c_declaration(&text, name).ok_or_else(|| {
                     Error::InvalidInput(format!(
-                        "{origin} has no array {name} to carry over (expected `static const \
+                        "{shown} has no array {name} to carry over (expected `static const \
                          float {name}[N] = {{ ... }};`, as in Blender's shader.tables)"
                     ))
                 })?;
-                // Copied verbatim, so it must be nothing but N numbers.
-                let declared = declaration
-                    .split_once('[')
-                    .and_then(|(_, rest)| rest.split_once(']'))
-                    .and_then(|(n, _)| n.trim().parse::<usize>().ok());
-                let values = c_array(&declaration, name);
+                let values = c_numbers(body);
                 match (declared, values) {
-                    (Some(n), Some(values)) if values.len() == n => Ok(declaration),
+                    (Some(n), Some(values)) if values.len() == n => Ok((name, values)),
                     (declared, values) => Err(Error::InvalidInput(format!(
-                        "{origin}: {name} is not an array of numbers of its declared size \
+                        "{shown}: {name} is not an array of numbers of its declared size \
                          ({} declared, {} numbers read): not carried over",
                         declared.map_or("no size".to_string(), |n| n.to_string()),
                         values.map_or("no".to_string(), |v| v.len().to_string())
@@ -542,26 +542,82 @@ impl Carried {
             .collect::<Result<_>>()?;
         Ok(Self {
             origin: origin.to_string(),
-            declarations,
+            arrays,
         })
     }
 }
 
-/// The whole declaration of the C array `name`, from `static` (or the name, without it) to its
-/// closing `};`.
-fn c_declaration(text: &str, name: &str) -> Option<String> {
+/// The declaration of the C array `name`: its declared size (`None` if not a whole number)
+/// and the text between its braces, from the first `name[` on (not `name` inside a longer
+/// identifier).
+fn c_declaration<'a>(text: &'a str, name: &str) -> Option<(Option<usize>, &'a str)> {
     let mut from = 0;
     loop {
         let at = from + text[from..].find(name)?;
+        let before = text[..at].chars().next_back();
         let after = &text[at + name.len()..];
-        if !after.starts_with('[') {
+        if before.is_some_and(|c| c.is_ascii_alphanumeric() || c == '_') || !after.starts_with('[')
+        {
             from = at + name.len();
             continue;
         }
-        let line_start = text[..at].rfind('\n').map_or(0, |k| k + 1);
-        let end = at + after.find("};")? + name.len() + 2;
-        return Some(text[line_start..end].to_string());
+        let (size, rest) = after[1..].split_once(']')?;
+        let (_, rest) = rest.split_once('{')?;
+        let (body, _) = rest.split_once('}')?;
+        return Some((size.trim().parse::<usize>().ok(), body));
     }
+}
+
+/// The numbers of a C array's braces: comma-separated C float literals (digits, one point, an
+/// exponent, an `f` suffix, a sign) and nothing else but white space; `None` if any item is
+/// something else or not finite.
+fn c_numbers(body: &str) -> Option<Vec<f32>> {
+    let mut items: Vec<&str> = body.split(',').map(str::trim).collect();
+    // A trailing comma leaves one empty item.
+    if items.last() == Some(&"") {
+        items.pop();
+    }
+    items
+        .into_iter()
+        .map(|item| {
+            let number = item.strip_suffix(['f', 'F']).unwrap_or(item);
+            let literal = !number.is_empty()
+                && number
+                    .chars()
+                    .all(|c| c.is_ascii_digit() || matches!(c, '.' | 'e' | 'E' | '+' | '-'));
+            let value = number.parse::<f32>().ok().filter(|v| v.is_finite());
+            value.filter(|_| literal)
+        })
+        .collect()
+}
+
+/// Appends a carried array as Blender writes its own: `static const float name[N] = {`, 32
+/// numbers a line indented by two spaces, each with five decimals where that is the number
+/// (else the shortest literal that is), `};`.
+fn carried_array(out: &mut String, name: &str, values: &[f32]) {
+    let literal = |v: f32| {
+        let five = format!("{v:.5}");
+        if five.parse::<f32>().map(f32::to_bits) == Ok(v.to_bits()) {
+            format!("{five}f")
+        } else {
+            let shortest = format!("{v:?}");
+            if shortest.contains(['.', 'e']) {
+                format!("{shortest}f")
+            } else {
+                format!("{shortest}.0f")
+            }
+        }
+    };
+    let _ = write!(out, "static const float {name}[{}] = {{", values.len());
+    for (k, &v) in values.iter().enumerate() {
+        out.push_str(match (k % 32, k) {
+            (_, 0) => "\n  ",
+            (0, _) => ",\n  ",
+            _ => ", ",
+        });
+        out.push_str(&literal(v));
+    }
+    out.push_str("\n};\n\n");
 }
 
 /// Cycles' `shader.tables`: each array of the layout under its name (2-D tables in the layout's
@@ -616,8 +672,9 @@ fn cycle_tables(
             Some(c) => {
                 let _ = writeln!(
                     header,
-                    " * {name}: not made by kiln (an LTC fit), carried over from {}.",
-                    c.origin
+                    " * {name}: not made by kiln (an LTC fit), its numbers carried over from \
+                     {}.",
+                    safe(&c.origin)
                 );
             }
             None => {
@@ -635,7 +692,7 @@ fn cycle_tables(
     let _ = write!(
         out,
         " * Regenerate: {}\n */\n\nCCL_NAMESPACE_BEGIN\n\n",
-        tables[0].command
+        safe(&tables[0].command)
     );
     for &(name, quantity) in arrays {
         let glass = quantity.has_ior().then_some(layout.glass).flatten();
@@ -658,9 +715,8 @@ fn cycle_tables(
         out.push('\n');
     }
     if let Some(c) = carried {
-        for declaration in &c.declarations {
-            out.push_str(declaration);
-            out.push_str("\n\n");
+        for (name, values) in &c.arrays {
+            carried_array(&mut out, name, values);
         }
     }
     out.push_str("CCL_NAMESPACE_END\n");
@@ -730,8 +786,9 @@ fn filament_include(
         "// kiln {}: Filament's DFG LUT (dfg.inc), {n} x {n} RGB16F half-float bits in GL \
          order,\n// x = NoV = (i + 0.5) / {n}, y = perceptual roughness = (j + 0.5) / {n} \
          (alpha = r^2), texel centres.\n// R = integral of Fc f mu_i, G = integral of f mu_i \
-         (GGX, height-correlated, F = 1);\n// B = {blue}.\n// Regenerate: {command}\n",
+         (GGX, height-correlated, F = 1);\n// B = {blue}.\n// Regenerate: {}\n",
         crate::format::metadata::KILN_VERSION,
+        safe(command)
     );
     for k in 0..n * n {
         for (_, plane) in planes {
@@ -783,7 +840,7 @@ fn three_module(n: usize, planes: &[(String, Vec<f64>)], command: &str) -> Strin
          '../../textures/DataTexture.js';\nimport {{ RGFormat, HalfFloatType, LinearFilter, \
          ClampToEdgeWrapping }} from '../../constants.js';\n\nconst DATA = new Uint16Array( [",
         crate::format::metadata::KILN_VERSION,
-        command.replace("*/", "* /")
+        safe(command)
     );
     for row in 0..n {
         out.push_str("\n\t");
