@@ -53,6 +53,24 @@ impl std::error::Error for Error {
 /// kiln's result type.
 pub type Result<T> = std::result::Result<T, Error>;
 
+/// A number computed from the user's (`alpha = r^2`) as a message shows it: [`shown`] of it
+/// rounded to 12 significant digits (`0.058655027344`, not `0.058655027343999994`).
+#[must_use]
+pub fn brief(x: f64) -> String {
+    let rounded = format!("{x:.11e}").parse::<f64>().unwrap_or(x);
+    shown(rounded)
+}
+
+/// `1 table`, `3 tables`: a count with its noun, singular for one.
+#[must_use]
+pub fn count(n: usize, noun: &str) -> String {
+    if n == 1 {
+        format!("1 {noun}")
+    } else {
+        format!("{n} {noun}s")
+    }
+}
+
 /// A number as a message shows it: plainly between 1e-4 and 1e6, in scientific notation beyond
 /// (`1e155`, not 156 digits).
 #[must_use]

@@ -382,6 +382,16 @@ impl Scene {
                 crate::BakeOptions::MIN_MAX_ERROR
             )));
         }
+        // What the plan lists, the bake bakes: each of its bakes passes every check `kiln bake`
+        // applies, here, so that `kiln plan` refuses what `kiln bake --scene` would.
+        for (options, effect, _) in self.needs() {
+            options.validate().map_err(|e| {
+                bad(format!(
+                    "the tables for {} cannot be baked: {e}",
+                    effect.map_or("the engine", Effect::name)
+                ))
+            })?;
+        }
         Ok(())
     }
 
@@ -521,8 +531,12 @@ impl Scene {
                 needs.push((base.clone(), Some(Effect::MultipleScattering), model));
             }
             if asked(Effect::ImageBasedLighting) {
+                // The split-sum channels vary with mu on a mirror (`Fc(mu) = (1 - mu)^5`),
+                // which the adaptive mu axis cannot follow: on kiln's linear mu axis, as
+                // `kiln bake --quantity e-scale,e-bias --mu-axis linear` and the engines' own.
                 let split_sum = crate::BakeOptions {
                     quantities: vec![Quantity::EScale, Quantity::EBias],
+                    mu_mapping: crate::MuMapping::Linear,
                     ..base.clone()
                 };
                 needs.push((split_sum, Some(Effect::ImageBasedLighting), model));

@@ -949,7 +949,6 @@ fn fresnel_flags_on_bake_and_verify() {
         "--density",
         "1",
         "--json",
-        "-q",
     ];
     let mut args = vec!["verify", external.to_str().unwrap()];
     args.extend(layout);
@@ -999,7 +998,6 @@ fn presets_bake_and_verify() {
         "three",
         file.to_str().unwrap(),
         "--json",
-        "-q",
         "--density",
         "1",
     ]);

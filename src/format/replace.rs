@@ -118,6 +118,52 @@ pub fn precheck(
     check(dir, specs, &planned_names(specs, formats), replace).map(drop)
 }
 
+/// The fields in which the spec `there` (an existing file's) differs from `here` (this
+/// bake's), as `field (THERE in the file, HERE here)`, by the names files are written with;
+/// nested fields joined by dots (`qmc.seed`).
+#[must_use]
+pub fn differences(there: &TableSpec, here: &TableSpec) -> Vec<String> {
+    fn walk(path: &str, a: &serde_json::Value, b: &serde_json::Value, out: &mut Vec<String>) {
+        use serde_json::Value;
+        match (a, b) {
+            (Value::Object(x), Value::Object(y)) => {
+                let mut keys: Vec<&String> = x.keys().chain(y.keys()).collect();
+                keys.sort();
+                keys.dedup();
+                for key in keys {
+                    let field = if path.is_empty() {
+                        key.clone()
+                    } else {
+                        format!("{path}.{key}")
+                    };
+                    walk(
+                        &field,
+                        x.get(key).unwrap_or(&Value::Null),
+                        y.get(key).unwrap_or(&Value::Null),
+                        out,
+                    );
+                }
+            }
+            // serde_json writes any text escaped (no control characters); long values are cut.
+            _ if a != b => out.push(format!(
+                "{path} ({} in the file, {} here)",
+                crate::error::quoted(&a.to_string()).trim_matches('\''),
+                crate::error::quoted(&b.to_string()).trim_matches('\'')
+            )),
+            _ => {}
+        }
+    }
+    let mut out = Vec::new();
+    match (serde_json::to_value(there), serde_json::to_value(here)) {
+        (Ok(a), Ok(b)) => walk("", &a, &b, &mut out),
+        _ => out.push("a field that does not serialise".into()),
+    }
+    if out.is_empty() {
+        out.push("nothing serialised (please report it)".into());
+    }
+    out
+}
+
 /// Checks the files of the tables of `specs` already in `dir` against the rule above, given the
 /// names of the files this bake writes. Returns the files to remove once the new ones are in
 /// place (only with [`Replace::Force`]); an error naming the files otherwise.
@@ -152,7 +198,13 @@ pub fn check(
             }
             let made = spec.map_or_else(
                 || "of unknown spec".to_string(),
-                |spec| format!("made to {}", describe(&spec)),
+                |spec| {
+                    format!(
+                        "made to {} (differing in {})",
+                        describe(&spec),
+                        differences(&spec, table_spec).join(", ")
+                    )
+                },
             );
             match found.iter_mut().find(|(m, _)| *m == made) {
                 Some((_, extensions)) => extensions.push(format.name()),

@@ -429,6 +429,14 @@ pub fn read_external(path: &Path, encoding: &Encoding, layout: &Layout) -> Resul
     let bytes = read(path)?;
     let values: Vec<f64> = match encoding {
         Encoding::Text => {
+            if bytes.starts_with(b"\x89PNG") {
+                return Err(invalid(
+                    path,
+                    "a PNG image, not a table of numbers: an engine's 8-bit PNG table is read \
+                     with --preset games202; --shape reads text (numbers) or, with --dtype, raw \
+                     floats",
+                ));
+            }
             let text = String::from_utf8(bytes)
                 .map_err(|_| invalid(path, "not text (use --dtype for raw floats)"))?;
             let mut values = Vec::new();

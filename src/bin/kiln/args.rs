@@ -59,9 +59,12 @@ pub fn parse_mu(text: &str) -> Result<f64, String> {
     parse_in(text, 0.0, 1.0, "mu is cos(theta) and")
 }
 
-/// A perceptual roughness `r` in [0, 1000].
+/// A perceptual roughness `r` in [0, 1].
 pub fn parse_roughness(text: &str) -> Result<f64, String> {
-    parse_in(text, 0.0, 1e3, "perceptual roughness r")
+    // The range of every table and scene; rougher surfaces by --alpha (alpha = r^2 > 1).
+    parse_in(text, 0.0, 1.0, "perceptual roughness r").map_err(|e| {
+        format!("{e} (tables and scenes span r in [0, 1]; for alpha above 1 give --alpha)")
+    })
 }
 
 /// A slope-space roughness `alpha` in [0, 1000].

@@ -59,17 +59,19 @@ pub struct BakeArgs {
     #[arg(long, default_value_t = BakeOptions::DEFAULT_SIZE, value_parser = parse_size, allow_negative_numbers = true)]
     size: usize,
     /// Samples on the IOR axis of the dielectric tables and f-avg (their roughness and mu
-    /// axes have --size samples; Cycles' glass tables are 16 x 16 x 16). 2 to 4096.
-    #[arg(long, default_value_t = BakeOptions::DEFAULT_IOR_SIZE, value_parser = parse_size, allow_negative_numbers = true)]
-    ior_size: usize,
+    /// axes have --size samples; Cycles' glass tables are 16 x 16 x 16). 2 to 4096
+    /// [default: 16]. Only with a table over the IOR.
+    #[arg(long, value_parser = parse_size, allow_negative_numbers = true)]
+    ior_size: Option<usize>,
     /// Spacing of the IOR axis over [1, --ior-max]: cycles (linear in sqrt((eta - 1) /
     /// (eta + 1)), denser near eta = 1 where the inside tables change fastest) or linear.
-    /// The axis lists eta >= 1; inside tables are computed at 1 / eta.
-    #[arg(long, value_enum, default_value = "cycles")]
-    ior_axis: IorMapping,
-    /// The top of the IOR axis, above 1 (Unreal's glass table goes to 3; diamond is 2.42).
-    #[arg(long, default_value_t = BakeOptions::DEFAULT_IOR_MAX, allow_negative_numbers = true)]
-    ior_max: f64,
+    /// The axis lists eta >= 1; inside tables are computed at 1 / eta [default: cycles].
+    #[arg(long, value_enum)]
+    ior_axis: Option<IorMapping>,
+    /// The top of the IOR axis, above 1 (Unreal's glass table goes to 3; diamond is 2.42)
+    /// [default: 3].
+    #[arg(long, allow_negative_numbers = true)]
+    ior_max: Option<f64>,
     /// How the dielectric tables count a refraction that ends on the incident side of the
     /// surface: single-scattering (lost, as the BSDF evaluates it; kiln's default) or cycles
     /// (kept, and an index within 1e-4 of 1 smooth, as Cycles' sampler computed Blender's glass
@@ -216,6 +218,7 @@ pub fn run(args: BakeArgs) -> kiln::Result<()> {
     }
     let out = args.out.clone().unwrap_or_else(|| PathBuf::from("tables"));
     check_method_flags(&args)?;
+    check_ior_flags(&args)?;
     let replace = args.replace();
     // Naming a method or a sample count asks for that method; otherwise a max error decides.
     let explicit_method =
@@ -258,9 +261,9 @@ pub fn run(args: BakeArgs) -> kiln::Result<()> {
         roughness_convention: args.roughness_axis,
         mu_mapping: args.mu_axis,
         grid: args.grid,
-        ior_size: args.ior_size,
-        ior_mapping: args.ior_axis,
-        ior_max: args.ior_max,
+        ior_size: args.ior_size.unwrap_or(BakeOptions::DEFAULT_IOR_SIZE),
+        ior_mapping: args.ior_axis.unwrap_or(IorMapping::Cycles),
+        ior_max: args.ior_max.unwrap_or(BakeOptions::DEFAULT_IOR_MAX),
         transmission: args.transmission,
         check_against_reference: !args.no_reference_check,
         method: args.method.unwrap_or(Method::Qmc),
@@ -315,9 +318,9 @@ pub fn run(args: BakeArgs) -> kiln::Result<()> {
             );
         }
         println!(
-            "baked {} tables in {seconds:.1} s; wrote {} files to {}",
-            tables.len(),
-            written.len(),
+            "baked {} in {seconds:.1} s; wrote {} to {}",
+            kiln::error::count(tables.len(), "table"),
+            kiln::error::count(written.len(), "file"),
             out.display()
         );
     }
@@ -359,8 +362,34 @@ fn bake_shard(
     Ok(())
 }
 
+/// The IOR axis' flags are errors for a bake without a table over the IOR, which would ignore
+/// them (and record nothing of them).
+fn check_ior_flags(args: &BakeArgs) -> kiln::Result<()> {
+    let given = crate::args::given(&[
+        ("--ior-size", args.ior_size.is_some()),
+        ("--ior-axis", args.ior_axis.is_some()),
+        ("--ior-max", args.ior_max.is_some()),
+    ]);
+    let over_ior = args
+        .quantity
+        .as_ref()
+        .is_some_and(|qs| qs.iter().any(|q| q.has_ior()));
+    if given.is_empty() || over_ior {
+        return Ok(());
+    }
+    Err(kiln::Error::InvalidInput(format!(
+        "{} {} the IOR axis, which none of the tables baked has: add a glass table \
+         (--quantity e-dielectric, e-dielectric-inside, e-avg-dielectric, \
+         e-avg-dielectric-inside or f-avg), or drop {}",
+        given.join(", "),
+        if given.len() == 1 { "sets" } else { "set" },
+        if given.len() == 1 { "it" } else { "them" }
+    )))
+}
+
 /// Flags that only QMC reads are errors with a method that does not read them, rather than
-/// being ignored or switching the method.
+/// being ignored or switching the method: `--method reference`, or a `--max-error` (the
+/// default 1e-7 included) below 1e-3, which kiln bakes by the quadrature.
 fn check_method_flags(args: &BakeArgs) -> kiln::Result<()> {
     let qmc_chosen = args.method == Some(Method::Qmc)
         || (args.method.is_none() && (args.samples.is_some() || args.avg_samples.is_some()));
@@ -371,6 +400,30 @@ fn check_method_flags(args: &BakeArgs) -> kiln::Result<()> {
              against the reference to --max-error)"
                 .into(),
         ));
+    }
+    let explicit_method =
+        args.method.is_some() || args.samples.is_some() || args.avg_samples.is_some();
+    let max_error = args
+        .max_error
+        .or((!explicit_method).then_some(BakeOptions::DEFAULT_MAX_ERROR));
+    let by_quadrature = args.method == Some(Method::Reference)
+        || (args.method.is_none() && max_error.is_some_and(|x| x < 1e-3));
+    if by_quadrature && args.method != Some(Method::Reference) {
+        let qmc_only = crate::args::given(&[
+            ("--scrambles", args.scrambles.is_some()),
+            ("--seed", args.seed.is_some()),
+        ]);
+        if !qmc_only.is_empty() {
+            return Err(kiln::Error::InvalidInput(format!(
+                "{} {} QMC's sampling, but --max-error {} is baked by the deterministic \
+                 quadrature, which has neither (kiln uses QMC from 1e-3 up): drop {}, or add \
+                 --method qmc --samples N to bake by QMC",
+                qmc_only.join(", "),
+                if qmc_only.len() == 1 { "sets" } else { "set" },
+                kiln::error::shown(max_error.unwrap_or(BakeOptions::DEFAULT_MAX_ERROR)),
+                if qmc_only.len() == 1 { "it" } else { "them" }
+            )));
+        }
     }
     if args.method == Some(Method::Reference) {
         let qmc_only = crate::args::given(&[
@@ -461,12 +514,12 @@ fn bake_preset(preset: kiln::preset::Preset, args: &BakeArgs) -> kiln::Result<()
             );
         }
         println!(
-            "{} layout: baked {} tables in {:.1} s; wrote {} ({} files) to {}",
+            "{} layout: baked {} in {:.1} s; wrote {} ({}) to {}",
             preset.name(),
-            tables.len(),
+            kiln::error::count(tables.len(), "table"),
             start.elapsed().as_secs_f64(),
             preset.file_name(),
-            written.len(),
+            kiln::error::count(written.len(), "file"),
             out.display()
         );
     }
@@ -524,10 +577,10 @@ fn bake_scene(
         println!("reused from the cache: {}", list(&result.report.reused));
         println!("baked: {}", list(&result.report.baked));
         println!(
-            "{} tables in {:.1} s; wrote {} files to {}",
-            result.report.tables.len(),
+            "{} in {:.1} s; wrote {} to {}",
+            kiln::error::count(result.report.tables.len(), "table"),
             start.elapsed().as_secs_f64(),
-            result.written.len(),
+            kiln::error::count(result.written.len(), "file"),
             dir.display()
         );
     }

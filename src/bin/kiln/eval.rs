@@ -58,7 +58,7 @@ pub struct EvalArgs {
     /// Slope-space roughness alpha, >= 0 (give this or --roughness).
     #[arg(long, value_parser = parse_alpha, conflicts_with = "roughness", allow_negative_numbers = true)]
     alpha: Option<f64>,
-    /// Perceptual roughness r >= 0, alpha = r^2 (give this or --alpha).
+    /// Perceptual roughness r in [0, 1], alpha = r^2 (give this or --alpha, which goes to 1000).
     #[arg(long, value_parser = parse_roughness, allow_negative_numbers = true)]
     roughness: Option<f64>,
     /// cos(theta) of the view direction, in [0, 1]; required for --quantity e.
@@ -222,7 +222,10 @@ pub fn run(args: EvalArgs) -> kiln::Result<()> {
         });
         print_json(&args, object);
     } else {
-        let at = mu.map(|mu| format!("mu = {mu}, ")).unwrap_or_default();
+        let at = mu
+            .map(|mu| format!("mu = {}, ", kiln::error::brief(mu)))
+            .unwrap_or_default();
+        let alpha = kiln::error::brief(alpha);
         let what = match args.method {
             Method::Qmc => format!("{samples} samples"),
             Method::Reference => format!("reference quadrature, {samples} evaluations"),
@@ -383,8 +386,10 @@ fn fresnel_weighted(
             format!("[{:.10}, {:.10}, {:.10}]", values[0], values[1], values[2])
         };
         println!(
-            "E_F(mu = {mu}, alpha = {alpha}; {} Fresnel) = {shown} ± {error:.1e} ({}, {method}, \
+            "E_F(mu = {}, alpha = {}; {} Fresnel) = {shown} ± {error:.1e} ({}, {method}, \
              {samples} evaluations, {seconds:.3} s)",
+            kiln::error::brief(mu),
+            kiln::error::brief(alpha),
             fresnel.name(),
             model
         );

@@ -30,19 +30,15 @@ struct Cli {
     command: Command,
 }
 
+// The variants carry no doc comments: a variant's would replace its command's `about` and
+// `long_about` (each `*Args` struct's doc comment and long description).
 #[derive(Subcommand, Debug)]
 enum Command {
-    /// Bake E(mu, roughness) and E_avg(roughness) tables and write them to a directory.
     Bake(bake::BakeArgs),
-    /// Evaluate E or E_avg at one point (QMC or the deterministic reference), or F_avg.
     Eval(eval::EvalArgs),
-    /// Show the minimal set of tables a scene file's materials need.
     Plan(plan::PlanArgs),
-    /// Audit a table (kiln's or an engine's) against the deterministic reference.
     Verify(verify::VerifyArgs),
-    /// Measure what accuracy costs: error against time per estimator, lookup error against size.
     Study(study::StudyArgs),
-    /// Merge the shard files of a sharded bake (`kiln bake --shard I/N`) into its tables.
     Merge(merge::MergeArgs),
 }
 
@@ -71,6 +67,26 @@ fn stray_scene_file(e: &clap::Error) -> Option<String> {
     match e.get(ContextKind::InvalidArg) {
         Some(ContextValue::String(arg)) if arg.ends_with(".toml") && !arg.starts_with('-') => {
             Some(arg.clone())
+        }
+        _ => None,
+    }
+}
+
+/// A point's flag (`--roughness`, `--mu`, `--alpha`, `--eta`) given to `kiln bake`, which takes
+/// none: the user wants `kiln eval`.
+fn point_flag_on_bake(e: &clap::Error) -> Option<String> {
+    use clap::error::{ContextKind, ContextValue};
+    if e.kind() != clap::error::ErrorKind::UnknownArgument
+        || std::env::args().nth(1).as_deref() != Some("bake")
+    {
+        return None;
+    }
+    match e.get(ContextKind::InvalidArg) {
+        Some(ContextValue::String(arg)) => {
+            let flag = arg.split('=').next().unwrap_or(arg);
+            ["--roughness", "--mu", "--alpha", "--eta"]
+                .contains(&flag)
+                .then(|| flag.to_string())
         }
         _ => None,
     }
@@ -135,10 +151,23 @@ fn main() -> ExitCode {
                 .take_while(|line| !line.is_empty())
                 .collect();
             eprintln!("kiln: {}", message.join(" ").trim_start_matches("error: "));
+            let point = point_flag_on_bake(&e);
             for line in &lines[message.len()..] {
+                // clap's look-alike (`--roughness-axis` for `--roughness`) is not what someone
+                // who names a point wants: the tip below replaces it.
+                if point.is_some() && (line.starts_with("tip:") || line.starts_with("Usage:")) {
+                    continue;
+                }
                 if line.starts_with("tip:") || line.starts_with("Usage:") {
                     eprintln!("  {line}");
                 }
+            }
+            if let Some(flag) = point {
+                eprintln!(
+                    "  tip: kiln bake writes whole tables; to compute one point, use kiln eval \
+                     {flag} ... (e.g. kiln eval --mu 0.5 --roughness 0.5); to choose the table's \
+                     axes, see kiln bake --help (--size, --roughness-axis, --mu-axis)"
+                );
             }
             if let Some(scene) = stray_scene_file(&e) {
                 eprintln!("  tip: name a scene file with --scene {scene}");

@@ -61,10 +61,10 @@ pub fn run(args: MergeArgs) -> kiln::Result<()> {
     let written = format::write_tables(&out, &tables, &formats, bake.precision, replace)?;
     if !args.quiet {
         println!(
-            "merged {} shards into {} tables; wrote {} files to {}",
-            shards.len(),
-            tables.len(),
-            written.len(),
+            "merged {} into {}; wrote {} to {}",
+            kiln::error::count(shards.len(), "shard"),
+            kiln::error::count(tables.len(), "table"),
+            kiln::error::count(written.len(), "file"),
             out.display()
         );
     }

@@ -4,6 +4,32 @@ use clap::Args;
 use kiln::scene::Scene;
 use std::path::PathBuf;
 
+/// A scene file, for `--help` (docs/scenes.md has it all).
+pub const SCENE_FORMAT: &str = "\
+A scene file (TOML; unknown keys are errors):
+
+  [output]                       # optional
+  dir = \"tables\"                 # relative to the scene file
+  formats = [\"exr\", \"rs\", \"json\"] # or preset = \"filament\" (an engine's own files)
+  precision = \"f16\"              # f32 (default) or f16
+  max_error = 1e-7               # the bake's bound (default 1e-7)
+
+  [[material]]
+  name = \"brushed_steel\"         # unique, no control characters
+  ndf = \"ggx\"                    # ggx | beckmann
+  masking = \"height-correlated\"  # optional (the default)
+  roughness = [0.2, 0.6]         # perceptual r in [0, 1]: one value or [min, max]
+  fresnel = { conductor = { eta = [2.9, 2.9, 2.4], k = [3.0, 2.9, 2.5] } }
+                                 # or { dielectric = { ior = 1.5 } }, { schlick = { f0 = 0.04 } },
+                                 # \"none\" (F = 1)
+  multiple_scattering = true     # Kulla-Conty: E, E_avg, f_ms_norm (the default)
+  image_based_lighting = false   # the split sum: E_scale, E_bias
+  transmission = false           # glass: the dielectric tables (a dielectric fresnel)
+  sheen = false                  # cloth albedo: only in filament's and godot's textures
+
+Then `kiln bake --scene FILE` bakes exactly what `kiln plan --scene FILE` lists. Example:
+examples/scene.toml; the format in full: docs/scenes.md.";
+
 /// Show the minimal set of tables a scene needs.
 #[derive(Args, Debug)]
 #[command(
@@ -24,7 +50,8 @@ use std::path::PathBuf;
                   minutes). output.dir is relative to the scene file. With --json, one object \
                   with a `tables` array (ndf, masking, quantity, materials, id, \
                   estimated_core_seconds) and a `materials` array (name, ndf, masking, \
-                  roughness, fresnel, f_avg)."
+                  roughness, fresnel, f_avg).",
+    after_long_help = SCENE_FORMAT
 )]
 pub struct PlanArgs {
     /// The scene file.
@@ -48,7 +75,7 @@ pub fn run(args: PlanArgs) -> kiln::Result<()> {
     if plan.materials.is_empty() {
         eprintln!(
             "kiln: warning: {} names no materials, so it needs no tables; add [[material]] \
-             entries (name, ndf, roughness, fresnel; see kiln plan --help)",
+             entries (name, ndf, roughness, fresnel; kiln plan --help shows the format)",
             args.scene.display()
         );
     }
@@ -58,11 +85,15 @@ pub fn run(args: PlanArgs) -> kiln::Result<()> {
         .iter()
         .fold(0.0, |sum, t| sum + t.estimated_core_seconds);
     println!(
-        "{}: {} materials need {} tables (estimated {} on {threads} threads, less what the \
-         cache in {} holds)",
+        "{}: {} {} {} (estimated {} on {threads} threads, less what the cache in {} holds)",
         args.scene.display(),
-        plan.materials.len(),
-        plan.tables.len(),
+        kiln::error::count(plan.materials.len(), "material"),
+        if plan.materials.len() == 1 {
+            "needs"
+        } else {
+            "need"
+        },
+        kiln::error::count(plan.tables.len(), "table"),
         crate::human_seconds(total / threads as f64),
         scene.output_dir().join(".kiln-cache").display()
     );

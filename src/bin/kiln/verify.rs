@@ -119,8 +119,8 @@ pub struct VerifyArgs {
     fresnel: FresnelArgs,
     /// Print nothing but errors: the exit status says whether the table passed --max-error
     /// (0 passed, 1 failed, 2 could not be read), and a failing check prints one line on
-    /// stderr. For build gates.
-    #[arg(long, short)]
+    /// stderr. For build gates. Not with --json, which prints the report.
+    #[arg(long, short, conflicts_with = "json")]
     quiet: bool,
 }
 
@@ -183,6 +183,33 @@ impl VerifyArgs {
     }
 
     fn layout(&self, path: &Path) -> kiln::Result<Layout> {
+        // kiln's pictures and lookup code are not tables: say which file is.
+        let extension = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+        let what = match extension {
+            "png" => Some("an 8-bit heat map (a picture of the table)"),
+            "wgsl" | "glsl" | "hlsl" => Some("shader code that samples the table's texture"),
+            _ => None,
+        };
+        if let (Some(what), None) = (what, &self.shape) {
+            let sidecar = path.with_extension("json");
+            let stem = path.with_extension("");
+            return Err(kiln::Error::InvalidInput(if sidecar.is_file() {
+                format!(
+                    "{} is {what}, not the table's numbers, which kiln does not read back: \
+                     verify the table itself, {} (or its .exr, .bin, .ktx2, .rs or .h)",
+                    path.display(),
+                    sidecar.display()
+                )
+            } else {
+                format!(
+                    "{} is {what} if kiln wrote it, not a table kiln reads: verify the table \
+                     it was made from ({}.json, .exr, ...); an engine's PNG table is read with \
+                     --preset games202",
+                    path.display(),
+                    stem.display()
+                )
+            }));
+        }
         let Shape(shape) = self.shape.clone().ok_or_else(|| {
             kiln::Error::InvalidInput(format!(
                 "{} is not a kiln table (no kiln metadata in it or a sidecar beside it): give \
@@ -600,6 +627,17 @@ pub fn run(args: VerifyArgs) -> kiln::Result<bool> {
         };
         plot_kind(args)?;
         let several = tables.len() > 1;
+        if let Some(path) = args.plot.as_ref().filter(|_| several && !args.quiet) {
+            let names: Vec<String> = tables
+                .iter()
+                .map(|t| plot_for(path, t).display().to_string())
+                .collect();
+            eprintln!(
+                "kiln: --plot: the file holds {} tables, so one picture each: {}",
+                tables.len(),
+                names.join(", ")
+            );
+        }
         let mut passed = true;
         for table in &tables {
             let args = &VerifyArgs {
@@ -777,6 +815,21 @@ fn plot_for(path: &Path, table: &Table) -> PathBuf {
 
 /// Whether `--plot` asks for SVG (true) or PNG (false); `None` without it.
 fn plot_kind(args: &VerifyArgs) -> kiln::Result<Option<bool>> {
+    // A picture goes into a folder that exists: a mistyped path is an error now, before the
+    // audit, not a chain of new folders after it.
+    if let Some(dir) = args
+        .plot
+        .as_deref()
+        .and_then(Path::parent)
+        .filter(|d| !d.as_os_str().is_empty() && !d.is_dir())
+    {
+        return Err(kiln::Error::InvalidInput(format!(
+            "--plot {}: the folder {} does not exist; create it, or give a path in a folder \
+             that does",
+            args.plot.as_deref().unwrap_or(dir).display(),
+            dir.display()
+        )));
+    }
     match &args.plot {
         Some(path) => match path.extension().and_then(|e| e.to_str()) {
             Some("svg") => Ok(Some(true)),

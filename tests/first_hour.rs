@@ -1,0 +1,299 @@
+//! The first hour of a new user (issue 42), one test per item fixed: flags never ignored, the
+//! replacement refusal naming what differs, no empty folders after a refusal or an interrupt,
+//! `--plot` paths that do not create folders, a preset's several pictures announced.
+
+#![cfg(feature = "cli")]
+
+use std::path::Path;
+use std::process::{Command, Output, Stdio};
+
+#[path = "common/command.rs"]
+mod command;
+use command::kiln;
+
+fn stderr(output: &Output) -> String {
+    String::from_utf8_lossy(&output.stderr).into_owned()
+}
+
+/// Runs kiln and expects a usage error (exit 2) whose message names each of `words`.
+fn refused(args: &[&str], words: &[&str]) -> String {
+    let output = kiln(args);
+    let message = stderr(&output);
+    assert_eq!(output.status.code(), Some(2), "{args:?}: {message}");
+    assert!(!message.contains("panicked"), "{message}");
+    for word in words {
+        assert!(
+            message.contains(word),
+            "{args:?}: '{message}' lacks '{word}'"
+        );
+    }
+    message
+}
+
+fn ok(args: &[&str]) -> Output {
+    let output = kiln(args);
+    assert!(output.status.success(), "{args:?}: {}", stderr(&output));
+    output
+}
+
+/// Item 2: `--seed` and `--scrambles` on a bake the quadrature makes (the default max error,
+/// or any below 1e-3) changed the recorded spec and nothing else; the IOR flags without a
+/// table over the IOR were ignored; `verify --json --quiet` printed the JSON anyway.
+#[test]
+fn flags_a_bake_would_ignore_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let o = out.to_str().unwrap();
+    refused(
+        &["bake", "--seed", "3", "--out", o],
+        &["--seed", "--max-error 1e-7", "quadrature", "--method qmc"],
+    );
+    refused(
+        &[
+            "bake",
+            "--max-error",
+            "1e-5",
+            "--scrambles",
+            "4",
+            "--out",
+            o,
+        ],
+        &["--scrambles", "--max-error 1e-5"],
+    );
+    for flag in [
+        ["--ior-size", "8"],
+        ["--ior-max", "2"],
+        ["--ior-axis", "linear"],
+    ] {
+        refused(
+            &["bake", flag[0], flag[1], "--out", o],
+            &[
+                flag[0],
+                "none of the tables baked",
+                "--quantity e-dielectric",
+            ],
+        );
+    }
+    let table = Path::new(env!("CARGO_MANIFEST_DIR")).join("tables/ggx-height-correlated-E.json");
+    refused(
+        &["verify", table.to_str().unwrap(), "--json", "--quiet"],
+        &["--quiet", "--json", "cannot be used with"],
+    );
+    assert!(!out.exists(), "a refusal created {}", out.display());
+    // Where they apply, they are taken: QMC at 1e-2 reads the seed, a glass table the IOR size.
+    ok(&[
+        "bake",
+        "--size",
+        "4",
+        "--max-error",
+        "1e-2",
+        "--seed",
+        "3",
+        "--format",
+        "json",
+        "-q",
+        "--out",
+        o,
+    ]);
+    ok(&[
+        "bake",
+        "--quantity",
+        "f-avg",
+        "--size",
+        "4",
+        "--ior-size",
+        "5",
+        "--format",
+        "json",
+        "-q",
+        "--out",
+        o,
+    ]);
+}
+
+/// Item 2: a bake refused for replacing tables of another spec showed two descriptions that
+/// read the same; it now names the field that differs, with both values.
+#[test]
+fn the_replacement_refusal_names_the_field_that_differs() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = dir.path().to_str().unwrap();
+    let bake = |seed: &str| {
+        kiln(&[
+            "bake",
+            "--size",
+            "4",
+            "--max-error",
+            "1e-2",
+            "--seed",
+            seed,
+            "--format",
+            "json",
+            "-q",
+            "--out",
+            o,
+        ])
+    };
+    assert!(bake("1").status.success());
+    let refusal = bake("2");
+    assert_eq!(refusal.status.code(), Some(2));
+    let message = stderr(&refusal);
+    assert!(
+        message.contains("differing in qmc.seed (1 in the file, 2 here)"),
+        "{message}"
+    );
+}
+
+/// Item 9: a refused or interrupted bake into a new folder left the folder behind, empty.
+#[test]
+fn refusals_and_interrupts_leave_no_empty_folders() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("new").join("deeper");
+    let o = out.to_str().unwrap();
+    // Refused after the folder check: a carried file that is not Blender's.
+    let bad = dir.path().join("bad.tables");
+    std::fs::write(&bad, "nothing").unwrap();
+    refused(
+        &[
+            "bake",
+            "--preset",
+            "cycles",
+            "--carry-over",
+            bad.to_str().unwrap(),
+            "--out",
+            o,
+        ],
+        &["has no array table_sheen_ltc"],
+    );
+    assert!(!dir.path().join("new").exists());
+    // Interrupted: a bake of minutes, killed once it has started integrating.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_kiln"))
+        .args(["bake", "--size", "512", "--max-error", "1e-9", "--out", o])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    assert!(
+        child.try_wait().unwrap().is_none(),
+        "the bake ended before it was interrupted"
+    );
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert!(
+        !dir.path().join("new").exists(),
+        "an interrupted bake left {}",
+        out.display()
+    );
+}
+
+/// Item 9: a mistyped `--plot` path created folders up to the root; now it is refused before
+/// the audit, and nothing is created.
+#[test]
+fn a_plot_path_in_a_missing_folder_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let table = Path::new(env!("CARGO_MANIFEST_DIR")).join("tables/ggx-height-correlated-E.json");
+    let plot = dir.path().join("typo").join("maps").join("e.png");
+    refused(
+        &[
+            "verify",
+            table.to_str().unwrap(),
+            "--plot",
+            plot.to_str().unwrap(),
+        ],
+        &["--plot", "does not exist", "typo"],
+    );
+    assert!(!dir.path().join("typo").exists());
+}
+
+/// Item 7: messages that pointed the wrong way. Every subcommand's `--help` lost its long
+/// description (the variants' doc comments replaced it), so the empty-scene warning's `kiln
+/// plan --help` said nothing of scenes: it now shows the format, and that example is a scene
+/// kiln reads. `bake --roughness` suggested `--roughness-axis`; a PNG given with `--shape` was
+/// told to use `--dtype`; kiln's own `E.png` had "no sidecar" beside its sidecar.
+#[test]
+fn messages_point_the_right_way() {
+    let help = String::from_utf8(kiln(&["plan", "--help"]).stdout).unwrap();
+    let at = help
+        .find("A scene file (TOML")
+        .expect("the scene format in plan --help");
+    let example: String = help[at..]
+        .lines()
+        .skip(1)
+        .take_while(|l| !l.starts_with("Then"))
+        .map(|l| l.strip_prefix("  ").unwrap_or(l))
+        .filter(|l| !l.trim_start().starts_with('#'))
+        .collect::<Vec<_>>()
+        .join("\n");
+    kiln::scene::Scene::parse(&example, "plan --help")
+        .unwrap_or_else(|e| panic!("the help's scene does not parse: {e}\n{example}"));
+    for (command, phrase) in [
+        ("bake", "picks the cheapest method"),
+        ("verify", "build gate"),
+        ("plan", "minimal set of tables its"),
+    ] {
+        let text = String::from_utf8(kiln(&[command, "--help"]).stdout).unwrap();
+        assert!(text.contains(phrase), "kiln {command} --help: {text}");
+    }
+    let message = refused(&["bake", "--roughness", "0.5"], &["kiln eval --roughness"]);
+    assert!(!message.contains("--roughness-axis <"), "{message}");
+    let tables = Path::new(env!("CARGO_MANIFEST_DIR")).join("tables");
+    let png = tables.join("ggx-height-correlated-E.png");
+    let png = png.to_str().unwrap();
+    refused(
+        &["verify", png],
+        &["heat map", "ggx-height-correlated-E.json"],
+    );
+    let message = refused(&["verify", png, "--shape", "32x32"], &["a PNG image"]);
+    assert!(!message.contains("use --dtype"), "{message}");
+}
+
+/// Item 9: `eval --roughness 1.5` was taken (a scene refuses it); counts of one were plural;
+/// `1e-12` was echoed as `0.000000000001` and `alpha = r^2` with all its binary digits.
+#[test]
+fn numbers_and_counts_read_as_written() {
+    refused(
+        &["eval", "--roughness", "1.5", "--mu", "0.5"],
+        &["[0, 1]", "--alpha"],
+    );
+    refused(
+        &["bake", "--max-error", "1e-12", "--out", "never"],
+        &["(got 1e-12)"],
+    );
+    let eval = ok(&[
+        "eval",
+        "--roughness",
+        "0.1",
+        "--mu",
+        "0.5",
+        "--method",
+        "reference",
+    ]);
+    let text = String::from_utf8(eval.stdout).unwrap();
+    assert!(text.contains("alpha = 0.01)"), "{text}");
+    let dir = tempfile::tempdir().unwrap();
+    let o = dir.path().to_str().unwrap();
+    let bake = ok(&[
+        "bake",
+        "--quantity",
+        "e-avg",
+        "--size",
+        "4",
+        "--format",
+        "json",
+        "--out",
+        o,
+    ]);
+    let text = String::from_utf8(bake.stdout).unwrap();
+    assert!(text.contains("baked 1 table in"), "{text}");
+    assert!(text.contains("wrote 1 file to"), "{text}");
+    let scene = dir.path().join("one.toml");
+    std::fs::write(
+        &scene,
+        "[[material]]\nname = \"m\"\nndf = \"ggx\"\nroughness = 0.5\nmultiple_scattering = \
+         false\nimage_based_lighting = true\n",
+    )
+    .unwrap();
+    let plan = ok(&["plan", "--scene", scene.to_str().unwrap()]);
+    let text = String::from_utf8(plan.stdout).unwrap();
+    assert!(text.contains("1 material needs 2 tables"), "{text}");
+}
