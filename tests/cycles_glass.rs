@@ -12,6 +12,9 @@ use kiln::preset::Preset;
 use kiln::{BakeOptions, Quantity, Table, TableSpec};
 use std::path::PathBuf;
 
+#[path = "common/cxx.rs"]
+mod cxx;
+
 fn engine_file(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("tests/data/engines")
@@ -214,13 +217,7 @@ fn kiln_s_shader_tables_compiles_as_cycles_includes_it() {
     }
     source.push_str("int main() { return 0; }\n");
     std::fs::write(dir.path().join("check.cpp"), source).unwrap();
-    let compiler = ["c++", "g++", "clang++"].into_iter().find(|c| {
-        std::process::Command::new(c)
-            .arg("--version")
-            .output()
-            .is_ok()
-    });
-    let Some(compiler) = compiler else {
+    let Some(compiler) = cxx::compiler() else {
         eprintln!("no C++ compiler: the declarations were checked structurally only");
         return;
     };

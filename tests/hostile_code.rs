@@ -20,6 +20,8 @@ use kiln::{Quantity, Table, TableSpec};
 
 #[path = "common/command.rs"]
 mod command;
+#[path = "common/cxx.rs"]
+mod cxx;
 use command::kiln;
 
 /// Texts that try to leave a comment in each way a language allows, each carrying the word
@@ -201,12 +203,7 @@ fn blender_shader_tables() -> String {
 /// Runs the C++ preprocessor on `file` (comments removed, as the compiler sees it), if there
 /// is one.
 fn preprocessed(file: &Path) -> Option<String> {
-    let compiler = ["c++", "g++", "clang++"].into_iter().find(|c| {
-        std::process::Command::new(c)
-            .arg("--version")
-            .output()
-            .is_ok()
-    })?;
+    let compiler = cxx::compiler()?;
     let out = std::process::Command::new(compiler)
         .args([
             "-x",

@@ -10,9 +10,7 @@
 //! `KILN_FUZZ_SECONDS=N cargo test --release --test hostile_input -- --nocapture` runs each
 //! reader for N seconds of fresh mutants instead (the longer fuzzing run), printing the counts.
 
-use std::alloc::{GlobalAlloc, Layout as AllocLayout, System};
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
 use kiln::format::{Format, Precision, replace::Replace};
@@ -20,31 +18,8 @@ use kiln::preset::Preset;
 use kiln::verify::input::{AxisName, Encoding, Layout, read_external, read_kiln};
 use kiln::{BakeOptions, Grid, MuMapping, Quantity, RoughnessConvention, Table};
 
-/// The system allocator, remembering the largest single request.
-struct Watching;
-
-static LARGEST: AtomicUsize = AtomicUsize::new(0);
-
-// SAFETY: forwards to the system allocator unchanged; only records the size asked for.
-unsafe impl GlobalAlloc for Watching {
-    unsafe fn alloc(&self, layout: AllocLayout) -> *mut u8 {
-        LARGEST.fetch_max(layout.size(), Ordering::Relaxed);
-        // SAFETY: the caller's contract is the system allocator's.
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: AllocLayout) {
-        // SAFETY: as above.
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: AllocLayout, new_size: usize) -> *mut u8 {
-        LARGEST.fetch_max(new_size, Ordering::Relaxed);
-        // SAFETY: as above.
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
-
-#[global_allocator]
-static ALLOCATOR: Watching = Watching;
+#[path = "common/watching.rs"]
+mod watching;
 
 const ALLOCATION_LIMIT: usize = 1 << 30;
 const TIME_LIMIT: Duration = Duration::from_secs(5);
@@ -208,11 +183,11 @@ fn mutate(seed: &[u8], text: bool, rng: &mut Rng, round: usize) -> Vec<u8> {
 
 /// Runs one mutant through `target`, checking the promises; returns whether it read.
 fn run_one(target: &Target, bytes: &[u8], what: &str) -> bool {
-    LARGEST.store(0, Ordering::Relaxed);
+    watching::reset();
     let start = Instant::now();
     let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| (target.read)(bytes)));
     let elapsed = start.elapsed();
-    let largest = LARGEST.load(Ordering::Relaxed);
+    let largest = watching::largest();
     let Ok(outcome) = outcome else {
         panic!("{}: {what}: the reader panicked", target.name);
     };

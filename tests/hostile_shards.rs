@@ -10,9 +10,7 @@
 
 #![cfg(feature = "cli")]
 
-use std::alloc::{GlobalAlloc, Layout as AllocLayout, System};
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 use kiln::shard::{ShardFile, ShardIndex, ShardedBake};
 
@@ -20,31 +18,8 @@ use kiln::shard::{ShardFile, ShardIndex, ShardedBake};
 mod command;
 use command::kiln;
 
-/// The system allocator, remembering the largest single request.
-struct Watching;
-
-static LARGEST: AtomicUsize = AtomicUsize::new(0);
-
-// SAFETY: forwards to the system allocator unchanged; only records the size asked for.
-unsafe impl GlobalAlloc for Watching {
-    unsafe fn alloc(&self, layout: AllocLayout) -> *mut u8 {
-        LARGEST.fetch_max(layout.size(), Ordering::Relaxed);
-        // SAFETY: the caller's contract is the system allocator's.
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: AllocLayout) {
-        // SAFETY: as above.
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: AllocLayout, new_size: usize) -> *mut u8 {
-        LARGEST.fetch_max(new_size, Ordering::Relaxed);
-        // SAFETY: as above.
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
-
-#[global_allocator]
-static ALLOCATOR: Watching = Watching;
+#[path = "common/watching.rs"]
+mod watching;
 
 fn stderr(output: &std::process::Output) -> String {
     String::from_utf8_lossy(&output.stderr).into_owned()
@@ -449,9 +424,9 @@ fn structure_aware_mutants_of_shards_never_panic_nor_allocate_past_their_bounds(
         for _ in 0..=rng.below(3) {
             mutate(&mut shards, &mut rng);
         }
-        LARGEST.store(0, Ordering::Relaxed);
+        watching::reset();
         let outcome = std::panic::catch_unwind(|| kiln::shard::merge(&named(shards.clone())));
-        let largest = LARGEST.load(Ordering::Relaxed);
+        let largest = watching::largest();
         assert!(
             largest <= 1 << 30,
             "round {round}: an allocation of {largest} bytes"
