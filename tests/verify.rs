@@ -499,6 +499,29 @@ fn furnace_plot_draws_each_form() {
     );
     let text = std::fs::read_to_string(&svg).unwrap();
     assert!(text.starts_with("<svg") && text.contains("kulla-conty: max |deviation|"));
+    // The picture states the command's own worst point (issue 42: the map's 64 x 64 grid alone
+    // showed 4.3e-5 and a ring elsewhere, beside the command's 1.16e-4 at r 0.001), and its
+    // colour bar says what the colours mean.
+    let json = kiln(&[
+        "verify",
+        "--furnace",
+        e.to_str().unwrap(),
+        "--form",
+        "kulla-conty",
+        "--json",
+    ]);
+    let report: serde_json::Value = serde_json::from_slice(&json.stdout).unwrap();
+    let form = &report["forms"][0];
+    let stated = format!(
+        "max |deviation| {:.2e} at mu {:.2e}, r {:.4}",
+        form["max_deviation"].as_f64().unwrap(),
+        form["worst_mu"].as_f64().unwrap(),
+        form["worst_roughness"].as_f64().unwrap()
+    );
+    assert!(text.contains(&stated), "the picture lacks '{stated}'");
+    for label in ["deviation", "&lt; 1e-7", "+1e-1", "-1e-3"] {
+        assert!(text.contains(label), "the colour bar lacks {label}");
+    }
     let bad = dir.path().join("furnace.txt");
     let output = kiln(&[
         "verify",

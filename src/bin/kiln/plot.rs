@@ -260,19 +260,87 @@ pub fn lookup_plot(report: &StudyReport) -> Result<(String, Vec<u8>), String> {
 pub fn furnace_plot(
     title: &str,
     maps: &[kiln::verify::furnace::FurnaceMap],
+    worst: &[Option<FurnaceMark>],
 ) -> Result<(String, Vec<u8>), String> {
     register_font();
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
-        heat_maps(&root, title, maps).map_err(|e| e.to_string())?;
+        heat_maps(&root, title, maps, worst).map_err(|e| e.to_string())?;
     }
     let mut pixels = vec![255u8; (SIZE.0 * SIZE.1 * 3) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut pixels, SIZE).into_drawing_area();
-        heat_maps(&root, title, maps).map_err(|e| e.to_string())?;
+        heat_maps(&root, title, maps, worst).map_err(|e| e.to_string())?;
     }
     Ok((svg, png_of(&pixels)?))
+}
+
+/// Where the furnace command measured its worst deviation, to ring on the map: the point in the
+/// map's coordinates (`t`, the E table's mu coordinate, across; roughness up), `mu` itself, and
+/// the deviation there.
+#[derive(Clone, Copy, Debug)]
+pub struct FurnaceMark {
+    pub t: f64,
+    pub mu: f64,
+    pub roughness: f64,
+    pub deviation: f64,
+}
+
+/// The width of a heat map's colour bar, label room included.
+const BAR_WIDTH: u32 = 130;
+
+/// A vertical colour bar in `area`: `colour(s)` for `s` from -1 (bottom) to 1 (top) if `signed`,
+/// else 0 to 1, with `labels` at their `s`, and a caption.
+fn colour_bar<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    caption: &str,
+    signed: bool,
+    colour: &dyn Fn(f64) -> RGBColor,
+    labels: &[(f64, String)],
+) -> Result<(), Box<dyn std::error::Error>>
+where
+    DB::ErrorType: 'static,
+{
+    let lo = if signed { -1.0 } else { 0.0 };
+    let mut chart = ChartBuilder::on(area)
+        .caption(caption, ("sans-serif", 14))
+        .margin_top(40)
+        .margin_bottom(52)
+        .margin_right(4)
+        .margin_left(6)
+        .build_cartesian_2d(0.0..1.0, lo..1.0)?;
+    // The bar in the left third, its labels to the right.
+    let (left, right) = (0.0, 0.3);
+    let steps = 240;
+    chart.draw_series((0..steps).map(|k| {
+        let (a, b) = (
+            lo + (1.0 - lo) * k as f64 / steps as f64,
+            lo + (1.0 - lo) * (k + 1) as f64 / steps as f64,
+        );
+        Rectangle::new([(left, a), (right, b)], colour((a + b) / 2.0).filled())
+    }))?;
+    chart.draw_series(std::iter::once(Rectangle::new(
+        [(left, lo), (right, 1.0)],
+        BLACK.stroke_width(1),
+    )))?;
+    for (at, text) in labels {
+        chart.draw_series(std::iter::once(PathElement::new(
+            vec![(right, *at), (right + 0.06, *at)],
+            BLACK.stroke_width(1),
+        )))?;
+        chart.draw_series(std::iter::once(Text::new(
+            text.clone(),
+            (right + 0.1, *at),
+            ("sans-serif", 13).into_font().color(&BLACK).pos(
+                plotters::style::text_anchor::Pos::new(
+                    plotters::style::text_anchor::HPos::Left,
+                    plotters::style::text_anchor::VPos::Center,
+                ),
+            ),
+        )))?;
+    }
+    Ok(())
 }
 
 /// A diverging colour for a signed deviation: white at |d| <= 1e-7, full blue (negative) or red
@@ -292,24 +360,75 @@ fn heat_maps<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     title: &str,
     maps: &[kiln::verify::furnace::FurnaceMap],
+    marks: &[Option<FurnaceMark>],
 ) -> Result<(), Box<dyn std::error::Error>>
 where
     DB::ErrorType: 'static,
 {
     root.fill(&WHITE)?;
-    let root = root.titled(title, ("sans-serif", 22))?;
-    let panels = root.split_evenly((1, maps.len().max(1)));
-    for (panel, map) in panels.iter().zip(maps) {
-        let worst = map
+    let root = root.titled(title, ("sans-serif", 20))?;
+    let (maps_area, bar) = root.split_horizontally(SIZE.0 - BAR_WIDTH);
+    // The bar: s in [-1, 1], |s| = (log10 |d| + 7) / 6, as `deviation_colour` shades.
+    let deviation_at = |s: f64| s.signum() * 10f64.powf(-7.0 + 6.0 * s.abs());
+    let labels: Vec<(f64, String)> = (-6..=6)
+        .step_by(2)
+        .map(|k| {
+            let s = f64::from(k) / 6.0;
+            let text = match k {
+                0 => "< 1e-7".to_string(),
+                _ => format!("{:+.0e}", deviation_at(s)),
+            };
+            (s, text)
+        })
+        .collect();
+    colour_bar(
+        &bar,
+        "deviation",
+        true,
+        &|s| deviation_colour(deviation_at(s)),
+        &labels,
+    )?;
+    let panels = maps_area.split_evenly((1, maps.len().max(1)));
+    for (k, (panel, map)) in panels.iter().zip(maps).enumerate() {
+        let (rows, columns) = (map.rows.max(2), map.columns.max(2));
+        let (dy, dx) = (1.0 / (rows - 1) as f64, 1.0 / (columns - 1) as f64);
+        let sampled = map
             .deviation
             .iter()
             .enumerate()
             .flat_map(|(j, row)| row.iter().enumerate().map(move |(k, d)| (j, k, *d)))
             .max_by(|a, b| a.2.abs().total_cmp(&b.2.abs()))
             .unwrap_or((0, 0, 0.0));
-        let caption = format!("{}: max |deviation| {:.1e}", map.form.name(), worst.2.abs());
+        // The ring and the caption give the command's own worst point where it is known (it
+        // measures on its own, finer ladder; the map samples a 64 x 64 grid).
+        let (x, y, caption) = match marks.get(k).copied().flatten() {
+            Some(m) => (
+                m.t,
+                m.roughness,
+                format!(
+                    "{}: max |deviation| {:.2e} at mu {}, r {:.4} (ringed)",
+                    map.form.name(),
+                    m.deviation.abs(),
+                    if m.mu >= 1e-3 {
+                        format!("{:.4}", m.mu)
+                    } else {
+                        format!("{:.2e}", m.mu)
+                    },
+                    m.roughness
+                ),
+            ),
+            None => (
+                sampled.1 as f64 * dx,
+                sampled.0 as f64 * dy,
+                format!(
+                    "{}: max |deviation| {:.1e} (ringed)",
+                    map.form.name(),
+                    sampled.2.abs()
+                ),
+            ),
+        };
         let mut chart = ChartBuilder::on(panel)
-            .caption(caption, ("sans-serif", 18))
+            .caption(caption, ("sans-serif", 15))
             .margin(12)
             .x_label_area_size(40)
             .y_label_area_size(50)
@@ -320,8 +439,6 @@ where
             .x_desc("t, the mu axis' coordinate (0 = grazing)")
             .y_desc("roughness r")
             .draw()?;
-        let (rows, columns) = (map.rows.max(2), map.columns.max(2));
-        let (dy, dx) = (1.0 / (rows - 1) as f64, 1.0 / (columns - 1) as f64);
         chart.draw_series(map.deviation.iter().enumerate().flat_map(|(j, row)| {
             row.iter().enumerate().map(move |(k, &d)| {
                 let (x, y) = (k as f64 * dx, j as f64 * dy);
@@ -331,10 +448,9 @@ where
                 )
             })
         }))?;
-        let (j, k, _) = worst;
         chart.draw_series(std::iter::once(Circle::new(
-            (k as f64 * dx, j as f64 * dy),
-            8,
+            (x, y),
+            9,
             BLACK.stroke_width(2),
         )))?;
     }
@@ -344,8 +460,8 @@ where
 
 /// The audit's error maps side by side (nodes, lookups): for a 2-D table a heat map over the
 /// table's texture coordinates (`mu`'s across, roughness up), colour by log10 of the error from
-/// dark (the panel's smallest, or a millionth of its largest) to bright (its largest), empty cells
-/// white, NaN magenta, the worst point ringed; for a 1-D table the error against roughness on a
+/// dark (the panels' smallest, or a millionth of their largest) to bright (their largest), as the
+/// colour bar beside them shows, empty cells white, NaN magenta, the worst point ringed; for a 1-D table the error against roughness on a
 /// log axis.
 pub fn error_map_plot(
     title: &str,
@@ -383,6 +499,8 @@ where
     let root = root.titled(title, ("sans-serif", 20))?;
     let panels = root.split_evenly((1, maps.len().max(1)));
     for (panel, map) in panels.iter().zip(maps) {
+        // Each heat map's own colour scale, shown by the bar beside it: log10 of the error
+        // from the panel's smallest (or a millionth of its largest) to its largest.
         let finite = || {
             map.cells
                 .iter()
@@ -392,16 +510,28 @@ where
         };
         let hi = finite().fold(0.0_f64, f64::max);
         let lo = finite().fold(f64::INFINITY, f64::min).max(hi * 1e-6);
+        let span = (hi / lo).log10().max(1e-12);
+        let panel = if map.rows > 1 && hi > 0.0 {
+            let (width, _) = panel.dim_in_pixel();
+            let (map_area, bar) = panel.split_horizontally(width.saturating_sub(BAR_WIDTH - 20));
+            let labels: Vec<(f64, String)> = (lo.log10().ceil() as i32..=hi.log10().floor() as i32)
+                .map(|d| ((f64::from(d) - lo.log10()) / span, format!("1e{d}")))
+                .filter(|(s, _)| (0.06..=0.94).contains(s))
+                .chain([(0.0, format!("{lo:.1e}")), (1.0, format!("{hi:.1e}"))])
+                .collect();
+            colour_bar(&bar, "error", false, &viridis, &labels)?;
+            map_area
+        } else {
+            panel.clone()
+        };
+        let panel = &panel;
         let (x, y, worst) = map.worst;
         let slice = map
             .eta
             .map(|eta| format!(", slice eta = {eta:.4}"))
             .unwrap_or_default();
         if map.rows > 1 {
-            let caption = format!(
-                "{}: max {worst:.2e}{slice}; colour log10 error {lo:.0e} to {hi:.0e}",
-                map.group
-            );
+            let caption = format!("{}: max {worst:.2e}{slice} (ringed)", map.group);
             let mut chart = ChartBuilder::on(panel)
                 .caption(caption, ("sans-serif", 15))
                 .margin(12)
@@ -415,7 +545,6 @@ where
                 .y_desc(map.y_axis.as_str())
                 .draw()?;
             let (dx, dy) = (1.0 / map.columns as f64, 1.0 / map.rows as f64);
-            let span = (hi / lo).log10().max(1e-12);
             chart.draw_series(map.cells.iter().enumerate().filter_map(|(k, cell)| {
                 let e = (*cell)?;
                 let colour = if e.is_nan() {

@@ -422,21 +422,6 @@ fn run_furnace(args: &VerifyArgs, table: &Table) -> kiln::Result<bool> {
         )),
         None => None,
     };
-    if let (Some(path), Some(svg)) = (&args.plot, plot_kind) {
-        let maps = kiln::verify::furnace::furnace_maps(
-            table,
-            normalisation.as_ref().map(|(_, t)| t),
-            &forms,
-            64,
-            64,
-        )?;
-        let title = format!(
-            "{}: white furnace deviation (blue: energy lost, red: added; white below 1e-7, full \
-             colour from 1e-1)",
-            table.spec.id()
-        );
-        write_plot(path, svg, crate::plot::furnace_plot(&title, &maps))?;
-    }
     let turquin_report = match forms.contains(&Form::Turquin) {
         true => {
             let settings = AuditSettings {
@@ -460,6 +445,38 @@ fn run_furnace(args: &VerifyArgs, table: &Table) -> kiln::Result<bool> {
         .map(|(_, report)| FormReport::of_kulla_conty(report))
         .chain(turquin_report)
         .collect();
+    if let (Some(path), Some(svg)) = (&args.plot, plot_kind) {
+        let maps = kiln::verify::furnace::furnace_maps(
+            table,
+            normalisation.as_ref().map(|(_, t)| t),
+            &forms,
+            64,
+            64,
+        )?;
+        // The command's worst point of each form, ringed on its map and stated in its caption.
+        let convention = table.spec.roughness_convention();
+        let marks: Vec<Option<crate::plot::FurnaceMark>> = maps
+            .iter()
+            .map(|map| {
+                let report = form_reports.iter().find(|f| f.form == map.form)?;
+                let kiln::Axis::Mu { mapping, .. } = table.spec.mu? else {
+                    return None;
+                };
+                let alpha = convention.to_alpha(report.worst_roughness);
+                Some(crate::plot::FurnaceMark {
+                    t: mapping.coordinate(report.worst_mu, alpha),
+                    mu: report.worst_mu,
+                    roughness: report.worst_roughness,
+                    deviation: report.deviation,
+                })
+            })
+            .collect();
+        let title = format!(
+            "{}: white furnace deviation (blue: energy lost, red: added)",
+            table.spec.id()
+        );
+        write_plot(path, svg, crate::plot::furnace_plot(&title, &maps, &marks))?;
+    }
     let max_deviation = kiln::stats::max_or_nan(form_reports.iter().map(|f| f.max_deviation));
     let passed = args.max_error.is_none_or(|bound| max_deviation <= bound);
     if args.json {
