@@ -297,3 +297,113 @@ fn numbers_and_counts_read_as_written() {
     let text = String::from_utf8(plan.stdout).unwrap();
     assert!(text.contains("1 material needs 2 tables"), "{text}");
 }
+
+/// Item 4: `verify --preset games202` gave a student no verdict. Four wrong files (rows not
+/// flipped, alpha = r, truncation, noise) exited 0 without a word, a perfect file read 0.369
+/// as its headline, and a 16-bit PNG was told its floor was 8 bits'. Each file here is kiln's
+/// own table with one mistake made on purpose; the verdict must name it.
+#[test]
+fn a_games202_file_gets_a_verdict_that_names_its_mistake() {
+    use kiln::preset::Preset;
+    let dir = tempfile::tempdir().unwrap();
+    let bake = |convention: Option<kiln::RoughnessConvention>| {
+        let mut options = Preset::Games202.bakes(Some(1e-5)).remove(0);
+        if let Some(c) = convention {
+            options.quantities = vec![kiln::Quantity::E];
+            options.roughness_convention = c;
+        }
+        options.bake(&|_| {}).unwrap()
+    };
+    let tables = bake(None);
+    let truth = tables[0].clone();
+    assert_eq!(truth.spec.quantity, kiln::Quantity::E);
+    let average = tables[1].clone();
+    let n = 128;
+    let write = |name: &str, values: Vec<f64>| {
+        let mut table = truth.clone();
+        table.one_minus_value = values.iter().map(|v| 1.0 - v).collect();
+        table.value = values;
+        let files = Preset::Games202.files(&[table, average.clone()]).unwrap();
+        let (_, bytes) = files.iter().find(|(f, _)| f == "GGX_E_LUT.png").unwrap();
+        let folder = dir.path().join(name);
+        std::fs::create_dir_all(&folder).unwrap();
+        let path = folder.join("GGX_E_LUT.png");
+        std::fs::write(&path, bytes).unwrap();
+        path
+    };
+    // --density 1: the verdict reads the nodes; the lookups' default density is for audits.
+    let audit = |path: &Path| {
+        let out = ok(&[
+            "verify",
+            "--preset",
+            "games202",
+            path.to_str().unwrap(),
+            "--density",
+            "1",
+        ]);
+        String::from_utf8(out.stdout).unwrap()
+    };
+    let verdict = |path: &Path| {
+        let text = audit(path);
+        let found = text
+            .lines()
+            .find_map(|l| l.trim().strip_prefix("verdict: ").map(str::to_string))
+            .unwrap_or_else(|| panic!("no verdict in\n{text}"));
+        eprintln!("{}: {found}", path.display());
+        found
+    };
+    let v = truth.value.clone();
+    let perfect = write("perfect", v.clone());
+    assert!(verdict(&perfect).starts_with("as good as 8-bit storage allows"));
+    assert!(audit(&perfect).contains("is the layout's own"));
+    // Rows in the other order.
+    let flipped: Vec<f64> = (0..n * n).map(|k| v[(n - 1 - k / n) * n + k % n]).collect();
+    assert!(verdict(&write("flipped", flipped)).starts_with("the roughness rows are flipped"));
+    // alpha = r where the axis is perceptual.
+    let alpha_is_r = bake(Some(kiln::RoughnessConvention::Alpha)).remove(0).value;
+    assert!(verdict(&write("alpha", alpha_is_r)).starts_with("computed at alpha = r"));
+    // floor(255 v) instead of round.
+    let truncated: Vec<f64> = v.iter().map(|x| (x * 255.0).floor() / 255.0).collect();
+    assert!(verdict(&write("truncated", truncated)).starts_with("truncated, not rounded"));
+    // Noise of a few hundredths, as too few samples per texel give.
+    let mut state = 0x2545_f491_u64;
+    let noisy: Vec<f64> = v
+        .iter()
+        .map(|x| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            let u = (state % 10_000) as f64 / 10_000.0 - 0.5;
+            (x + 0.08 * u).clamp(0.0, 1.0)
+        })
+        .collect();
+    assert!(verdict(&write("noisy", noisy)).starts_with("noisy"));
+    // A 16-bit PNG of the true values: its floor is 16 bits' (7.6e-6), not 8 bits'.
+    let folder = dir.path().join("sixteen");
+    std::fs::create_dir_all(&folder).unwrap();
+    let path = folder.join("GGX_E_LUT.png");
+    let mut data = Vec::with_capacity(2 * n * n);
+    for y in 0..n {
+        // The homework's file has the roughest row on top.
+        let i = n - 1 - y;
+        for j in 0..n {
+            let word = (v[i * n + j] * 65535.0).round() as u16;
+            data.extend_from_slice(&word.to_be_bytes());
+        }
+    }
+    let mut bytes = Vec::new();
+    {
+        let mut encoder = png::Encoder::new(&mut bytes, n as u32, n as u32);
+        encoder.set_color(png::ColorType::Grayscale);
+        encoder.set_depth(png::BitDepth::Sixteen);
+        let mut writer = encoder.write_header().unwrap();
+        writer.write_image_data(&data).unwrap();
+    }
+    std::fs::write(&path, bytes).unwrap();
+    let text = audit(&path);
+    assert!(text.contains("the true values in 16-bit"), "{text}");
+    assert!(
+        verdict(&path).starts_with("as good as 16-bit storage allows"),
+        "{text}"
+    );
+}

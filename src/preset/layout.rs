@@ -125,6 +125,9 @@ pub enum Stored {
     F16,
     /// 8-bit unsigned normalised, `round(255 v) / 255` ([`crate::format::png::unorm8`]).
     Unorm8,
+    /// 16-bit unsigned normalised, `round(65535 v) / 65535` (a 16-bit PNG given where the
+    /// engine's is 8-bit: [`crate::preset::Preset::storage_of`]).
+    Unorm16,
 }
 
 impl Stored {
@@ -141,6 +144,17 @@ impl Stored {
             Stored::F32 => |v| f64::from(v as f32),
             Stored::F16 => crate::format::f16::stored,
             Stored::Unorm8 => |v| f64::from(crate::format::png::unorm8(v)) / 255.0,
+            Stored::Unorm16 => |v| (v.clamp(0.0, 1.0) * 65535.0).round() / 65535.0,
+        }
+    }
+
+    /// The spacing of a fixed-point storage (`1 / 255` for 8 bits), 0 for a floating one.
+    #[must_use]
+    pub fn step(self) -> f64 {
+        match self {
+            Stored::F32 | Stored::F16 => 0.0,
+            Stored::Unorm8 => 1.0 / 255.0,
+            Stored::Unorm16 => 1.0 / 65535.0,
         }
     }
 
@@ -151,6 +165,7 @@ impl Stored {
             Stored::F32 => "f32",
             Stored::F16 => "f16",
             Stored::Unorm8 => "8-bit",
+            Stored::Unorm16 => "16-bit",
         }
     }
 }

@@ -130,11 +130,29 @@ impl Preset {
     /// (half floats, 8 bits); `None` for f32, whose cost is below anything an audit reports.
     #[must_use]
     pub fn storage(self) -> Option<crate::verify::Storage> {
-        let stored = self.layout().stored;
+        Self::storage_as(self.layout().stored)
+    }
+
+    fn storage_as(stored: layout::Stored) -> Option<crate::verify::Storage> {
         (stored != layout::Stored::F32).then(|| crate::verify::Storage {
             name: stored.name(),
             round: stored.rounding(),
+            step: stored.step(),
         })
+    }
+
+    /// [`Preset::storage`] of the engine's file `bytes` as it is: a 16-bit PNG given where the
+    /// engine writes 8 bits is audited against 16-bit storage (its floor is 7.6e-6, not 1.96e-3).
+    #[must_use]
+    pub fn storage_of(self, bytes: &[u8]) -> Option<crate::verify::Storage> {
+        let stored = self.layout().stored;
+        // A PNG's bit depth is byte 24, in its IHDR chunk after the 8-byte signature.
+        let sixteen_bit_png = bytes.starts_with(b"\x89PNG\r\n\x1a\n") && bytes.get(24) == Some(&16);
+        if stored == layout::Stored::Unorm8 && sixteen_bit_png {
+            Self::storage_as(layout::Stored::Unorm16)
+        } else {
+            Self::storage_as(stored)
+        }
     }
 
     /// The name on the command line.

@@ -5,6 +5,7 @@
 pub mod error_map;
 pub mod furnace;
 pub mod input;
+pub mod verdict;
 
 pub use error_map::{ErrorMap, MAX_MAP_CELLS, error_maps};
 
@@ -57,6 +58,9 @@ pub struct Storage {
     pub name: &'static str,
     /// A value as stored, widened back.
     pub round: fn(f64) -> f64,
+    /// The spacing of a fixed-point storage (`1 / 255` for 8 bits), 0 for a floating one: what
+    /// [`verdict`] compares a file's errors with.
+    pub step: f64,
 }
 
 /// What storing the truth itself would cost: the table of the true node values as the storage
@@ -944,6 +948,7 @@ mod tests {
         let storage = Storage {
             name: "plus",
             round: |x| x + 2e-3,
+            step: 0.0,
         };
         let settings = AuditSettings {
             storage: Some(storage),

@@ -678,7 +678,7 @@ pub fn run(args: VerifyArgs) -> kiln::Result<bool> {
                     })?;
                 normalisation_audit(args, table, &e, &e_path)?
             } else {
-                audit_one(args, table, preset.storage())?
+                audit_one(args, table, preset.storage_of(&bytes))?
             };
         }
         if let Some(audit) = preset.audit_extra(&bytes).map_err(in_file)? {
@@ -932,8 +932,15 @@ fn audit_one(
     let passed = args
         .max_error
         .is_none_or(|bound| report.node_max_error <= bound);
+    // For a file in fixed point (an 8-bit PNG): whether it is as good as that allows, and the
+    // likely mistake where it is not.
+    let verdict = storage.and_then(|s| kiln::verify::verdict::verdict(table, &report, &s));
     if args.json {
-        println!("{}", json_report(&report, args, passed));
+        let mut object = json_report(&report, args, passed);
+        if let Some(v) = &verdict {
+            object["verdict"] = serde_json::to_value(v).expect("a verdict serialises");
+        }
+        println!("{object}");
     } else if args.quiet {
         quiet_verdict(args, passed, "node max error", report.node_max_error);
     } else {
@@ -984,6 +991,26 @@ fn audit_one(
                 cost.lookup_max_error,
                 cost.lookup_rms_error
             );
+        }
+        if let Some(v) = &verdict {
+            println!("  verdict: {}", v.sentence);
+            if let Some(cost) = &report.storage_cost
+                && cost.lookup_max_error >= 0.5 * report.lookup_max_error
+                && report.lookup_max_error > 10.0 * cost.node_max_error
+            {
+                let at = &report.worst_lookup;
+                println!(
+                    "  the lookups' {:.2e} is the layout's own, not the file's: the true values \
+                     stored in it give {:.2e}, where a bilinear lookup cannot follow the table \
+                     between or beyond its texel centres (worst at {}r = {:.6})",
+                    report.lookup_max_error,
+                    cost.lookup_max_error,
+                    at.mu
+                        .map(|mu| format!("mu = {mu:.6}, "))
+                        .unwrap_or_default(),
+                    at.roughness
+                );
+            }
         }
         if report.node_reference_tolerance > 0.0 {
             println!(
