@@ -901,22 +901,31 @@ pub fn estimated_core_seconds(spec: &TableSpec) -> f64 {
             texels * spec.qmc.samples as f64 / rate
         }
         Method::Reference => {
-            let per_texel = match (spec.quantity, beckmann) {
-                (Quantity::E, false) => 0.3e-3,
-                (Quantity::E, true) => 0.6e-3,
-                (Quantity::EAvg, false) => 4e-3,
-                (Quantity::EAvg, true) => 25e-3,
-                (Quantity::EDielectric, _) => 1.1e-3,
-                (Quantity::EDielectricInside, _) => 3.2e-3,
-                (Quantity::EAvgDielectric, _) => 37e-3,
-                (Quantity::EAvgDielectricInside, _) => 49e-3,
-                (Quantity::FAvg, _) => 1e-5,
-                // Integrals of the E table's lookup, not of the BRDF.
-                (Quantity::FMsNorm, _) => 0.15e-3,
-                _ => 0.15e-3,
-            };
             let digits = spec.reference_digits.unwrap_or(10);
-            texels * per_texel * f64::from(digits) / 8.0
+            texels * reference_seconds_per_point(spec, digits)
         }
     }
+}
+
+/// The estimated cost of one reference value of `spec`'s quantity and model at tolerance
+/// `10^-digits`, in seconds of one core (the per-texel figures of [`estimated_core_seconds`]):
+/// for `kiln verify` to say how long an audit will take.
+#[must_use]
+pub fn reference_seconds_per_point(spec: &TableSpec, digits: u32) -> f64 {
+    let beckmann = spec.model.ndf == crate::model::Ndf::Beckmann;
+    let per_texel = match (spec.quantity, beckmann) {
+        (Quantity::E, false) => 0.3e-3,
+        (Quantity::E, true) => 0.6e-3,
+        (Quantity::EAvg, false) => 4e-3,
+        (Quantity::EAvg, true) => 25e-3,
+        (Quantity::EDielectric, _) => 1.1e-3,
+        (Quantity::EDielectricInside, _) => 3.2e-3,
+        (Quantity::EAvgDielectric, _) => 37e-3,
+        (Quantity::EAvgDielectricInside, _) => 49e-3,
+        (Quantity::FAvg, _) => 1e-5,
+        // Integrals of the E table's lookup, not of the BRDF.
+        (Quantity::FMsNorm, _) => 0.15e-3,
+        _ => 0.15e-3,
+    };
+    per_texel * f64::from(digits) / 8.0
 }

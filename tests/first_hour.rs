@@ -407,3 +407,34 @@ fn a_games202_file_gets_a_verdict_that_names_its_mistake() {
         "{text}"
     );
 }
+
+/// Item 8: Blender's whole `shader.tables` took 157 s with a bar per table ("eta 14s" with two
+/// minutes left) and no warning. Now the audit says its estimate for the whole file before it
+/// starts (the measured time: 2 min 24 s on 2 cores, docs/engines.md).
+#[test]
+fn a_long_audit_says_how_long_for_the_whole_file_first() {
+    use std::io::BufRead;
+    let file =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/engines/cycles/shader.tables");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_kiln"))
+        .args(["verify", "--preset", "cycles", file.to_str().unwrap()])
+        .env("RAYON_NUM_THREADS", "2")
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut line = String::new();
+    std::io::BufReader::new(child.stderr.take().unwrap())
+        .read_line(&mut line)
+        .unwrap();
+    child.kill().unwrap();
+    child.wait().unwrap();
+    // Within a factor of three of the measured 144 s: "estimated 2.6 min on 2 threads".
+    let minutes: f64 = line
+        .split("estimated ")
+        .nth(1)
+        .and_then(|rest| rest.split(" min").next())
+        .and_then(|number| number.trim().parse().ok())
+        .unwrap_or_else(|| panic!("no estimate in minutes: {line}"));
+    assert!((0.8..=7.2).contains(&minutes), "{line}");
+}
