@@ -203,3 +203,39 @@ fn numbers_are_read_with_their_printed_precision() {
     assert!((last_digit("0.9987730") - 1e-7).abs() < 1e-20);
     assert_eq!(last_digit("5980"), 1.0);
 }
+
+/// The `kiln eval` table of docs/accuracy.md (issue 42: five of its seven rows had gone stale):
+/// each row's ARGS, run with `--json`, give the row's value to its ten decimals and its
+/// standard error to its last digit.
+#[test]
+fn the_documented_eval_table_is_what_kiln_eval_prints() {
+    let page = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/accuracy.md");
+    let text = std::fs::read_to_string(&page).unwrap();
+    let mut rows = 0;
+    for line in text.lines().filter(|l| l.starts_with("| ") && l.contains("| `--ndf")) {
+        let cells: Vec<&str> = line.split('|').map(str::trim).collect();
+        let args: Vec<&str> = cells[2].trim_matches('`').split_whitespace().collect();
+        let (value, std_error) = (cells[3], cells[4]);
+        let mut command = vec!["eval"];
+        command.extend(&args);
+        command.push("--json");
+        let output = Command::new(env!("CARGO_BIN_EXE_kiln"))
+            .args(&command)
+            .output()
+            .unwrap();
+        assert!(output.status.success(), "{line}");
+        let json: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+        let got = json["value"].as_f64().unwrap();
+        let got_error = json["std_error"].as_f64().unwrap();
+        assert!(
+            (got - value.parse::<f64>().unwrap()).abs() <= 1.01 * last_digit(value),
+            "{line}: kiln eval now gives {got:.10}"
+        );
+        assert!(
+            (got_error - std_error.parse::<f64>().unwrap()).abs() <= 1.01 * last_digit(std_error),
+            "{line}: kiln eval now gives std error {got_error:.1e}"
+        );
+        rows += 1;
+    }
+    assert_eq!(rows, 7, "the table's rows were not found");
+}
