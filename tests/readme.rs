@@ -212,7 +212,10 @@ fn the_documented_eval_table_is_what_kiln_eval_prints() {
     let page = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/accuracy.md");
     let text = std::fs::read_to_string(&page).unwrap();
     let mut rows = 0;
-    for line in text.lines().filter(|l| l.starts_with("| ") && l.contains("| `--ndf")) {
+    for line in text
+        .lines()
+        .filter(|l| l.starts_with("| ") && l.contains("| `--ndf"))
+    {
         let cells: Vec<&str> = line.split('|').map(str::trim).collect();
         let args: Vec<&str> = cells[2].trim_matches('`').split_whitespace().collect();
         let (value, std_error) = (cells[3], cells[4]);
@@ -238,4 +241,193 @@ fn the_documented_eval_table_is_what_kiln_eval_prints() {
         rows += 1;
     }
     assert_eq!(rows, 7, "the table's rows were not found");
+}
+
+/// Whether `text` states a duration: a number, an optional space and `s`, `ms`, `min` or `h`,
+/// standing alone (`0.18 s`, `2 min`; not `2^19 samples`, `1e-3`, `32 x 32`).
+fn states_a_duration(text: &str) -> bool {
+    let b = text.as_bytes();
+    let mut k = 0;
+    while k < b.len() {
+        let alone = k == 0 || !(b[k - 1].is_ascii_alphanumeric() || b[k - 1] == b'.');
+        if !(b[k].is_ascii_digit() && alone) {
+            k += 1;
+            continue;
+        }
+        let mut end = k;
+        while end < b.len() && (b[end].is_ascii_digit() || b[end] == b'.') {
+            end += 1;
+        }
+        let rest = &text[end..];
+        let rest = rest.strip_prefix(' ').unwrap_or(rest);
+        for unit in ["ms", "min", "s", "h"] {
+            if let Some(after) = rest.strip_prefix(unit)
+                && after
+                    .chars()
+                    .next()
+                    .is_none_or(|c| !(c.is_alphanumeric() || c == '-' || c == '_'))
+            {
+                return true;
+            }
+        }
+        k = end.max(k + 1);
+    }
+    false
+}
+
+/// Whether `text` dates a figure: a date (`2026-12-03`), a numerics version or a commit it was
+/// measured at, or says the figure is an estimate or a bound rather than a measurement.
+fn dates_it(text: &str) -> bool {
+    let lower = text.to_lowercase();
+    let b = lower.as_bytes();
+    let date = (0..b.len().saturating_sub(9)).any(|k| {
+        let d = |i: usize| b[k + i].is_ascii_digit();
+        b[k..].starts_with(b"20")
+            && d(2)
+            && d(3)
+            && b[k + 4] == b'-'
+            && d(5)
+            && d(6)
+            && b[k + 7] == b'-'
+            && d(8)
+            && d(9)
+    });
+    let commit = lower.match_indices("commit ").any(|(at, m)| {
+        lower[at + m.len()..]
+            .chars()
+            .take(7)
+            .filter(char::is_ascii_hexdigit)
+            .count()
+            == 7
+    });
+    date || commit
+        || lower
+            .match_indices("numerics version ")
+            .any(|(at, m)| lower[at + m.len()..].starts_with(|c: char| c.is_ascii_digit()))
+        || lower
+            .split(|c: char| !c.is_alphanumeric())
+            .any(|w| ["estimated", "estimate", "timeout", "limit", "limits"].contains(&w))
+}
+
+/// Issue 42: figures of time went stale (a bake "0.80 s" that took 0.30, `study --quick` "22 s"
+/// for 9.2). Every duration the pages state in prose (outside the fenced blocks, whose `$ kiln`
+/// lines the test above runs) must say when it was measured: a date, a numerics version or a
+/// commit, in its paragraph (a table: in its caption, one of the two paragraphs before it or
+/// its section's first); or be an estimate or a bound.
+#[test]
+fn every_documented_timing_says_when_it_was_measured() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut pages = vec![root.join("README.md")];
+    let mut docs: Vec<_> = std::fs::read_dir(root.join("docs"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "md"))
+        .collect();
+    docs.sort();
+    pages.extend(docs);
+    let mut undated = Vec::new();
+    let mut checked = 0;
+    for page in &pages {
+        let text = std::fs::read_to_string(page).unwrap();
+        // Paragraphs outside fenced blocks, with the line each starts on; a heading ends one and
+        // starts a section.
+        let mut in_block = false;
+        let mut paragraph: Vec<&str> = Vec::new();
+        let mut start = 0;
+        let mut section_first: Option<String> = None;
+        let mut before: Vec<String> = Vec::new();
+        let mut finish = |paragraph: &mut Vec<&str>,
+                          start: usize,
+                          section_first: &mut Option<String>,
+                          before: &mut Vec<String>| {
+            if paragraph.is_empty() {
+                return;
+            }
+            let joined = paragraph.join(" ");
+            // Inline code is commands and names, not figures.
+            let prose: String = joined.split('`').step_by(2).collect::<Vec<_>>().join(" ");
+            if states_a_duration(&prose) {
+                checked += 1;
+                // A table is dated by its caption (the paragraph before it, or its section's
+                // first); prose must date its own figures.
+                let table = joined.trim_start().starts_with('|');
+                let context = table
+                    && before
+                        .iter()
+                        .rev()
+                        .take(2)
+                        .chain(section_first.iter())
+                        .any(|p| dates_it(p));
+                if !dates_it(&joined) && !context {
+                    undated.push(format!(
+                        "{}:{}: {}",
+                        page.display(),
+                        start + 1,
+                        &joined[..joined.len().min(120)]
+                    ));
+                }
+            }
+            if section_first.is_none() {
+                *section_first = Some(joined.clone());
+            }
+            before.push(joined);
+            paragraph.clear();
+        };
+        for (k, line) in text.lines().enumerate() {
+            if line.starts_with("```") {
+                in_block = !in_block;
+                finish(&mut paragraph, start, &mut section_first, &mut before);
+                continue;
+            }
+            if in_block {
+                continue;
+            }
+            if line.trim().is_empty() || line.starts_with('#') {
+                finish(&mut paragraph, start, &mut section_first, &mut before);
+                if line.starts_with('#') {
+                    section_first = None;
+                    before.clear();
+                }
+                continue;
+            }
+            if paragraph.is_empty() {
+                start = k;
+            }
+            paragraph.push(line);
+        }
+        finish(&mut paragraph, start, &mut section_first, &mut before);
+    }
+    assert!(
+        checked > 20,
+        "only {checked} paragraphs with durations found"
+    );
+    assert!(
+        undated.is_empty(),
+        "durations without a date, numerics version or commit:\n{}",
+        undated.join("\n")
+    );
+}
+
+#[test]
+fn durations_and_dates_are_recognised() {
+    for (text, duration) in [
+        ("bakes in 0.18 s on 2 cores", true),
+        ("took 2 min 21 s", true),
+        ("3.5 ms each", true),
+        ("2^19 samples, 1e-3, 32 x 32, 5 sigma, 0.5 sr", false),
+        ("the 16 x 16 x 16 tables", false),
+    ] {
+        assert_eq!(states_a_duration(text), duration, "{text}");
+    }
+    for (text, dated) in [
+        ("median of 5, 2026-12-03", true),
+        ("numerics version 6", true),
+        ("against commit 29b77f9", true),
+        ("estimated 2.6 min", true),
+        ("one run, time", false),
+        ("every estimator", false),
+        ("numerics version", false),
+    ] {
+        assert_eq!(dates_it(text), dated, "{text}");
+    }
 }
