@@ -438,3 +438,33 @@ fn a_long_audit_says_how_long_for_the_whole_file_first() {
         .unwrap_or_else(|| panic!("no estimate in minutes: {line}"));
     assert!((0.8..=7.2).contains(&minutes), "{line}");
 }
+
+/// Item 6: a wgpu user uploading the default `.ktx2` (RG32Float) with a linear sampler gets a
+/// validation error unless the device has `float32-filterable`. The generated WGSL says so and
+/// points at `--precision f16`, whose texture is RG16Float (checked in the file's own header).
+#[test]
+fn the_wgsl_says_which_texture_webgpu_filters() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = dir.path().to_str().unwrap();
+    ok(&[
+        "bake",
+        "--quantity",
+        "e",
+        "--size",
+        "4",
+        "--format",
+        "wgsl,ktx2",
+        "--precision",
+        "f16",
+        "-q",
+        "--out",
+        o,
+    ]);
+    let wgsl = std::fs::read_to_string(dir.path().join("ggx-height-correlated-E.wgsl")).unwrap();
+    assert!(wgsl.contains("float32-filterable"), "{wgsl}");
+    assert!(wgsl.contains("--precision f16"), "{wgsl}");
+    // KTX2's vkFormat (bytes 12..16 of the header): 83 is VK_FORMAT_R16G16_SFLOAT.
+    let ktx2 = std::fs::read(dir.path().join("ggx-height-correlated-E.ktx2")).unwrap();
+    let format = u32::from_le_bytes(ktx2[12..16].try_into().unwrap());
+    assert_eq!(format, 83);
+}

@@ -219,6 +219,14 @@ pub fn encode(table: &Table, language: Language) -> String {
             String::new()
         }
     );
+    if language == Language::Wgsl {
+        let _ = writeln!(
+            out,
+            "{c} WebGPU filters the default f32 texture (RG32Float) linearly only with the \
+             optional float32-filterable feature;\n{c} kiln bake --precision f16 writes \
+             RG16Float, which every adapter filters (1 - value keeps the grazing digits)."
+        );
+    }
     // The coordinate function: fastest axis first (x, y, z).
     let dims = axes.len();
     out += &language.function(&format!("{stem}_uv"), &params, &language.vector(dims));
