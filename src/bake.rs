@@ -1,6 +1,6 @@
 //! Baking: from options to table specs, and from a spec to a table, texels in parallel.
 //!
-//! Each texel is one QMC estimate ([`crate::integrate::albedo`]), a pure function of the spec and
+//! Each texel is one QMC estimate ([`crate::integrate::albedo`](mod@crate::integrate::albedo)), a pure function of the spec and
 //! the texel's coordinates, summed in a fixed order inside one thread. Rayon spreads texels over
 //! cores and collects them in index order, so a table is byte-identical for any thread count.
 
@@ -308,7 +308,7 @@ impl BakeOptions {
 
     /// The options `bake` runs with: these, or for a `max_error` the cheapest method that meets
     /// it, by what `kiln study` measured (GGX, 32 x 32, kiln's axes; README "What accuracy
-    /// costs"): from 1e-3 up (glass excepted, [`BakeOptions::bakes_glass`]), QMC with
+    /// costs"): from 1e-3 up (glass excepted, `BakeOptions::bakes_glass`), QMC with
     /// visible-normal sampling, whose max error over a table
     /// falls as about `N^-0.9`, at the smallest power of two `N >= (2 / max_error)^(1 / 0.9)`
     /// (twice the margin; 16 times that for `E_avg`); below 1e-3, where it is cheaper at every

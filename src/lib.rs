@@ -35,6 +35,30 @@
 //! # Ok::<(), kiln::Error>(())
 //! ```
 //!
+//! A build script (`build.rs`) of an engine crate that depends on kiln with
+//! `default-features = false`, bakes what its scene needs into `OUT_DIR` (through kiln's cache
+//! there, so an unchanged scene costs nothing) and `include!`s the Rust tables
+//! (`examples/build-script` is such a crate, built and run by the tests):
+//!
+//! ```no_run
+//! // build.rs
+//! use std::path::{Path, PathBuf};
+//!
+//! fn main() -> Result<(), kiln::Error> {
+//!     println!("cargo::rerun-if-changed=scene.toml");
+//!     let out = PathBuf::from(std::env::var("OUT_DIR").expect("cargo sets OUT_DIR"));
+//!     let scene = kiln::scene::Scene::read(Path::new("scene.toml"))?;
+//!     // OUT_DIR is this build's own: a changed scene replaces what an earlier build wrote.
+//!     let baked = scene.bake(&out, &|_samples| {}, kiln::format::replace::Replace::Force)?;
+//!     for table in &baked.report.baked {
+//!         println!("cargo::warning=kiln baked {table}");
+//!     }
+//!     Ok(())
+//! }
+//! // src/lib.rs then holds, for the scene's GGX tables:
+//! // include!(concat!(env!("OUT_DIR"), "/ggx-height-correlated-E.rs"));
+//! ```
+//!
 //! Conventions, everywhere: `mu = cos(theta)` of the view direction; roughness is either the
 //! perceptual `r` with `alpha = r^2` or `alpha` itself, and every table says which; grids put
 //! samples at nodes `i / (N - 1)` (the default) or at texel centres `(i + 0.5) / N`.

@@ -634,7 +634,7 @@ struct Share<'a> {
 }
 
 /// Texels and check terms the merge computes again per table, spread over the shards (at least
-/// one of each per shard): [`confirm_shares`].
+/// one of each per shard): `confirm_shares`.
 pub const MERGE_CONFIRMATIONS: usize = 16;
 
 /// `m` of the `n` positions `0..n`, evenly spread from an offset keyed by `key` (a shard's

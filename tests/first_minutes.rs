@@ -103,6 +103,8 @@ fn the_repository_root_holds_no_junk() {
         ".gitignore",
         "Cargo.lock",
         "Cargo.toml",
+        "LICENSE-APACHE",
+        "LICENSE-MIT",
         "README.md",
         "benches",
         "docs",

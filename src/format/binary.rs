@@ -28,8 +28,8 @@
 //! bytes after the version-1 fixed header: at 64 `dims[2]` (the fastest axis, mu, of a rank-3
 //! table; 1 otherwise), 68..80 reserved (0), at 80 the axis 2 descriptor; the channel entries
 //! then start at 96 and are 48 bytes each (a 40-byte name, then dtype and offset as above), and
-//! the planes hold `dims[0] * dims[1] * dims[2]` values (index = (i0 * dims[1] + i1) * dims[2]
-//! + i2).
+//! the planes hold `dims[0] * dims[1] * dims[2]` values (index
+//! `(i0 * dims[1] + i1) * dims[2] + i2`).
 //!
 //! Channels, in order: `E`, `one_minus_E`, `std_error` (or `E_avg`, `one_minus_E_avg`,
 //! `std_error`). The value channels use the requested precision; `std_error` is always f32.

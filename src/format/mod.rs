@@ -357,7 +357,7 @@ pub fn write_files(dir: &Path, files: &[(String, Vec<u8>)]) -> Result<Vec<PathBu
 const STALE_AFTER: std::time::Duration = std::time::Duration::from_secs(60);
 
 /// Removes the temporary files an interrupted kiln left in `dir` (`.NAME.EXT.XXXXXX.tmp` of the
-/// files kiln writes, and `.kiln-probe-*`), if older than [`STALE_AFTER`], so that a
+/// files kiln writes, and `.kiln-probe-*`), if older than `STALE_AFTER`, so that a
 /// concurrent bake's own are left alone. Returns how many were removed; failures to remove are
 /// ignored (the next run tries again).
 pub fn remove_stale_temporaries(dir: &Path) -> usize {

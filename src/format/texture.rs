@@ -109,7 +109,7 @@ fn metadata_json(tables: &[&Table]) -> String {
     object.to_string()
 }
 
-/// The tables' metadata of a texture's `kiln` JSON (as [`metadata_json`] writes it).
+/// The tables' metadata of a texture's `kiln` JSON (as `metadata_json` writes it).
 pub fn texture_metadata(text: &str) -> std::result::Result<Vec<super::metadata::Metadata>, String> {
     #[derive(serde::Deserialize)]
     struct TextureMetadata {

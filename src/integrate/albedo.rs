@@ -494,7 +494,7 @@ pub fn ggx_rim(vz: f64) -> f64 {
 }
 
 /// One stratum of the cap coordinate: `t = start + width u` for `u` uniform in [0, 1), whose
-/// samples carry the stratum's measure `weight = width` (see [`stratified_sum`]).
+/// samples carry the stratum's measure `weight = width` (see `stratified_sum`).
 #[derive(Clone, Copy, Debug)]
 pub struct Stratum {
     pub start: f64,

@@ -6,7 +6,7 @@
 //! `cos(theta) = mu` that a single scattering event at the interface of relative index `eta`
 //! (`n_other / n_view`) sends on, by reflection or by refraction. `E_avg,eta = 2 ∫ E_eta(mu) mu dmu`.
 //!
-//! QMC: visible-normal sampling as for `E` ([`super::albedo`]), each sample scoring both branches
+//! QMC: visible-normal sampling as for `E` ([`super::albedo`](mod@super::albedo)), each sample scoring both branches
 //! (no Russian roulette between them, so no variance from the choice); `1 - E` is accumulated.
 //!
 //! Reference: the parametrisation of [`super::reference`] (`phi in [0, pi]`, `x = ln(tan(theta_m)
@@ -18,7 +18,7 @@
 //! Geometric ladders of breaks close in on the two horizons, whose masking layers are ~`alpha`
 //! wide (as `E`'s horizon ladder). The piece below the peak is integrated from `x = -infinity` in
 //! `s = t / (alpha + t)`, as in `E`'s reference; above, `x` is cut where GGX's tail holds a
-//! hundredth of the tolerance ([`super::reference::x_range`]).
+//! hundredth of the tolerance (`super::reference::x_range`).
 //!
 //! The averages integrate over the microfacet normal first ([`super::dielectric_average`]);
 //! [`nested_dielectric_average_albedo_with`], an integral over `mu` of the reference above, is

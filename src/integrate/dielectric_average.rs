@@ -9,7 +9,7 @@
 //! `X_avg = (1 / pi) ∫ dω_o ∫ dω_m D(m) (o.m)+ G1(o) s_X(o, m) = (1 / pi) ∫ dω_m D(m) K_X(m)`,
 //!
 //! with `s_X` the reflected, transmitted or lost fraction at one visible normal
-//! ([`scattering_at_cos`], Walter et al. 2007 with Smith masking; `docs/physics.md`) and
+//! (`scattering_at_cos`, Walter et al. 2007 with Smith masking; `docs/physics.md`) and
 //! `K_X(m) = ∫ (o.m)+ G1(o) s_X(o, m) dω_o` over the views above the surface. `K` depends only
 //! on `theta_m` (isotropy). In the normal's frame, with `o.m = cos(theta_h)` and `phi_h` the
 //! view's azimuth about `m` (`phi_h = 0` tilted toward the macro normal):

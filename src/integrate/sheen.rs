@@ -12,7 +12,7 @@
 //! and covers every `phi` below `theta_h = (pi/2 - theta_o) / 2`: both are break points of the
 //! outer integral, as is the distribution's width `1 / sqrt(k)`, `k = 1 / (2 alpha)`, past the
 //! support's start. Both integrals are adaptive Gauss-Kronrod ([`super::gauss_kronrod`]); the
-//! inner one evaluates a rule's nodes at once ([`inner_values`], compiled for AVX2 where the CPU
+//! inner one evaluates a rule's nodes at once (`inner_values`, compiled for AVX2 where the CPU
 //! has it), and its error estimates are carried through the outer integral into the stated error.
 
 use super::albedo::sin_from_cos;

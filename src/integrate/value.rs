@@ -9,7 +9,7 @@
 //!
 //! - `E` and the split-sum channels (`E_scale`, `E_bias`, the weight `h(o.h)` of
 //!   [`Quantity::weight`]): the reference ([`super::reference`]) or VNDF QMC
-//!   ([`super::albedo`]);
+//!   ([`super::albedo`](mod@super::albedo));
 //! - `E_F` for a grey Fresnel model: for a dielectric the reflected part of the dielectric
 //!   quadrature (it splits at the critical angle, where `F` has a square-root kink that misleads
 //!   the generic rule's error estimate), otherwise the reference weighted by `F(o.h)`;

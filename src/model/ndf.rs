@@ -3,7 +3,7 @@
 //! Each distribution is a small type whose methods carry the formulas' book names (`d`, `lambda`,
 //! `g1`, `sample_visible_normal`), in the manner of pbrt-v4's `TrowbridgeReitzDistribution`.
 //! Roughness is always `alpha` here (the slope-space width); the perceptual `r` with
-//! `alpha = r^2` is converted at the edges (see [`crate::Roughness`]).
+//! `alpha = r^2` is converted at the edges (see `crate::Roughness`).
 //!
 //! Sources: Walter et al. 2007, "Microfacet Models for Refraction through Rough Surfaces" (D and
 //! Lambda of both distributions); Heitz 2014, "Understanding the Masking-Shadowing Function in
@@ -580,8 +580,8 @@ impl VisibleSlopeX {
     /// The share of the visible x-slopes above `x`, `(C(b) - C(x)) / C(b)`, with the upper tail
     /// computed as `C(b) - C(x) = (b sqrt(pi) (erfc(x) - erfc(b)) + exp(-b^2) - exp(-x^2)) / 2`
     /// (the difference of the CDF's two terms, each from `erfc` of a positive argument where it
-    /// matters), and near the end `b`, where those terms cancel ([`near_the_end`]), as
-    /// `exp(-b^2)` times [`tilted_end_integral`]; so shares far below f64's epsilon keep their
+    /// matters), and near the end `b`, where those terms cancel (`near_the_end`), as
+    /// `exp(-b^2)` times `tilted_end_integral`; so shares far below f64's epsilon keep their
     /// relative precision (within 1e-13 of 80-digit values, tested). At normal incidence the slope
     /// is Gaussian: `erfc(x) / 2`.
     #[must_use]

@@ -192,7 +192,7 @@ fn cody_rational<const P: usize, const Q: usize>(x: f64, p: &[f64; P], q: &[f64;
 /// before its rational fit), `Lambda = (exp(-a^2) / (a sqrt(pi)) - erfc(a)) / 2`, at several `a`
 /// at once, branch-free so that the loop vectorises. `a = 0` gives `+inf`, `a = +inf` gives 0.
 ///
-/// `erfc` comes from Cody's three rational approximations (see [`CODY_A`]), each written so that
+/// `erfc` comes from Cody's three rational approximations (see `CODY_A`), each written so that
 /// the two terms of `Lambda` cancel as little as they can:
 /// - `a <= 0.46875`: `(exp(-a^2) / (a sqrt(pi)) - 1 + a A(a^2) / B(a^2)) / 2`;
 /// - `a <= 4`: `exp(-a^2) (1 / (a sqrt(pi)) - C(a) / D(a)) / 2`, which loses at most

@@ -13,7 +13,7 @@
 //!
 //! The first two and "VNDF, random" use independent pseudo-random points (SplitMix64, Steele et al.
 //! 2014), seeded per texel; "NDF, Sobol" uses one Owen-scrambled Sobol sequence; "VNDF, Sobol" is
-//! [`crate::integrate::albedo`] itself (kiln's default, two scrambles).
+//! [`crate::integrate::albedo`](mod@crate::integrate::albedo) itself (kiln's default, two scrambles).
 //! `G2 / mu_o` is evaluated as `1 / (projected_area(mu_o) + mu_o Lambda(i))` (height-correlated)
 //! or `G1(i) / projected_area(mu_o)` (separable), finite at `mu_o = 0`.
 
