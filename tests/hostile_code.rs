@@ -325,3 +325,55 @@ fn a_carried_array_that_is_not_numbers_is_refused() {
         assert!(!out.exists());
     }
 }
+
+/// A scene's material names reach only `materials.json` (JSON, escaped), never generated code:
+/// a name that tries to close a comment and a string, baked into every code format.
+#[test]
+fn a_hostile_material_name_stays_out_of_generated_code() {
+    let dir = tempfile::tempdir().unwrap();
+    let name = "evil*/ int injected_g; /* \\\" `x` ??/";
+    let scene = format!(
+        "[output]\nformats = [\"rs\", \"h\", \"wgsl\", \"glsl\", \"hlsl\", \"json\"]\n\
+         max_error = 1e-3\n\n[[material]]\nname = {}\nndf = \"ggx\"\nroughness = 0.5\n",
+        serde_json::to_string(name).unwrap()
+    );
+    let path = dir.path().join("scene.toml");
+    std::fs::write(&path, scene).unwrap();
+    let out = dir.path().join("out");
+    let run = kiln(&[
+        "bake",
+        "--scene",
+        path.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "-q",
+    ]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let files: Vec<(String, Vec<u8>)> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.is_file())
+        .map(|p| {
+            (
+                p.file_name().unwrap().to_string_lossy().into_owned(),
+                std::fs::read(&p).unwrap(),
+            )
+        })
+        .collect();
+    assert!(free_of_injections(&files, "scene") >= 5);
+    for (file, bytes) in &files {
+        if rules_of(file).is_some() {
+            assert!(
+                !String::from_utf8_lossy(bytes).contains("evil"),
+                "{file} holds the material's name"
+            );
+        }
+    }
+    let materials: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("materials.json")).unwrap()).unwrap();
+    assert_eq!(materials["materials"][0]["name"], name);
+}
