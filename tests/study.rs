@@ -87,6 +87,29 @@ fn study_errors_are_recomputed_against_the_reference() {
     // One summary per method, each with the three targets.
     assert_eq!(report.summary.len(), 3);
     assert!(report.summary.iter().all(|s| s.reaches.len() == 3));
+    // Each method's convergence exponent, recomputed here from its runs as the least-squares
+    // slope of ln(max error) on ln(samples); none for a method with one run.
+    for summary in &report.summary {
+        let points: Vec<(f64, f64)> = report
+            .runs
+            .iter()
+            .filter(|r| r.method == summary.method && r.tolerance.is_none())
+            .map(|r| ((r.samples as f64).ln(), r.max_error.ln()))
+            .collect();
+        match points.as_slice() {
+            [(x0, y0), (x1, y1)] => {
+                let p = -(y1 - y0) / (x1 - x0);
+                let got = summary.convergence_exponent.unwrap();
+                assert!(
+                    (got - p).abs() < 1e-12,
+                    "{}: {got} against {p}",
+                    summary.method
+                );
+            }
+            [_] | [] => assert_eq!(summary.convergence_exponent, None, "{}", summary.method),
+            other => panic!("{} runs of {}", other.len(), summary.method),
+        }
+    }
     // The adaptive axis beats the linear one at this size, as verify measures.
     assert_eq!(report.lookup.len(), 2);
     assert!(report.lookup[1].max_error < report.lookup[0].max_error);

@@ -162,11 +162,37 @@ pub struct Reach {
     pub samples: Option<u64>,
 }
 
-/// Per method: when it reaches 1e-4, 1e-6 and 1e-8.
+/// Per method: when it reaches 1e-4, 1e-6 and 1e-8, and how fast its error falls.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Summary {
     pub method: String,
     pub reaches: Vec<Reach>,
+    /// The measured convergence exponent `p` of `max error ~ N^-p` over the method's runs
+    /// ([`convergence_exponent`]); `None` with fewer than two sample counts.
+    pub convergence_exponent: Option<f64>,
+}
+
+/// The least-squares slope of `ln(max error)` against `ln(samples)` over the sampling runs of
+/// `runs` (not the quadrature's, whose evaluations follow its tolerance, not a power law) with a
+/// positive, finite error, negated: `p` in `max error ~ N^-p` (plain Monte Carlo 0.5, QMC
+/// towards 1). `None` with fewer than two distinct sample counts.
+#[must_use]
+pub fn convergence_exponent(runs: &[&Run]) -> Option<f64> {
+    let points: Vec<(f64, f64)> = runs
+        .iter()
+        .filter(|r| r.tolerance.is_none())
+        .filter(|r| r.samples > 0 && r.max_error > 0.0 && r.max_error.is_finite())
+        .map(|r| ((r.samples as f64).ln(), r.max_error.ln()))
+        .collect();
+    let n = points.len() as f64;
+    let mean_x = points.iter().map(|p| p.0).sum::<f64>() / n;
+    let mean_y = points.iter().map(|p| p.1).sum::<f64>() / n;
+    let sxx: f64 = points.iter().map(|p| (p.0 - mean_x).powi(2)).sum();
+    if points.len() < 2 || sxx <= 0.0 {
+        return None;
+    }
+    let sxy: f64 = points.iter().map(|p| (p.0 - mean_x) * (p.1 - mean_y)).sum();
+    Some(-sxy / sxx)
 }
 
 /// The lookup error of one reference-filled table.
@@ -252,6 +278,12 @@ pub fn summarise(runs: &[Run]) -> Vec<Summary> {
                     }
                 })
                 .collect(),
+            convergence_exponent: convergence_exponent(
+                &runs
+                    .iter()
+                    .filter(|r| r.method == method)
+                    .collect::<Vec<_>>(),
+            ),
         })
         .collect()
 }
@@ -419,6 +451,52 @@ mod tests {
             max_error,
             rms_error: max_error / 2.0,
         }
+    }
+
+    /// `max error = 3 N^-0.75` (a power law, exactly): the exponent 0.75; one sample count, or
+    /// errors of 0, give none.
+    #[test]
+    fn the_convergence_exponent_is_the_power_law_s() {
+        let runs: Vec<Run> = (4..=10)
+            .map(|k| Run {
+                samples: 1 << k,
+                max_error: 3.0 * f64::from(1 << k).powf(-0.75),
+                ..run_at("a", 1.0, 0.0)
+            })
+            .collect();
+        let all: Vec<&Run> = runs.iter().collect();
+        let p = convergence_exponent(&all).unwrap();
+        assert!((p - 0.75).abs() < 1e-12, "{p}");
+        // Plain Monte Carlo's N^-1/2 from two counts a factor 4 apart and errors a factor 2.
+        let two = [
+            Run {
+                samples: 64,
+                ..run_at("b", 1.0, 1e-2)
+            },
+            Run {
+                samples: 256,
+                ..run_at("b", 1.0, 5e-3)
+            },
+        ];
+        let p = convergence_exponent(&two.iter().collect::<Vec<_>>()).unwrap();
+        assert!((p - 0.5).abs() < 1e-12, "{p}");
+        assert_eq!(convergence_exponent(&all[..1]), None);
+        let zero = run_at("c", 1.0, 0.0);
+        assert_eq!(convergence_exponent(&[&zero, &zero]), None);
+        // The quadrature's runs (with a tolerance) are not a power law in their evaluations.
+        let quadrature: Vec<Run> = runs
+            .iter()
+            .map(|r| Run {
+                tolerance: Some(1e-6),
+                ..r.clone()
+            })
+            .collect();
+        assert_eq!(
+            convergence_exponent(&quadrature.iter().collect::<Vec<_>>()),
+            None
+        );
+        let summary = summarise(&runs);
+        assert!((summary[0].convergence_exponent.unwrap() - 0.75).abs() < 1e-12);
     }
 
     #[test]

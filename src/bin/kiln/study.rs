@@ -190,17 +190,22 @@ pub fn run(args: StudyArgs) -> kiln::Result<()> {
         report.ndf, report.masking, report.size, report.size, report.threads
     );
     println!(
-        "{:<16} {:>22} {:>22} {:>22}",
+        "{:<16} {:>22} {:>22} {:>22} {:>12}",
         "time to max error",
         format!("{:.0e}", TARGETS[0]),
         format!("{:.0e}", TARGETS[1]),
-        format!("{:.0e}", TARGETS[2])
+        format!("{:.0e}", TARGETS[2]),
+        "error ~"
     );
     for summary in &report.summary {
         let cells: Vec<String> = summary.reaches.iter().map(reach_text).collect();
+        // The measured exponent of max error ~ N^-p over the method's runs.
+        let rate = summary
+            .convergence_exponent
+            .map_or_else(|| "-".to_string(), |p| format!("N^-{p:.2}"));
         println!(
-            "{:<16} {:>22} {:>22} {:>22}",
-            summary.method, cells[0], cells[1], cells[2]
+            "{:<16} {:>22} {:>22} {:>22} {:>12}",
+            summary.method, cells[0], cells[1], cells[2], rate
         );
     }
     println!("{}", headline(&report));
