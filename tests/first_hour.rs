@@ -413,22 +413,12 @@ fn a_games202_file_gets_a_verdict_that_names_its_mistake() {
 /// starts (the measured time: 2 min 24 s on 2 cores, docs/engines.md).
 #[test]
 fn a_long_audit_says_how_long_for_the_whole_file_first() {
-    use std::io::BufRead;
     let file =
         Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/engines/cycles/shader.tables");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_kiln"))
-        .args(["verify", "--preset", "cycles", file.to_str().unwrap()])
-        .env("RAYON_NUM_THREADS", "2")
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut line = String::new();
-    std::io::BufReader::new(child.stderr.take().unwrap())
-        .read_line(&mut line)
-        .unwrap();
-    child.kill().unwrap();
-    child.wait().unwrap();
+    let line = command::first_stderr_line(
+        &["verify", "--preset", "cycles", file.to_str().unwrap()],
+        &[("RAYON_NUM_THREADS", "2")],
+    );
     // Within a factor of three of the measured 144 s: "estimated 2.6 min on 2 threads".
     let minutes: f64 = line
         .split("estimated ")

@@ -5,9 +5,8 @@
 #![cfg(feature = "cli")]
 
 use serde_json::Value;
-use std::io::BufRead;
 use std::path::Path;
-use std::process::{Command, Output, Stdio};
+use std::process::Output;
 
 #[path = "common/command.rs"]
 mod command;
@@ -442,24 +441,16 @@ fn messages_teach() {
 #[test]
 fn a_long_bake_says_how_long_on_any_stderr() {
     let dir = tempfile::tempdir().unwrap();
-    let mut child = Command::new(env!("CARGO_BIN_EXE_kiln"))
-        .args([
+    let line = command::first_stderr_line(
+        &[
             "bake",
             "--size",
             "4096",
             "--out",
             dir.path().to_str().unwrap(),
-        ])
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut line = String::new();
-    std::io::BufReader::new(child.stderr.take().unwrap())
-        .read_line(&mut line)
-        .unwrap();
-    child.kill().unwrap();
-    child.wait().unwrap();
+        ],
+        &[],
+    );
     assert!(
         line.contains("estimated") && (line.contains(" h ") || line.contains(" min ")),
         "{line}"

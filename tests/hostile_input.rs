@@ -25,20 +25,9 @@ const ALLOCATION_LIMIT: usize = 1 << 30;
 const TIME_LIMIT: Duration = Duration::from_secs(5);
 const MUTANTS: usize = 150;
 
-/// xorshift64*: the mutants are the same on every run.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
-    }
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n.max(1) as u64) as usize
-    }
-}
+#[path = "common/rng.rs"]
+mod rng;
+use rng::Rng;
 
 /// What a reader made of a file: the numbers it read (to be finite), or an error.
 type Outcome = Result<Vec<f64>, String>;

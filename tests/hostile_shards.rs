@@ -283,20 +283,9 @@ fn a_bake_whose_axes_multiply_past_the_bound_is_refused() {
     assert!(!out.exists());
 }
 
-/// xorshift64*: the mutants are the same on every run.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
-    }
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n.max(1) as u64) as usize
-    }
-}
+#[path = "common/rng.rs"]
+mod rng;
+use rng::Rng;
 
 /// A large, a negative-looking or an out-of-range number for a size field.
 fn hostile_size(rng: &mut Rng) -> usize {

@@ -164,17 +164,24 @@ fn check(example: &Example, dir: &Path) {
     }
 }
 
-#[test]
-fn every_documented_command_runs_and_prints_what_the_page_shows() {
+/// `README.md` and `docs/*.md`, in order.
+fn pages() -> Vec<std::path::PathBuf> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let mut pages = vec![root.join("README.md")];
     let mut docs: Vec<_> = std::fs::read_dir(root.join("docs"))
         .unwrap()
         .map(|e| e.unwrap().path())
         .filter(|p| p.extension().is_some_and(|e| e == "md"))
         .collect();
     docs.sort();
-    pages.extend(docs);
+    std::iter::once(root.join("README.md"))
+        .chain(docs)
+        .collect()
+}
+
+#[test]
+fn every_documented_command_runs_and_prints_what_the_page_shows() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let pages = pages();
     let mut ran = 0;
     for page in &pages {
         let examples = examples(page);
@@ -316,15 +323,7 @@ fn dates_it(text: &str) -> bool {
 /// its section's first); or be an estimate or a bound.
 #[test]
 fn every_documented_timing_says_when_it_was_measured() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let mut pages = vec![root.join("README.md")];
-    let mut docs: Vec<_> = std::fs::read_dir(root.join("docs"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "md"))
-        .collect();
-    docs.sort();
-    pages.extend(docs);
+    let pages = pages();
     let mut undated = Vec::new();
     let mut checked = 0;
     for page in &pages {

@@ -548,14 +548,14 @@ impl Carried {
 }
 
 /// The declaration of the C array `name`: its declared size (`None` if not a whole number)
-/// and the text between its braces, from the first `name[` on (not `name` inside a longer
-/// identifier).
+/// and the text between its braces, from the first `name[` on (the whole identifier: not
+/// `table_ggx_E` inside `table_ggx_Eavg`, nor the name in a comment).
 fn c_declaration<'a>(text: &'a str, name: &str) -> Option<(Option<usize>, &'a str)> {
     let mut from = 0;
     loop {
         let at = from + text[from..].find(name)?;
         let before = text[..at].chars().next_back();
-        let after = &text[at + name.len()..];
+        let after = text[at + name.len()..].trim_start();
         if before.is_some_and(|c| c.is_ascii_alphanumeric() || c == '_') || !after.starts_with('[')
         {
             from = at + name.len();
@@ -734,30 +734,17 @@ fn little_endian(data: &[u8]) -> Vec<u16> {
 /// The numbers of the C float array `name` (`name[...] = { ... }`), `f` suffixes allowed, read
 /// as f32 (what the C compiler stores) and widened.
 fn c_array(text: &str, name: &str) -> Option<Vec<f64>> {
-    let mut rest = text;
-    loop {
-        let at = rest.find(name)?;
-        let after = &rest[at + name.len()..];
-        // The declaration of the whole identifier: not table_ggx_E inside table_ggx_Eavg, nor
-        // the name in a comment.
-        if !after.trim_start().starts_with('[') {
-            rest = after;
-            continue;
-        }
-        let open = after.find('{')?;
-        let close = after[open..].find('}')? + open;
-        return after[open + 1..close]
-            .split(',')
-            .map(str::trim)
-            .filter(|s| !s.is_empty())
-            .map(|s| {
-                s.trim_end_matches(['f', 'F'])
-                    .parse::<f32>()
-                    .ok()
-                    .map(f64::from)
-            })
-            .collect();
-    }
+    let (_, body) = c_declaration(text, name)?;
+    body.split(',')
+        .map(str::trim)
+        .filter(|s| !s.is_empty())
+        .map(|s| {
+            s.trim_end_matches(['f', 'F'])
+                .parse::<f32>()
+                .ok()
+                .map(f64::from)
+        })
+        .collect()
 }
 
 /// Half-float bits, one per channel per texel, as hex literals.

@@ -156,13 +156,9 @@ pub fn verdict(table: &Table, report: &Report, storage: &Storage) -> Option<Verd
             (truth, alpha_is_r)
         })
         .collect();
-    let at = |i: usize, j: usize| {
-        points
-            .iter()
-            .position(|&p| p == (i, j))
-            .map(|n| truths[n])
-            .expect("the lattice holds the texel")
-    };
+    let truth_at: std::collections::HashMap<(usize, usize), (f64, Option<f64>)> =
+        points.iter().copied().zip(truths).collect();
+    let at = |i: usize, j: usize| truth_at[&(i, j)];
     let file = |i: usize, j: usize| table.value[i * columns + j];
     let max_over = |f: &dyn Fn(usize, usize) -> f64| {
         points

@@ -174,6 +174,15 @@ impl VerifyArgs {
 
     /// The quantity of an external table: `--quantity`, else `E_avg` for a one-size shape and
     /// `E` otherwise.
+    /// The audit's settings from the flags: `--clamp-min` (0 unless given), `--density`.
+    fn audit_settings(&self, storage: Option<kiln::verify::Storage>) -> AuditSettings {
+        AuditSettings {
+            clamp_min: self.clamp_min.unwrap_or(0.0),
+            density: self.density as usize,
+            storage,
+        }
+    }
+
     fn quantity(&self, shape: &[usize]) -> Quantity {
         self.quantity.unwrap_or(if shape.len() == 1 {
             Quantity::EAvg
@@ -424,11 +433,7 @@ fn run_furnace(args: &VerifyArgs, table: &Table) -> kiln::Result<bool> {
     };
     let turquin_report = match forms.contains(&Form::Turquin) {
         true => {
-            let settings = AuditSettings {
-                clamp_min: args.clamp_min.unwrap_or(0.0),
-                density: args.density as usize,
-                storage: None,
-            };
+            let settings = args.audit_settings(None);
             let points = kiln::verify::lookup_coordinates(&table.spec, &settings).len() as u64;
             // The furnace's reference is the default one (1e-10); a glass table's points cost
             // three times what the bake's figures say (measured: the 16 x 16 x 16
@@ -663,11 +668,7 @@ pub fn run(args: VerifyArgs) -> kiln::Result<bool> {
         // One estimate and one bar for the whole file.
         let quiet = args.quiet || args.json;
         let audited = |t: &&Table| t.spec.quantity != Quantity::FMsNorm;
-        let settings = AuditSettings {
-            clamp_min: args.clamp_min.unwrap_or(0.0),
-            density: args.density as usize,
-            storage: None,
-        };
+        let settings = args.audit_settings(None);
         let seconds: f64 = tables
             .iter()
             .filter(audited)
@@ -950,11 +951,7 @@ fn audit_one(
         }
         Against::Table(&other)
     };
-    let settings = AuditSettings {
-        clamp_min: args.clamp_min.unwrap_or(0.0),
-        density: args.density as usize,
-        storage,
-    };
+    let settings = args.audit_settings(storage);
     let report = match shared {
         // The command's one bar, sized for every table up front: each point its estimated cost.
         Some(bar) => {
