@@ -24,7 +24,13 @@
 use super::estimate::Estimate;
 use super::sobol::{OwenSobol, mix_seed};
 pub use crate::model::masking::reflection_loss;
-use crate::model::ndf::BeckmannVisibleNormals;
+use crate::model::ndf::{BeckmannVisibleNormals, VisibleSlopeX};
+use crate::model::special::{FRAC_1_SQRT_PI, erfc};
+
+/// The unit-roughness slopes the Beckmann sum samples inside the lost circle reach at most this
+/// far from 0; the share beyond, under `exp(-27^2) = 1e-317` (below f64's smallest normal
+/// number), counts as lost.
+const SLOPE_REACH: f64 = 27.0;
 use crate::model::{
     Beckmann, Ggx, Masking, MicrofacetDistribution, Model, Ndf, SMOOTH_ALPHA, Vec3,
     albedo_is_exactly_one, smooth_point,
@@ -819,6 +825,112 @@ struct BeckmannView {
     lambda_o: f64,
     visible: BeckmannVisibleNormals,
     strata: Vec<Stratum>,
+    /// The slopes whose reflection stays above the horizon, where the view is not grazing: the
+    /// sum then runs inside them ([`LostCircle`]) and not by `strata`.
+    circle: Option<LostCircle>,
+}
+
+/// The visible normals of a Beckmann view `o = (so, 0, mu)` whose mirror reflection stays above
+/// the horizon, in unit-roughness slopes `(x, y)` (the view's frame, as
+/// [`BeckmannVisibleNormals::normal_from_slopes`]): a disc. With slopes `alpha (x, y)`, the
+/// normal `m ∝ (-alpha x, -alpha y, 1)` reflects `o` to `i_z = 2 (o.m) m_z - mu`, which is
+/// positive iff `(x - c)^2 + y^2 < r^2` with centre `c = -so / (mu alpha)` and radius
+/// `r = 1 / (mu alpha)` (expand `2 (mu - alpha x so) > mu (1 + alpha^2 (x^2 + y^2))`). Outside
+/// it the loss is 1 exactly, so the sum takes the share outside in closed form and samples the
+/// inside only: for each x in `[c - r, c + r]`, the y-slope (Gaussian, folded by the view's
+/// mirror symmetry) within `|y| < y*(x) = sqrt((right - x)(x - left))`, its share outside added
+/// as `erfc(y*)` (conditional Monte Carlo). The integrand is then smooth inside, and the square
+/// roots at the disc's two ends are undone by drawing the share between them through the
+/// smoothstep `3 v^2 - 2 v^3`, whose derivative vanishes at both ends.
+#[derive(Clone, Copy, Debug)]
+struct LostCircle {
+    /// `c - r` and `c + r`.
+    left: f64,
+    right: f64,
+    /// The x-slopes sampled: `[start, start + span]`, the disc's x range within
+    /// [`SLOPE_REACH`] of 0.
+    start: f64,
+    span: f64,
+    /// The visible slopes' share outside `[start, start + span]`, all counted as lost.
+    lost: f64,
+    /// The logistic proxy of the x-slopes' density: its centre, scale, and its CDF at `start`
+    /// (`p_start`, and `1 - p_start` as `q_start`) and over the range (`p_span`).
+    centre: f64,
+    scale: f64,
+    p_start: f64,
+    q_start: f64,
+    p_span: f64,
+}
+
+/// The logistic CDF `1 / (1 + exp(-z))`.
+fn logistic(z: f64) -> f64 {
+    1.0 / (1.0 + (-z).exp())
+}
+
+impl LostCircle {
+    fn new(slopes: &VisibleSlopeX, alpha: f64, mu: f64) -> Self {
+        let so = sin_from_cos(mu);
+        let (centre, radius) = (-so / (mu * alpha), 1.0 / (mu * alpha));
+        // c + r as (1 - so) / (mu alpha): no cancellation at near-normal views.
+        let (left, right) = (centre - radius, (1.0 - so) / (mu * alpha));
+        let start = left.max(-SLOPE_REACH);
+        let end = right.min(SLOPE_REACH).max(start);
+        // The mode of (b - x) exp(-x^2), the root of 2 x^2 - 2 b x - 1 in the stable form (0 at
+        // normal incidence), and a scale near the Gaussian's (standard deviation 0.71 = 0.39 pi /
+        // sqrt 3), a little wider for the tilt.
+        let b = slopes.end();
+        let centre = if b.is_finite() {
+            -1.0 / (b + (b * b + 2.0).sqrt())
+        } else {
+            0.0
+        };
+        let scale = 0.45;
+        let p_start = logistic((start - centre) / scale);
+        let q_start = logistic((centre - start) / scale);
+        let p_end = logistic((end - centre) / scale);
+        Self {
+            left,
+            right,
+            start,
+            span: end - start,
+            lost: slopes.upper_share(end) + (1.0 - slopes.upper_share(start)),
+            centre,
+            scale,
+            p_start,
+            q_start,
+            p_span: (p_end - p_start).max(0.0),
+        }
+    }
+
+    /// The x-slope for the variate `v` in [0, 1] and its density per unit of `v`, `dx/dv`:
+    /// `x = centre + scale ln(p / (1 - p))` (the logistic proxy's inverse CDF, which puts the
+    /// points where the visible slopes are) with `p` from `p_start` over `p_span` through the
+    /// smoothstep `3 v^2 - 2 v^3` (whose zero derivative at both ends undoes the disc ends' square
+    /// roots). `1 - p` is carried on its own, so the tails keep their digits.
+    #[inline(always)]
+    fn x_slope(&self, v: f64) -> (f64, f64) {
+        let step = v * v * (3.0 - 2.0 * v);
+        let p = self.p_start + self.p_span * step;
+        let q = self.q_start - self.p_span * step;
+        if !(p > 0.0 && q > 0.0) {
+            return (self.start, 0.0);
+        }
+        let x = (self.centre + self.scale * (p / q).ln()).clamp(self.start, self.start + self.span);
+        (x, self.scale / (p * q) * self.p_span * 6.0 * v * (1.0 - v))
+    }
+
+    /// The y-slope `|y|` in `[0, reach]` for the variate `v` in [0, 1] and `dy/dv`: the inverse
+    /// CDF of the half-logistic proxy `tanh(y / 2 s)` (scale `s` as for x) restricted to the
+    /// range, `y = 2 s atanh(v tanh(reach / 2 s))`, smooth up to `reach` and `reach v` when the
+    /// reach is short.
+    #[inline(always)]
+    fn y_slope(&self, reach: f64, v: f64) -> (f64, f64) {
+        let two_s = (2.0 * self.scale).max(reach);
+        let top = (reach / two_s).tanh();
+        let p = v * top;
+        let y = (two_s * p.atanh()).min(reach);
+        (y, two_s * top / ((1.0 - p) * (1.0 + p)))
+    }
 }
 
 impl BeckmannView {
@@ -827,13 +939,43 @@ impl BeckmannView {
         let o = Vec3::from_mu(mu);
         let visible = BeckmannVisibleNormals::tabulated(ndf, o);
         let strata = beckmann_strata(&visible, alpha, mu);
+        let grazing = mu <= 0.0 || mu / (alpha * sin_from_cos(mu)) < GRAZING_COT;
+        let circle = (!grazing).then(|| LostCircle::new(visible.slope_x(), alpha, mu));
         Self {
             ndf,
             o,
             lambda_o: ndf.lambda(o),
             visible,
             strata,
+            circle,
         }
+    }
+
+    /// The sum of [`BeckmannView::sum`] inside the [`LostCircle`], for an `integrand` that is 1
+    /// wherever the reflection leaves the hemisphere (a loss).
+    fn circle_sum(
+        &self,
+        circle: &LostCircle,
+        seq: &OwenSobol,
+        log2_n: u32,
+        integrand: impl Fn(Vec3) -> f64,
+    ) -> f64 {
+        let slopes = self.visible.slope_x();
+        let (left, right) = (circle.left, circle.right);
+        let inside = sum_over_block(seq, log2_n, |[v0, v1]: [f64; 2]| {
+            let (x, jacobian) = circle.x_slope(v0);
+            let jacobian = jacobian * slopes.density(x);
+            let reach = ((right - x).max(0.0) * (x - left).max(0.0))
+                .sqrt()
+                .min(SLOPE_REACH);
+            // |y| on [0, reach] from the half-logistic proxy, weighted by its density
+            // 2 exp(-y^2) / sqrt(pi) per unit of v1.
+            let (y, dy) = circle.y_slope(reach, v1);
+            let density = 2.0 * FRAC_1_SQRT_PI * (-y * y).exp();
+            let m = self.visible.normal_from_slopes(x, y);
+            jacobian * (erfc(reach) + dy * density * integrand(m))
+        });
+        circle.lost * (1u64 << log2_n) as f64 + inside
     }
 
     /// The loss `1 - w` of the visible normal `m` ([`reflection_loss`]).
@@ -849,6 +991,9 @@ impl BeckmannView {
     /// measure, add up to the integral, returned as a sum over `2^log2_n` points as
     /// [`sum_over_block`] does.
     fn sum(&self, seq: &OwenSobol, log2_n: u32, integrand: impl Fn(Vec3) -> f64) -> f64 {
+        if let Some(circle) = &self.circle {
+            return self.circle_sum(circle, seq, log2_n, integrand);
+        }
         let slopes = self.visible.slope_x();
         let at = |slope_x: f64, u1: f64| integrand(self.visible.normal_from_slope_x(slope_x, u1));
         let tail_levels = self.strata.len().saturating_sub(1);

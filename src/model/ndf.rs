@@ -456,7 +456,13 @@ impl BeckmannVisibleNormals {
     /// tilts the normal away from the view) and y-slope drawn from `u1`.
     #[must_use]
     pub fn normal_from_slope_x(&self, slope_x: f64, u1: f64) -> Vec3 {
-        let slope_y = erf_inv_uniform(u1);
+        self.normal_from_slopes(slope_x, erf_inv_uniform(u1))
+    }
+
+    /// The visible normal with unit-roughness slopes `slope_x` and `slope_y` in the view's frame
+    /// (see [`BeckmannVisibleNormals::normal_from_slope_x`]).
+    #[must_use]
+    pub fn normal_from_slopes(&self, slope_x: f64, slope_y: f64) -> Vec3 {
         let sx = self.alpha * (self.cos_phi * slope_x - self.sin_phi * slope_y);
         let sy = self.alpha * (self.sin_phi * slope_x + self.cos_phi * slope_y);
         Vec3::new(-sx, -sy, 1.0).normalize()
@@ -603,6 +609,23 @@ impl VisibleSlopeX {
         let upper = 0.5
             * (b * (1.0 / FRAC_1_SQRT_PI) * (erfc(x) - erfc(b)) + (-b * b).exp() - (-x * x).exp());
         (upper / self.total).clamp(0.0, 1.0)
+    }
+
+    /// The end of the visible x-slopes, `b = cot(theta)` of the stretched view (`+inf` at normal
+    /// incidence).
+    #[must_use]
+    pub fn end(&self) -> f64 {
+        if self.b > 1e8 { f64::INFINITY } else { self.b }
+    }
+
+    /// The density of the visible x-slopes at `x`: `(b - x)+ exp(-x^2) / C(b)`, and the Gaussian
+    /// `exp(-x^2) / sqrt(pi)` at normal incidence.
+    #[must_use]
+    pub fn density(&self, x: f64) -> f64 {
+        if self.b > 1e8 {
+            return FRAC_1_SQRT_PI * (-x * x).exp();
+        }
+        (self.b - x).max(0.0) * (-x * x).exp() / self.total
     }
 
     /// The x-slope above which a share `w` in (0, 1) of the visible slopes lies: the inverse of
