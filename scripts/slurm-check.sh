@@ -43,7 +43,7 @@ chmod 400 "$work/munge/munge.key"
 socket="$work/munge/munge.socket"
 munged --key-file="$work/munge/munge.key" --socket="$socket" \
     --pid-file="$work/munge/munged.pid" --log-file="$work/munge/munged.log" \
-    --seed-file="$work/munge/seed" --force --foreground &
+    --seed-file="$work/munge/seed" --force --foreground 2>>"$work/log/munged.err" &
 pids+=($!)
 
 host="$(hostname -s)"
@@ -83,9 +83,9 @@ for _ in $(seq 50); do
     munge --socket="$socket" -n </dev/null >/dev/null 2>&1 && break
     sleep 0.2
 done
-slurmctld -D -i -f "$SLURM_CONF" &
+slurmctld -D -i -f "$SLURM_CONF" 2>>"$work/log/slurmctld.err" &
 pids+=($!)
-slurmd -D -f "$SLURM_CONF" &
+slurmd -D -f "$SLURM_CONF" 2>>"$work/log/slurmd.err" &
 pids+=($!)
 
 deadline=$((SECONDS + timeout_seconds))

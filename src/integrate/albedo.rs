@@ -27,14 +27,15 @@ pub use crate::model::masking::reflection_loss;
 use crate::model::ndf::{BeckmannVisibleNormals, VisibleSlopeX};
 use crate::model::special::{FRAC_1_SQRT_PI, erfc};
 
-/// The unit-roughness slopes the Beckmann sum samples inside the lost circle reach at most this
-/// far from 0; the share beyond, under `exp(-27^2) = 1e-317` (below f64's smallest normal
-/// number), counts as lost.
-const SLOPE_REACH: f64 = 27.0;
 use crate::model::{
     Beckmann, Ggx, Masking, MicrofacetDistribution, Model, Ndf, SMOOTH_ALPHA, Vec3,
     albedo_is_exactly_one, smooth_point,
 };
+
+/// The unit-roughness slopes the Beckmann sum samples inside the lost circle reach at most this
+/// far from 0; the share beyond, under `exp(-27^2) = 1e-317` (below f64's smallest normal
+/// number), counts as lost.
+const SLOPE_REACH: f64 = 27.0;
 
 /// How a QMC estimate is run.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
@@ -817,17 +818,23 @@ fn beckmann_strata(visible: &BeckmannVisibleNormals, alpha: f64, mu: f64) -> Vec
 }
 
 /// What the Beckmann sums need of one view `o = (so, 0, mu)`, set up once per estimate: the
-/// visible-normal sampler (with its table of starting points) and the strata of
-/// [`beckmann_strata`].
+/// visible-normal sampler and how the points are placed ([`BeckmannSampling`]).
 struct BeckmannView {
     ndf: Beckmann,
     o: Vec3,
     lambda_o: f64,
     visible: BeckmannVisibleNormals,
-    strata: Vec<Stratum>,
-    /// The slopes whose reflection stays above the horizon, where the view is not grazing: the
-    /// sum then runs inside them ([`LostCircle`]) and not by `strata`.
-    circle: Option<LostCircle>,
+    sampling: BeckmannSampling,
+}
+
+/// How a Beckmann view's sum places its points.
+enum BeckmannSampling {
+    /// Inside the slopes whose reflection stays above the horizon ([`LostCircle`]): every view
+    /// but the grazing ones.
+    Circle(LostCircle),
+    /// By the strata of [`beckmann_strata`] over the visible x-slope's share: grazing views (the
+    /// stretched view's `cot(theta)` below [`GRAZING_COT`]), whose masking layer they resolve.
+    Ladder(Vec<Stratum>),
 }
 
 /// The visible normals of a Beckmann view `o = (so, 0, mu)` whose mirror reflection stays above
@@ -836,12 +843,14 @@ struct BeckmannView {
 /// normal `m ∝ (-alpha x, -alpha y, 1)` reflects `o` to `i_z = 2 (o.m) m_z - mu`, which is
 /// positive iff `(x - c)^2 + y^2 < r^2` with centre `c = -so / (mu alpha)` and radius
 /// `r = 1 / (mu alpha)` (expand `2 (mu - alpha x so) > mu (1 + alpha^2 (x^2 + y^2))`). Outside
-/// it the loss is 1 exactly, so the sum takes the share outside in closed form and samples the
-/// inside only: for each x in `[c - r, c + r]`, the y-slope (Gaussian, folded by the view's
-/// mirror symmetry) within `|y| < y*(x) = sqrt((right - x)(x - left))`, its share outside added
-/// as `erfc(y*)` (conditional Monte Carlo). The integrand is then smooth inside, and the square
-/// roots at the disc's two ends are undone by drawing the share between them through the
-/// smoothstep `3 v^2 - 2 v^3`, whose derivative vanishes at both ends.
+/// it the loss is 1 exactly, so the sum takes the share outside in closed form
+/// ([`VisibleSlopeX::upper_share`]) and samples the inside only: x in `[c - r, c + r]` from a
+/// logistic proxy of the visible x-slopes ([`LostCircle::x_slope`]), and for each x the folded
+/// y-slope (the view's mirror symmetry) within `|y| < y*(x) = sqrt((right - x)(x - left))` from
+/// a half-logistic proxy ([`LostCircle::y_slope`]), each weighted by the true density over the
+/// proxy's, with the share beyond `y*` added as `erfc(y*)` (conditional Monte Carlo). The
+/// integrand is then smooth inside; the x map goes through the smoothstep `3 v^2 - 2 v^3`,
+/// whose zero derivative at both ends undoes the square roots of `y*` at the disc's ends.
 #[derive(Clone, Copy, Debug)]
 struct LostCircle {
     /// `c - r` and `c + r`.
@@ -870,9 +879,8 @@ fn logistic(z: f64) -> f64 {
 impl LostCircle {
     fn new(slopes: &VisibleSlopeX, alpha: f64, mu: f64) -> Self {
         let so = sin_from_cos(mu);
-        let (centre, radius) = (-so / (mu * alpha), 1.0 / (mu * alpha));
-        // c + r as (1 - so) / (mu alpha): no cancellation at near-normal views.
-        let (left, right) = (centre - radius, (1.0 - so) / (mu * alpha));
+        // c - r, and c + r as (1 - so) / (mu alpha): no cancellation at near-normal views.
+        let (left, right) = (-(so + 1.0) / (mu * alpha), (1.0 - so) / (mu * alpha));
         let start = left.max(-SLOPE_REACH);
         let end = right.min(SLOPE_REACH).max(start);
         // The mode of (b - x) exp(-x^2), the root of 2 x^2 - 2 b x - 1 in the stable form (0 at
@@ -937,22 +945,28 @@ impl BeckmannView {
     fn new(alpha: f64, mu: f64) -> Self {
         let ndf = Beckmann { alpha };
         let o = Vec3::from_mu(mu);
-        let visible = BeckmannVisibleNormals::tabulated(ndf, o);
-        let strata = beckmann_strata(&visible, alpha, mu);
-        let grazing = mu <= 0.0 || mu / (alpha * sin_from_cos(mu)) < GRAZING_COT;
-        let circle = (!grazing).then(|| LostCircle::new(visible.slope_x(), alpha, mu));
+        let untabulated = BeckmannVisibleNormals::new(ndf, o);
+        // The stretched view's cot(theta): the visible x-slopes end there.
+        let grazing = mu <= 0.0 || untabulated.slope_x().end() < GRAZING_COT;
+        let (visible, sampling) = if grazing {
+            // The ladder solves for slopes at every point: start it from a table.
+            let visible = BeckmannVisibleNormals::tabulated(ndf, o);
+            let strata = beckmann_strata(&visible, alpha, mu);
+            (visible, BeckmannSampling::Ladder(strata))
+        } else {
+            let circle = LostCircle::new(untabulated.slope_x(), alpha, mu);
+            (untabulated, BeckmannSampling::Circle(circle))
+        };
         Self {
             ndf,
             o,
             lambda_o: ndf.lambda(o),
             visible,
-            strata,
-            circle,
+            sampling,
         }
     }
 
-    /// The sum of [`BeckmannView::sum`] inside the [`LostCircle`], for an `integrand` that is 1
-    /// wherever the reflection leaves the hemisphere (a loss).
+    /// [`BeckmannView::sum`] inside the [`LostCircle`], the share outside in closed form.
     fn circle_sum(
         &self,
         circle: &LostCircle,
@@ -983,26 +997,38 @@ impl BeckmannView {
         reflection_loss(self.ndf, masking, self.o, self.lambda_o, m)
     }
 
-    /// A stratified sum of `integrand(m)` over one scramble: the first stratum (the body) gets
-    /// half the points, the others share the other half ([`points_per_level`]), each level from
-    /// its own stream of the scramble; with fewer than `2^MIN_LEVEL_LOG2` points per level, plain
+    /// The sum of `integrand(m)` over the visible normals of one scramble, returned as a sum over
+    /// `2^log2_n` points as [`sum_over_block`] does; `integrand` must be 1 wherever the
+    /// reflection leaves the hemisphere (a loss). By [`BeckmannSampling`].
+    fn sum(&self, seq: &OwenSobol, log2_n: u32, integrand: impl Fn(Vec3) -> f64) -> f64 {
+        match &self.sampling {
+            BeckmannSampling::Circle(circle) => self.circle_sum(circle, seq, log2_n, integrand),
+            BeckmannSampling::Ladder(strata) => self.ladder_sum(strata, seq, log2_n, integrand),
+        }
+    }
+
+    /// [`BeckmannView::sum`] by the ladder's strata: the first stratum (the body) gets half the
+    /// points, the others share the other half ([`points_per_level`]), each level from its own
+    /// stream of the scramble; with fewer than `2^MIN_LEVEL_LOG2` points per level, plain
     /// sampling. Each level draws the x-slope whose upper share is uniform within it
     /// ([`crate::model::ndf::VisibleSlopeX::sample_upper`]); the level means, weighted by their
-    /// measure, add up to the integral, returned as a sum over `2^log2_n` points as
-    /// [`sum_over_block`] does.
-    fn sum(&self, seq: &OwenSobol, log2_n: u32, integrand: impl Fn(Vec3) -> f64) -> f64 {
-        if let Some(circle) = &self.circle {
-            return self.circle_sum(circle, seq, log2_n, integrand);
-        }
+    /// measure, add up to the integral.
+    fn ladder_sum(
+        &self,
+        strata: &[Stratum],
+        seq: &OwenSobol,
+        log2_n: u32,
+        integrand: impl Fn(Vec3) -> f64,
+    ) -> f64 {
         let slopes = self.visible.slope_x();
         let at = |slope_x: f64, u1: f64| integrand(self.visible.normal_from_slope_x(slope_x, u1));
-        let tail_levels = self.strata.len().saturating_sub(1);
+        let tail_levels = strata.len().saturating_sub(1);
         let body_log2 = log2_n.saturating_sub(1);
-        if self.strata.len() == 1 || points_per_level(body_log2, tail_levels, 0) < MIN_LEVEL_LOG2 {
+        if strata.len() == 1 || points_per_level(body_log2, tail_levels, 0) < MIN_LEVEL_LOG2 {
             return sum_over_block(seq, log2_n, |[u0, u1]: [f64; 2]| at(slopes.sample(u0), u1));
         }
         let mut mean = 0.0;
-        for (k, stratum) in self.strata.iter().enumerate() {
+        for (k, stratum) in strata.iter().enumerate() {
             let (stream, log2) = if k == 0 {
                 (*seq, body_log2)
             } else {
