@@ -20,8 +20,11 @@ test -x "$kiln" || { echo "slurm-check: no kiln binary at $kiln (cargo build --r
 if ! command -v slurmctld >/dev/null || ! command -v slurmd >/dev/null \
     || ! command -v sbatch >/dev/null || ! command -v munged >/dev/null; then
     echo "slurm-check: installing slurmctld slurmd slurm-client munge"
-    DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends \
-        slurmctld slurmd slurm-client munge >/dev/null
+    export DEBIAN_FRONTEND=noninteractive
+    packages=(slurmctld slurmd slurm-client munge)
+    apt-get install -y --no-install-recommends "${packages[@]}" >/dev/null \
+        || { apt-get update >/dev/null \
+            && apt-get install -y --no-install-recommends "${packages[@]}" >/dev/null; }
 fi
 
 work="$(mktemp -d /tmp/kiln-slurm.XXXXXX)"

@@ -10,24 +10,20 @@
 //!
 //! HLSL is C++ as it stands. GLSL needs one rewrite, of its array constructor (`float[N](...)`
 //! to a brace list). WGSL is rewritten by [`wgsl_as_cpp`] token for token (`fn f(x: f32) -> T`
-//! to `T f(float x)`, `let`/`var` to `auto`, `vec2<f32>` to `vec2`, `array<f32, N>(...)` to a
-//! `std::array`); nothing in an expression changes. naga parses and validates the WGSL and GLSL
+//! to `T f(float x)`, `let`/`var` to `auto`, `vec2<f32>` to `vec2`, a module's `array<f32, N>(...)`
+//! to a `std::array`); nothing in an expression changes. naga parses and validates the WGSL and GLSL
 //! in `tests/shaders.rs`.
 
 #![cfg(feature = "cli")]
 
-use kiln::model::kulla_conty::{fresnel_colour, multiple_scattering};
-use kiln::table::normalisation::normalisation_lookup;
-use kiln::verify::input::read_kiln;
-use kiln::verify::{AuditSettings, lookup_coordinates};
-use kiln::{Quantity, Table};
+use kiln::Table;
 use std::fmt::Write as _;
 use std::path::Path;
 use std::process::Command;
 
-#[path = "common/command.rs"]
-mod command;
-use command::kiln;
+#[path = "common/shader_cases.rs"]
+mod shader_cases;
+use shader_cases::{Cases, POINT_SETS, TABLE_FILES};
 
 /// The vocabulary the three languages share, in C++, with GPU texture sampling.
 const PRELUDE: &str = r"
@@ -168,7 +164,8 @@ fn glsl_as_cpp(source: &str) -> String {
 }
 
 /// WGSL's declarations as C++: `fn f(x: f32, t: T) -> R {` as `R f(float x, T t) {`, `let` and
-/// `var` as `auto`, `const NAME = array<f32, N>(...);` as a `std::array`, and the type names
+/// `var` as `auto`, `var<private> NAME: array<f32, N> = array<f32, N>(...);` (or `const NAME =
+/// array<f32, N>(...);`) as a `std::array`, and the type names
 /// (`f32`, `i32`, `vec2<f32>`, `vec3<f32>`, `texture_2d<f32>`) as the prelude's.
 fn wgsl_as_cpp(source: &str) -> String {
     let types = |text: &str| {
@@ -201,9 +198,12 @@ fn wgsl_as_cpp(source: &str) -> String {
                     .trim_end_matches('{')
                     .trim();
                 format!("{indent}{} {name}({}) {{", types(ret), params.join(", "))
-            } else if let Some(rest) = trimmed.strip_prefix("const ") {
+            } else if let Some(rest) = trimmed
+                .strip_prefix("var<private> ")
+                .or_else(|| trimmed.strip_prefix("const "))
+            {
                 if let Some(at) = rest.find("= array<f32, ") {
-                    let name = rest[..at].trim();
+                    let name = rest[..at].split(':').next().unwrap().trim();
                     let n_end = at + rest[at..].find('>').unwrap();
                     let n = &rest[at + "= array<f32, ".len()..n_end];
                     let body = &rest[n_end + 2..rest.trim_end().len() - 2];
@@ -223,12 +223,6 @@ fn wgsl_as_cpp(source: &str) -> String {
         })
         .collect::<Vec<_>>()
         .join("\n")
-}
-
-fn read(dir: &Path, name: &str) -> Table {
-    read_kiln(&dir.join(format!("{name}.json")))
-        .unwrap()
-        .unwrap()
 }
 
 /// A C++ float array initialiser.
@@ -272,13 +266,6 @@ fn run(dir: &Path, language: Language, files: &[&str], main: &str) -> Vec<f64> {
         .collect()
 }
 
-fn assert_close(language: Language, got: f64, want: f64, tolerance: f64, what: &str) {
-    assert!(
-        (got - want).abs() <= tolerance,
-        "{what}: {language:?} {got:e}, library {want:e}"
-    );
-}
-
 /// A C++ array of the points' coordinates, flattened.
 fn point_array(name: &str, points: &[f64]) -> String {
     format!(
@@ -289,92 +276,8 @@ fn point_array(name: &str, points: &[f64]) -> String {
 
 #[test]
 fn generated_shaders_run_and_agree_with_the_library() {
-    let dir = tempfile::tempdir().unwrap();
-    let d = dir.path();
-    let out = d.to_str().unwrap();
-    let baked = kiln(&[
-        "bake",
-        "--format",
-        "hlsl,glsl,wgsl,json",
-        "-q",
-        "--out",
-        out,
-    ]);
-    assert!(
-        baked.status.success(),
-        "{}",
-        String::from_utf8_lossy(&baked.stderr)
-    );
-    // A second layout: texel centres and the sqrt mu axis, 8 x 8.
-    let other = d.join("centres");
-    let baked = kiln(&[
-        "bake",
-        "--format",
-        "hlsl,glsl,wgsl,json",
-        "--mu-axis",
-        "sqrt",
-        "--grid",
-        "centers",
-        "--size",
-        "8",
-        "--quantity",
-        "e",
-        "-q",
-        "--out",
-        other.to_str().unwrap(),
-    ]);
-    assert!(
-        baked.status.success(),
-        "{}",
-        String::from_utf8_lossy(&baked.stderr)
-    );
-    for language in [Language::Hlsl, Language::Glsl, Language::Wgsl] {
-        std::fs::copy(
-            other.join(format!(
-                "ggx-height-correlated-E-mu-sqrt-centers.{}",
-                language.extension()
-            )),
-            d.join(format!(
-                "ggx-height-correlated-E-mu-sqrt-centers.{}",
-                language.extension()
-            )),
-        )
-        .unwrap();
-    }
-
-    let e = read(d, "ggx-height-correlated-E");
-    let avg = read(d, "ggx-height-correlated-E_avg");
-    let norm = read(d, "ggx-height-correlated-f_ms_norm");
-    let centres = read(&other, "ggx-height-correlated-E-mu-sqrt-centers");
-    assert_eq!(centres.spec.quantity, Quantity::E);
-
-    // The 2-D lookups at every point `verify` audits, on both layouts.
-    let points = |t: &Table| -> Vec<f64> {
-        lookup_coordinates(&t.spec, &AuditSettings::default())
-            .into_iter()
-            .flat_map(|c| [c.mu.unwrap(), c.alpha.sqrt()])
-            .collect()
-    };
-    let (e_points, c_points) = (points(&e), points(&centres));
-    assert!(e_points.len() > 2000 && c_points.len() > 200);
-    // The 1-D lookups, the lobe, its colour and Turquin's factor on dense ladders.
-    let ladder: Vec<f64> = (0..=1500)
-        .map(|k| (f64::from(k) / 1500.0).powi(2))
-        .collect();
-    let lobes: Vec<f64> = (0..1200)
-        .flat_map(|k| {
-            let k = f64::from(k);
-            let r = ((k * 0.618_034) % 1.0).powi(2);
-            [(k * 0.754_877) % 1.0 * 0.6, (k * 0.569_840) % 1.0 * 0.6, r]
-        })
-        .collect();
-    let fresnels: Vec<f64> = (0..1200)
-        .flat_map(|k| {
-            let k = f64::from(k);
-            [(k * 0.618_034) % 1.0, 0.05 + 0.95 * ((k * 0.754_877) % 1.0)]
-        })
-        .collect();
-
+    let cases = Cases::bake(&["hlsl", "glsl", "wgsl"]);
+    let d = &cases.dir();
     let texture = |name: &str, t: &Table| {
         let [rows, columns] = t.spec.shape()[..] else {
             unreachable!()
@@ -382,13 +285,13 @@ fn generated_shaders_run_and_agree_with_the_library() {
         let texels = floats((0..t.spec.len()).flat_map(|k| [t.value[k], t.one_minus_value[k]]));
         format!("const Tex {name} = {{{columns}, {rows}, {texels}}};\n")
     };
-    let data = texture("E", &e)
-        + &texture("C", &centres)
-        + &point_array("E_POINTS", &e_points)
-        + &point_array("C_POINTS", &c_points)
-        + &point_array("LADDER", &ladder)
-        + &point_array("LOBES", &lobes)
-        + &point_array("FRESNELS", &fresnels);
+    let data = texture("E", &cases.e)
+        + &texture("C", &cases.centres)
+        + &point_array("E_POINTS", &cases.e_points)
+        + &point_array("C_POINTS", &cases.c_points)
+        + &point_array("LADDER", &cases.ladder)
+        + &point_array("LOBES", &cases.lobes)
+        + &point_array("FRESNELS", &cases.fresnels);
 
     for language in [Language::Hlsl, Language::Glsl, Language::Wgsl] {
         let mut main = data.clone();
@@ -417,76 +320,18 @@ fn generated_shaders_run_and_agree_with_the_library() {
                  c.y, t.z); }\n";
         main += "    return 0;\n}\n";
 
-        let printed = run(
-            d,
-            language,
-            &[
-                "ggx-height-correlated-E",
-                "ggx-height-correlated-E-mu-sqrt-centers",
-                "ggx-height-correlated-E_avg",
-                "ggx-height-correlated-f_ms_norm",
-            ],
-            &main,
-        );
+        let printed = run(d, language, &TABLE_FILES, &main);
         let mut values = printed.into_iter();
-        let mut next = || values.next().expect("as many numbers as asked for");
-        let f32_of = |v: f64| f64::from(v as f32);
-
-        // f32 positions err by ~31 * 6e-8 of a texel (texel steps below 0.1): 2e-6 at most.
-        for (table, points) in [(&e, &e_points), (&centres, &c_points)] {
-            for p in points.chunks(2) {
-                let (mu, r) = (f32_of(p[0]), f32_of(p[1]));
-                let what = format!("{} at mu {mu}, r {r}", table.spec.id());
-                assert_close(language, next(), table.lookup(mu, r), 2e-6, &what);
-                assert_close(language, next(), table.lookup_one_minus(mu, r), 2e-6, &what);
+        for ((set, inputs), points) in POINT_SETS.into_iter().zip(cases.point_sets()) {
+            for point in points.chunks(inputs) {
+                for (want, tolerance) in cases.expected(set, point) {
+                    let got = values.next().expect("as many numbers as asked for");
+                    assert!(
+                        (got - want).abs() <= tolerance,
+                        "{set} at {point:?}: {language:?} {got:e}, library {want:e}"
+                    );
+                }
             }
-        }
-        for &r in &ladder {
-            let r = f32_of(r);
-            assert_close(
-                language,
-                next(),
-                avg.lookup(1.0, r),
-                1e-6,
-                &format!("E_avg at r {r}"),
-            );
-            let want = normalisation_lookup(&norm, r);
-            assert_close(
-                language,
-                next(),
-                want,
-                1e-6 * want.max(1e-3),
-                &format!("f_ms_norm at r {r}"),
-            );
-        }
-        for p in lobes.chunks(3) {
-            let (o, i, r) = (f32_of(p[0]), f32_of(p[1]), f32_of(p[2]));
-            let want = multiple_scattering(o, i, normalisation_lookup(&norm, r));
-            assert_close(
-                language,
-                next(),
-                want,
-                1e-5 * want.max(1.0),
-                &format!("f_ms({o}, {i}, {r})"),
-            );
-        }
-        for p in fresnels.chunks(2) {
-            let (f, x) = (f32_of(p[0]), f32_of(p[1]));
-            assert_close(
-                language,
-                next(),
-                fresnel_colour(f, x),
-                1e-6,
-                &format!("colour({f}, {x})"),
-            );
-            let turquin = 1.0 + f * (1.0 / x - 1.0);
-            assert_close(
-                language,
-                next(),
-                turquin,
-                1e-6 * turquin,
-                &format!("turquin({x}, {f})"),
-            );
         }
         assert!(values.next().is_none());
     }

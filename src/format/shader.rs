@@ -6,8 +6,8 @@
 //!   G = `1 - value`): `NAME_uv(...)` gives the texture coordinate, `NAME_lookup(...)` samples
 //!   it (level 0) and returns both channels. Texture x is the fastest axis (`mu`), y the
 //!   roughness (row 0 at `v = 0`, the first row uploaded), z the IOR.
-//! - 1-D tables (`E_avg`, `F_avg`) are constant arrays in the shader with their own linear
-//!   interpolation, usable in any stage.
+//! - 1-D tables (`E_avg`, `F_avg`) are arrays in the shader (WGSL `var<private>`, a GLSL global,
+//!   HLSL `static const`) with their own linear interpolation, usable in any stage.
 //!
 //! Texel conventions: with `centers`, sample `i` sits at `t_i = (i + 0.5) / N`, where the GPU
 //! puts texel centres, so `u = t`; with `nodes`, `t_i = i / (N - 1)`, and the lookup must remap
@@ -359,9 +359,16 @@ fn write_array_lookup(
     let values: Vec<String> = table.value.iter().map(|&v| literal(v)).collect();
     let constant = stem.to_uppercase();
     let list = values.join(", ");
+    // WGSL and GLSL: a private (per-invocation, never written) array rather than a `const`, which
+    // naga (wgpu's compiler) copies into a local at every dynamic index: on Mesa's lavapipe a
+    // compute pipeline over the 497-value f_ms_norm then took 7.1-8.6 s (WGSL) and 24-27 s
+    // (GLSL) to build, 4.4-5.6 s as a private array (tests/gpu_shaders.rs, 2026-12-03).
     let _ = match language {
-        Language::Wgsl => writeln!(out, "const {constant} = array<f32, {n}>({list});"),
-        Language::Glsl => writeln!(out, "const float {constant}[{n}] = float[{n}]({list});"),
+        Language::Wgsl => writeln!(
+            out,
+            "var<private> {constant}: array<f32, {n}> = array<f32, {n}>({list});"
+        ),
+        Language::Glsl => writeln!(out, "float {constant}[{n}] = float[{n}]({list});"),
         Language::Hlsl => writeln!(out, "static const float {constant}[{n}] = {{ {list} }};"),
     };
     *out += &language.function(&format!("{stem}_lookup"), params, language.float());
@@ -383,14 +390,6 @@ fn write_array_lookup(
         Language::Wgsl => {
             let _ = writeln!(out, "    let i = {i_value};");
             let _ = writeln!(out, "    let f = p - f32(i);");
-            // A function-scope copy: WGSL indexes a `const` array only by constants.
-            let _ = writeln!(out, "    var values = {constant};");
-            let _ = writeln!(
-                out,
-                "    return {}(values[i] * (1.0 - f) + values[i + 1] * f);\n}}",
-                array_scale(table)
-            );
-            return;
         }
         Language::Glsl | Language::Hlsl => {
             let _ = writeln!(out, "    {int} i = {i_value};");
