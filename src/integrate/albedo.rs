@@ -650,6 +650,34 @@ impl Levels {
         &self.strata[..self.count]
     }
 
+    /// These levels with a geometric ladder toward the rim merged in: edges at `ratio^k`
+    /// (`ratio` a quarter, or a sixteenth if the quarters would exceed [`MAX_GGX_LEVELS`]) down
+    /// to `floor`, leaving out any within a factor 2 of one of these levels' own edges. Below
+    /// `floor` the last level runs to the rim, so nothing is left out. For integrands whose rare
+    /// events are not the reflection's alone (the dielectric's refraction and total internal
+    /// reflection, [`crate::integrate::dielectric`]): each range of tilts near the rim gets its
+    /// own points.
+    #[must_use]
+    pub(crate) fn with_rim_ladder(&self, floor: f64) -> Levels {
+        let own: Vec<f64> = self.strata().iter().map(|s| s.start).collect();
+        for ratio in [0.25, 1.0 / 16.0, 1.0 / 256.0] {
+            let mut edges = own.clone();
+            edges.push(1.0);
+            let mut rung = ratio;
+            while rung >= floor {
+                if !own.iter().any(|&e| e > 0.5 * rung && e < 2.0 * rung) {
+                    edges.push(rung);
+                }
+                rung *= ratio;
+            }
+            if edges.len() <= MAX_GGX_LEVELS + 1 {
+                edges.sort_by(f64::total_cmp);
+                return Levels::from_edges(&edges, self.tail_share);
+            }
+        }
+        *self
+    }
+
     fn from_edges(edges: &[f64], tail_share: f64) -> Self {
         let mut out = Levels {
             strata: [Stratum {
@@ -797,6 +825,13 @@ fn beckmann_strata(visible: &BeckmannVisibleNormals, alpha: f64, mu: f64) -> Vec
             weight: 1.0,
         }];
     };
+    ladder_down_to(lost)
+}
+
+/// The ladder of [`beckmann_strata`] over the visible x-slope's share: `[1/2, 1]`, then levels
+/// each holding [`LADDER_RATIO`] of the share above, until one starts below `lost` (at most
+/// [`MAX_LADDER_LEVELS`]), then the rest down to 0.
+fn ladder_down_to(lost: f64) -> Vec<Stratum> {
     let mut strata = vec![Stratum {
         start: 0.5,
         weight: 0.5,
@@ -817,12 +852,41 @@ fn beckmann_strata(visible: &BeckmannVisibleNormals, alpha: f64, mu: f64) -> Vec
     strata
 }
 
+/// Strata of the visible x-slope's share for rare events in either tail: the body `[1/4, 3/4]`
+/// (half the points), then on each side levels each holding [`LADDER_RATIO`] of the share
+/// beyond, down to the share `floor` in the upper tail (normals tilted away from the view) and
+/// to `max(floor, 1e-12)` in the lower (tilted toward it: the share is `1 - w` there, and `w`
+/// near 1 keeps fewer digits), then the rest of each tail.
+fn two_sided_ladder(floor: f64) -> Vec<Stratum> {
+    let mut strata = vec![Stratum {
+        start: 0.25,
+        weight: 0.5,
+    }];
+    for (side_floor, upper) in [(floor, true), (floor.max(1e-12), false)] {
+        let mut top: f64 = 0.25;
+        while top >= side_floor {
+            let bottom = top * LADDER_RATIO;
+            let start = if upper { bottom } else { 1.0 - top };
+            strata.push(Stratum {
+                start,
+                weight: top - bottom,
+            });
+            top = bottom;
+        }
+        strata.push(Stratum {
+            start: if upper { 0.0 } else { 1.0 - top },
+            weight: top,
+        });
+    }
+    strata
+}
+
 /// What the Beckmann sums need of one view `o = (so, 0, mu)`, set up once per estimate: the
 /// visible-normal sampler and how the points are placed ([`BeckmannSampling`]).
-struct BeckmannView {
+pub(crate) struct BeckmannView {
     ndf: Beckmann,
-    o: Vec3,
-    lambda_o: f64,
+    pub(crate) o: Vec3,
+    pub(crate) lambda_o: f64,
     visible: BeckmannVisibleNormals,
     sampling: BeckmannSampling,
 }
@@ -966,6 +1030,22 @@ impl BeckmannView {
         }
     }
 
+    /// A view whose sum runs by a ladder on both tails of the visible x-slopes
+    /// ([`two_sided_ladder`]) whatever the view: for integrands whose rare events are not the
+    /// reflection's alone (the dielectric's refraction and total internal reflection,
+    /// [`crate::integrate::dielectric`]), which the [`LostCircle`] does not know.
+    pub(crate) fn with_ladder(alpha: f64, mu: f64, floor: f64) -> Self {
+        let ndf = Beckmann { alpha };
+        let o = Vec3::from_mu(mu);
+        Self {
+            ndf,
+            o,
+            lambda_o: ndf.lambda(o),
+            visible: BeckmannVisibleNormals::tabulated(ndf, o),
+            sampling: BeckmannSampling::Ladder(two_sided_ladder(floor)),
+        }
+    }
+
     /// [`BeckmannView::sum`] inside the [`LostCircle`], the share outside in closed form.
     fn circle_sum(
         &self,
@@ -1000,7 +1080,7 @@ impl BeckmannView {
     /// The sum of `integrand(m)` over the visible normals of one scramble, returned as a sum over
     /// `2^log2_n` points as [`sum_over_block`] does; `integrand` must be 1 wherever the
     /// reflection leaves the hemisphere (a loss). By [`BeckmannSampling`].
-    fn sum(&self, seq: &OwenSobol, log2_n: u32, integrand: impl Fn(Vec3) -> f64) -> f64 {
+    pub(crate) fn sum(&self, seq: &OwenSobol, log2_n: u32, integrand: impl Fn(Vec3) -> f64) -> f64 {
         match &self.sampling {
             BeckmannSampling::Circle(circle) => self.circle_sum(circle, seq, log2_n, integrand),
             BeckmannSampling::Ladder(strata) => self.ladder_sum(strata, seq, log2_n, integrand),
@@ -1038,7 +1118,12 @@ impl BeckmannView {
                 )
             };
             let sum = sum_over_block(&stream, log2, |[v0, u1]: [f64; 2]| {
-                at(slopes.sample_upper(stratum.t(v0)), u1)
+                // A share of exactly 0 or 1 (a level's end, or 1 - tiny rounded up) is an
+                // infinite slope: the nearest shares that are not.
+                let share = stratum
+                    .t(v0)
+                    .clamp(f64::MIN_POSITIVE, 1.0 - f64::EPSILON / 2.0);
+                at(slopes.sample_upper(share), u1)
             });
             mean += stratum.weight * (sum / (1u64 << log2) as f64);
         }

@@ -33,8 +33,8 @@
 //! hold once `F` depends on `mu`).
 
 use super::albedo::{
-    QmcSettings, TAG_DIELECTRIC, TAG_DIELECTRIC_AVG, model_key, replicates, sin_from_cos,
-    sum_over_block,
+    BeckmannView, GgxView, Levels, QmcSettings, TAG_DIELECTRIC, TAG_DIELECTRIC_AVG, levels_sum,
+    model_key, replicates, sin_from_cos, sum_over_block,
 };
 use super::dielectric_average::average;
 use super::estimate::Estimate;
@@ -108,42 +108,49 @@ pub fn dielectric_albedo_with(
         mu.to_bits(),
         eta.to_bits(),
     ];
-    fn kernel<N: MicrofacetDistribution>(
-        ndf: N,
-        masking: Masking,
-        mu: f64,
-        eta: f64,
-        convention: TransmissionConvention,
-        settings: &QmcSettings,
-        key: &[u64],
-    ) -> Estimate {
-        let o = Vec3::from_mu(mu);
-        let lambda_o = ndf.lambda(o);
-        replicates(settings, key, |seq, log2_n| {
-            sum_over_block(
-                seq,
-                log2_n,
-                #[inline(always)]
-                |u: [f64; 2]| {
-                    let m = ndf.sample_visible_normal(o, u);
-                    scattering_with(ndf, masking, o, lambda_o, m, eta, convention).loss
-                },
-            )
-        })
-    }
     let masking = model.masking;
     match model.ndf {
-        Ndf::Ggx => kernel(Ggx { alpha }, masking, mu, eta, convention, settings, &key),
-        Ndf::Beckmann => kernel(
-            Beckmann { alpha },
-            masking,
-            mu,
-            eta,
-            convention,
-            settings,
-            &key,
-        ),
+        Ndf::Ggx => {
+            let ndf = Ggx { alpha };
+            let o = Vec3::from_mu(mu);
+            let lambda_o = ndf.lambda(o);
+            let levels = dielectric_levels(alpha, mu);
+            replicates(settings, &key, |seq, log2_n| {
+                levels_sum(seq, log2_n, &levels, |u0, t| {
+                    let m = ndf.visible_normal_on_cap(o, u0, t);
+                    scattering_with(ndf, masking, o, lambda_o, m, eta, convention).loss
+                })
+            })
+        }
+        Ndf::Beckmann => {
+            let ndf = Beckmann { alpha };
+            let view = BeckmannView::with_ladder(alpha, mu, BECKMANN_FLOOR);
+            replicates(settings, &key, |seq, log2_n| {
+                view.sum(seq, log2_n, |m| {
+                    scattering_with(ndf, masking, view.o, view.lambda_o, m, eta, convention).loss
+                })
+            })
+        }
     }
+}
+
+/// The visible x-slope share down to which a Beckmann view's ladder runs
+/// ([`BeckmannView::with_ladder`]): the slopes below it hold at most this share of any loss,
+/// and each level of the ladder gets its own points down to there.
+const BECKMANN_FLOOR: f64 = 1e-16;
+
+/// The strata of a GGX view's cap coordinate for the dielectric: the reflection's
+/// ([`GgxView::levels`]: its tail, the rungs around its horizon crossing and the body's) with a
+/// ladder of quarters toward the rim merged in, down to `alpha^2 / 100` (at most `1e-3`), where
+/// a normal's tilt reaches `tan(theta_m) ~ 10` (`t ~ alpha^2 / tan^2` in the body). The
+/// refraction's rare events lie at other tilts than the reflection's: at alpha = 1e-3, mu =
+/// 0.7, eta = 1.5, plain visible-normal sampling put `1 - E` at `8.28e-8` with a standard error
+/// of `4.2e-13`, the reference `2.92e-7`; at mu = 0, eta = 1/3 (total internal reflection
+/// everywhere but the rim's normals facing the view) every scramble of 2^13 points gave 0.
+fn dielectric_levels(alpha: f64, mu: f64) -> Levels {
+    GgxView::new(alpha, mu, sin_from_cos(mu))
+        .levels()
+        .with_rim_ladder((alpha * alpha * 1e-2).min(1e-3))
 }
 
 /// `E_avg,eta = 2 ∫ E_eta(mu) mu dmu` by QMC, with `s = mu^2` as a third dimension.

@@ -3,11 +3,19 @@
 //! compared with the deterministic reference and scored in units of the QMC's own standard
 //! error. A stated error is honest when no point scores far beyond a few units.
 //!
-//! `cargo run --release --example hard_grid` runs the whole grid and prints the worst scores;
-//! `tests/hard_grid.rs` holds a fast subset.
+//! The dielectric grid does the same for the energy albedo `R + T` of a rough dielectric
+//! interface ([`crate::integrate::dielectric`]) over the relative index `eta`, from 1/3 to 3 and
+//! at 1.001 and 1/1.001, where the interface nearly vanishes and total internal reflection sets
+//! in at grazing normals.
+//!
+//! `cargo run --release --example hard_grid [-- --dielectric]` runs the whole grid and prints the
+//! worst scores; `tests/hard_grid.rs` holds a fast subset of the first and the whole second at
+//! 2^16 samples.
 
 use crate::integrate::QmcSettings;
 use crate::integrate::albedo::{albedo, weighted_albedo};
+use crate::integrate::dielectric::{dielectric_albedo, reference_dielectric_albedo};
+use crate::integrate::estimate::Estimate;
 use crate::integrate::reference::{ReferenceSettings, reference_albedo, reference_weighted_albedo};
 use crate::model::{Masking, Model, Ndf};
 use serde::Serialize;
@@ -57,10 +65,52 @@ fn schlick(f0: f64) -> impl Fn(f64) -> f64 + Copy {
     move |c: f64| f0 + (1.0 - f0) * (1.0 - c).powi(5)
 }
 
+/// The dielectric grid's view cosines `mu`.
+pub const DIELECTRIC_MU: [f64; 6] = [0.0, 0.05, 0.3, 0.7, 0.99, 1.0];
+/// The dielectric grid's roughnesses `alpha`.
+pub const DIELECTRIC_ALPHA: [f64; 6] = [1e-4, 1e-3, 1e-2, 0.1, 0.5, 1.0];
+/// The dielectric grid's relative indices `eta = n_other / n_view`: inside and outside glass
+/// and a dense medium, and either side of an interface that nearly vanishes.
+pub const ETA: [f64; 6] = [1.0 / 3.0, 1.0 / 1.5, 1.0 / 1.001, 1.001, 1.5, 3.0];
+
+/// One point of the dielectric grid.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct DielectricPoint {
+    pub model: Model,
+    pub alpha: f64,
+    pub mu: f64,
+    pub eta: f64,
+}
+
+/// Every point of the dielectric grid: both distributions (height-correlated masking), every
+/// `alpha`, `mu` and `eta`.
+#[must_use]
+pub fn dielectric_points() -> Vec<DielectricPoint> {
+    let mut out = Vec::new();
+    for ndf in [Ndf::Ggx, Ndf::Beckmann] {
+        for alpha in DIELECTRIC_ALPHA {
+            for mu in DIELECTRIC_MU {
+                for eta in ETA {
+                    out.push(DielectricPoint {
+                        model: Model {
+                            ndf,
+                            masking: Masking::HeightCorrelated,
+                        },
+                        alpha,
+                        mu,
+                        eta,
+                    });
+                }
+            }
+        }
+    }
+    out
+}
+
 /// The QMC estimate at a point beside the reference, and the score.
 #[derive(Clone, Copy, Debug, Serialize)]
-pub struct HardCheck {
-    pub point: HardPoint,
+pub struct HardCheck<P = HardPoint> {
+    pub point: P,
     pub samples: u64,
     /// `1 - value` by QMC and its stated standard error.
     pub qmc_one_minus: f64,
@@ -79,15 +129,7 @@ pub const REFERENCE_TOLERANCE: f64 = 1e-13;
 /// Scores the QMC estimate at `point` with `samples` points in `scrambles` scrambles.
 #[must_use]
 pub fn check(point: HardPoint, samples: u64, scrambles: u32, seed: u64) -> HardCheck {
-    let settings = QmcSettings {
-        samples,
-        scrambles,
-        seed,
-    };
-    let reference_settings = ReferenceSettings {
-        tolerance: REFERENCE_TOLERANCE,
-        max_intervals: 400,
-    };
+    let (settings, reference_settings) = grid_settings(samples, scrambles, seed);
     let HardPoint {
         model, alpha, mu, ..
     } = point;
@@ -101,8 +143,67 @@ pub fn check(point: HardPoint, samples: u64, scrambles: u32, seed: u64) -> HardC
             reference_weighted_albedo(model, alpha, mu, schlick(f0), &reference_settings),
         ),
     };
-    let difference = (qmc.one_minus_value - reference.one_minus_value).abs();
-    let scale = qmc.std_error.hypot(reference.error);
+    score(
+        point,
+        samples,
+        qmc,
+        reference.one_minus_value,
+        reference.error,
+    )
+}
+
+/// Scores the QMC estimate of `R + T` at `point` with `samples` points in `scrambles`
+/// scrambles against the dielectric reference.
+#[must_use]
+pub fn check_dielectric(
+    point: DielectricPoint,
+    samples: u64,
+    scrambles: u32,
+    seed: u64,
+) -> HardCheck<DielectricPoint> {
+    let (settings, reference_settings) = grid_settings(samples, scrambles, seed);
+    let DielectricPoint {
+        model,
+        alpha,
+        mu,
+        eta,
+    } = point;
+    let qmc = dielectric_albedo(model, alpha, mu, eta, &settings);
+    let reference = reference_dielectric_albedo(model, alpha, mu, eta, &reference_settings);
+    score(
+        point,
+        samples,
+        qmc,
+        reference.one_minus_value,
+        reference.error,
+    )
+}
+
+/// The QMC settings of one check and the reference's, shared by both grids.
+fn grid_settings(samples: u64, scrambles: u32, seed: u64) -> (QmcSettings, ReferenceSettings) {
+    (
+        QmcSettings {
+            samples,
+            scrambles,
+            seed,
+        },
+        ReferenceSettings {
+            tolerance: REFERENCE_TOLERANCE,
+            max_intervals: 400,
+        },
+    )
+}
+
+/// The check of `qmc` against the reference's `1 - value` and error estimate.
+fn score<P>(
+    point: P,
+    samples: u64,
+    qmc: Estimate,
+    reference_one_minus: f64,
+    reference_error: f64,
+) -> HardCheck<P> {
+    let difference = (qmc.one_minus_value - reference_one_minus).abs();
+    let scale = qmc.std_error.hypot(reference_error);
     let z = if difference == 0.0 {
         0.0
     } else {
@@ -113,8 +214,8 @@ pub fn check(point: HardPoint, samples: u64, scrambles: u32, seed: u64) -> HardC
         samples,
         qmc_one_minus: qmc.one_minus_value,
         std_error: qmc.std_error,
-        reference_one_minus: reference.one_minus_value,
-        reference_error: reference.error,
+        reference_one_minus,
+        reference_error,
         z,
     }
 }
