@@ -23,10 +23,14 @@ fn beckmann_qmc_standard_error_falls_at_least_as_n_to_the_minus_0_9() {
         ndf: Ndf::Beckmann,
         masking: Masking::HeightCorrelated,
     };
-    let points: Vec<(f64, f64)> = [0.1, 0.3, 1.0]
+    // The lost circle, and the three other ways a view is sampled: the grazing ladder (alpha
+    // 0.1, mu 0.005), the lost circle at a grazing view (1, 0.05) and the reflected directions
+    // (0.7, 1 and 1.5, 0.95).
+    let mut points: Vec<(f64, f64)> = [0.1, 0.3, 1.0]
         .into_iter()
         .flat_map(|alpha| [0.2, 0.5, 1.0].map(|mu| (alpha, mu)))
         .collect();
+    points.extend([(0.1, 0.005), (1.0, 0.05), (0.7, 1.0), (1.5, 0.95)]);
     let logs = [14, 16, 18, 20, 22];
     let exponents: Vec<((f64, f64), f64)> = points
         .into_par_iter()
@@ -55,4 +59,46 @@ fn beckmann_qmc_standard_error_falls_at_least_as_n_to_the_minus_0_9() {
     }
     let slow: Vec<_> = exponents.iter().filter(|(_, e)| *e < 0.9).collect();
     assert!(slow.is_empty(), "converging slower than N^-0.9: {slow:?}");
+}
+
+/// Beckmann's standard error is within twice GGX's at the same point, sample count and seed,
+/// over rough surfaces at every tilt (issue 40's goal; at lower roughness Beckmann's is the
+/// smaller, 0.0 to 0.4 of GGX's at alpha 0.3). The exception is GGX's own: at alpha = 1 its
+/// distribution is uniform over the hemisphere (`D = 1 / pi`), the cap point it samples is the
+/// reflected direction itself, and its integrand depends on one coordinate only, so its error
+/// there is 10 to 25 times below its own at alpha 0.7 or 1.5 (and Beckmann's 2.6 to 6 times
+/// above it at mu 0.001 to 0.8; `docs/accuracy.md`): the grid steps over alpha in [0.95, 1.1].
+#[test]
+fn beckmann_qmc_standard_error_is_within_twice_ggx_s() {
+    let points: Vec<(f64, f64)> = [0.3, 0.5, 0.7, 0.9, 1.25, 1.5, 2.0, 3.0]
+        .into_iter()
+        .flat_map(|alpha| [0.001, 0.05, 0.2, 0.5, 0.8, 0.95, 1.0].map(|mu| (alpha, mu)))
+        .collect();
+    let ratios: Vec<((f64, f64, u32), f64)> = points
+        .into_par_iter()
+        .flat_map_iter(|(alpha, mu)| {
+            [16, 19].into_iter().map(move |k| {
+                let settings = QmcSettings {
+                    samples: 1 << k,
+                    scrambles: 8,
+                    seed: 0,
+                };
+                let error = |ndf| {
+                    let model = Model {
+                        ndf,
+                        masking: Masking::HeightCorrelated,
+                    };
+                    albedo(model, alpha, mu, &settings).std_error
+                };
+                ((alpha, mu, k), error(Ndf::Beckmann) / error(Ndf::Ggx))
+            })
+        })
+        .collect();
+    let worst = ratios.iter().map(|(_, r)| *r).fold(0.0, f64::max);
+    eprintln!("worst Beckmann / GGX standard error: {worst:.2}");
+    let over: Vec<_> = ratios.iter().filter(|(_, r)| !(*r <= 2.0)).collect();
+    assert!(
+        over.is_empty(),
+        "Beckmann's standard error over twice GGX's at (alpha, mu, log2 samples): {over:?}"
+    );
 }
