@@ -147,8 +147,7 @@ pub fn check(point: HardPoint, samples: u64, scrambles: u32, seed: u64) -> HardC
         point,
         samples,
         qmc,
-        reference.one_minus_value,
-        reference.error,
+        (reference.one_minus_value, reference.error),
     )
 }
 
@@ -170,13 +169,8 @@ pub fn check_dielectric(
     } = point;
     let qmc = dielectric_albedo(model, alpha, mu, eta, &settings);
     let reference = reference_dielectric_albedo(model, alpha, mu, eta, &reference_settings);
-    score(
-        point,
-        samples,
-        qmc,
-        reference.one_minus_value,
-        reference.error,
-    )
+    let (one_minus, error) = (reference.one_minus_value, reference.error);
+    score(point, samples, qmc, (one_minus, error))
 }
 
 /// The QMC settings of one check and the reference's, shared by both grids.
@@ -194,13 +188,12 @@ fn grid_settings(samples: u64, scrambles: u32, seed: u64) -> (QmcSettings, Refer
     )
 }
 
-/// The check of `qmc` against the reference's `1 - value` and error estimate.
+/// The check of `qmc` against the reference's `(1 - value, error estimate)`.
 fn score<P>(
     point: P,
     samples: u64,
     qmc: Estimate,
-    reference_one_minus: f64,
-    reference_error: f64,
+    (reference_one_minus, reference_error): (f64, f64),
 ) -> HardCheck<P> {
     let difference = (qmc.one_minus_value - reference_one_minus).abs();
     let scale = qmc.std_error.hypot(reference_error);
