@@ -178,3 +178,56 @@ fn exact_limits() {
     let r = reference_albedo(HC_GGX, 0.5, 0.0, &s);
     assert!((r.value - 1.0).abs() < 1e-12, "{r:?}");
 }
+
+/// Below `SMOOTH_ALPHA` (1e-7) a weight of `o.h` follows `mu` itself: near a mirror every
+/// visible normal is the surface normal, so `E_bias = ∫ (1 - o.h)^5 w` tends to `(1 - mu)^5 E`
+/// (the mirror's Schlick weight) and `E_scale` to `(1 - (1 - mu)^5) E`, by both methods, with
+/// a stated error that covers the distance. It once took `mu` from `E`'s similar point
+/// (`mu 1e-7 / alpha`): `E_bias(0.1476)` was 0.100 at alpha 4e-8 and 0 at 1e-8.
+#[test]
+fn schlick_weights_near_a_mirror_follow_the_view() {
+    use kiln::integrate::albedo::weighted_albedo;
+    use kiln::integrate::reference::reference_weighted_albedo;
+    let s = ReferenceSettings {
+        tolerance: 1e-9,
+        ..ReferenceSettings::default()
+    };
+    let bias = |x: f64| (1.0 - x).powi(5);
+    let scale = |x: f64| 1.0 - (1.0 - x).powi(5);
+    for model in models()
+        .into_iter()
+        .filter(|m| m.masking != Masking::SchlickGgx)
+    {
+        for alpha in [9e-8, 4e-8, 1e-8, 1e-10, 1e-12] {
+            for mu in [0.02, 0.1476, 0.5, 0.93] {
+                let e = reference_albedo(model, alpha, mu, &s).value;
+                for (name, h) in [("bias", &bias as &dyn Fn(f64) -> f64), ("scale", &scale)] {
+                    let expected = h(mu) * e;
+                    let got = reference_weighted_albedo(model, alpha, mu, h, &s);
+                    let difference = (got.value - expected).abs();
+                    assert!(
+                        difference < 2e-6 && difference <= got.error + 1e-12,
+                        "{model} {name} alpha {alpha:e} mu {mu}: {} vs {expected} (error {:e})",
+                        got.value,
+                        got.error
+                    );
+                    let qmc = weighted_albedo(
+                        model,
+                        alpha,
+                        mu,
+                        h,
+                        &QmcSettings {
+                            samples: 1 << 10,
+                            ..QmcSettings::default()
+                        },
+                    );
+                    assert!(
+                        (qmc.value - expected).abs() < 2e-6,
+                        "{model} QMC {name} alpha {alpha:e} mu {mu}: {} vs {expected}",
+                        qmc.value
+                    );
+                }
+            }
+        }
+    }
+}

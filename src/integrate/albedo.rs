@@ -201,7 +201,26 @@ pub fn weighted_albedo(
         // A mirror: m = n, so o.m = mu and w = 1.
         return Estimate::exact(1.0 - h(mu));
     }
-    let (alpha, mu) = smooth_point(alpha, mu);
+    if alpha < SMOOTH_ALPHA {
+        // As the reference below SMOOTH_ALPHA (`reference::weighted_below_smooth`): E's
+        // similarity does not hold for a weight of o.h = mu + O(alpha), so E_h = h(mu) E, and
+        // the product's deviation at SMOOTH_ALPHA joins the standard error.
+        let e = albedo(model, alpha, mu, settings);
+        let weight = h(mu);
+        let one_minus_value = 1.0 - weight * e.value;
+        let (deviation, _) = super::reference::weighted_product_deviation(
+            model,
+            mu,
+            h,
+            &super::reference::ReferenceSettings::default(),
+        );
+        return Estimate {
+            value: 1.0 - one_minus_value,
+            one_minus_value,
+            std_error: (weight * e.std_error).hypot(deviation),
+            samples: e.samples,
+        };
+    }
     let key = [
         TAG_WEIGHTED,
         model_key(model),

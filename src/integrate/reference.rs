@@ -197,7 +197,9 @@ pub fn reference_weighted_albedo(
             ..MIRROR
         };
     }
-    let (alpha, mu) = smooth_point(alpha, mu);
+    if alpha < SMOOTH_ALPHA {
+        return weighted_below_smooth(model, alpha, mu, h, settings);
+    }
     let q = weighted_quadrature_for(model, alpha, mu, h, Channels::WeightedOnly, settings);
     // A raw value outside [0, 1] is the quadrature's error showing: kept within the range, with
     // the stated error widened to cover the distance (never clamped silently).
@@ -209,6 +211,49 @@ pub fn reference_weighted_albedo(
         evaluations: q.evaluations,
         converged: q.converged,
     }
+}
+
+/// `E_h` below [`SMOOTH_ALPHA`], where `E`'s similarity ([`smooth_point`]) does not hold for a
+/// weight of `o.h`: every visible normal lies within `O(alpha)` of the normal there, so
+/// `o.h = mu + O(alpha)` and `E_h = h(mu) E + O(alpha |h'|)`, with `E` from the similarity. The
+/// error adds what that product misses at `SMOOTH_ALPHA` itself ([`weighted_product_deviation`]),
+/// which bounds it at every smaller `alpha` (it shrinks with `alpha`). Without this, a weight
+/// of `mu` was evaluated at the similar point's `mu * SMOOTH_ALPHA / alpha`: `E_bias(0.1476)`
+/// was 0.100 at `alpha = 4e-8` and 0 at 1e-8 instead of `(1 - mu)^5 = 0.450`.
+fn weighted_below_smooth(
+    model: Model,
+    alpha: f64,
+    mu: f64,
+    h: impl Fn(f64) -> f64 + Copy,
+    settings: &ReferenceSettings,
+) -> ReferenceValue {
+    let e = reference_albedo(model, alpha, mu, settings);
+    let value = (h(mu) * e.value).clamp(0.0, 1.0);
+    let deviation = weighted_product_deviation(model, mu, h, settings);
+    ReferenceValue {
+        value,
+        one_minus_value: 1.0 - value,
+        error: e.error + deviation.0,
+        evaluations: e.evaluations + deviation.1,
+        converged: e.converged,
+    }
+}
+
+/// `|E_h(mu, SMOOTH_ALPHA) - h(mu) E(mu, SMOOTH_ALPHA)|` plus both quadratures' error
+/// estimates, and the evaluations spent: how far the product `h(mu) E` is from `E_h` at the
+/// smallest roughness integrated directly (see [`weighted_below_smooth`]).
+pub(crate) fn weighted_product_deviation(
+    model: Model,
+    mu: f64,
+    h: impl Fn(f64) -> f64 + Copy,
+    settings: &ReferenceSettings,
+) -> (f64, u64) {
+    let q = weighted_quadrature_for(model, SMOOTH_ALPHA, mu, h, Channels::WeightedOnly, settings);
+    let e = reference_albedo(model, SMOOTH_ALPHA, mu, settings);
+    (
+        (q.value[0] - h(mu) * e.value).abs() + q.error + e.error,
+        q.evaluations + e.evaluations,
+    )
 }
 
 /// `E_avg = 2 ∫ E(mu) mu dmu` by nested quadrature.
