@@ -35,12 +35,12 @@ const GOLDEN: &[(u32, &str, &str)] = &[
     (
         10,
         "ggx-height-correlated-E_scale-mu-linear Reference",
-        "44458dbad202129e",
+        "5855b395dd37186c",
     ),
     (
         10,
         "ggx-height-correlated-E_bias-mu-linear Reference",
-        "912bf62e8c1c999f",
+        "149f2472c7115111",
     ),
     (
         10,

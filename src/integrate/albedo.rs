@@ -208,12 +208,16 @@ pub fn weighted_albedo(
         let e = albedo(model, alpha, mu, settings);
         let weight = h(mu);
         let one_minus_value = 1.0 - weight * e.value;
-        let (deviation, _) = super::reference::weighted_product_deviation(
-            model,
-            mu,
-            h,
-            &super::reference::ReferenceSettings::default(),
-        );
+        let (deviation, _) = if alpha == 0.0 {
+            (0.0, 0)
+        } else {
+            super::reference::weighted_product_deviation(
+                model,
+                mu,
+                h,
+                &super::reference::ReferenceSettings::default(),
+            )
+        };
         return Estimate {
             value: 1.0 - one_minus_value,
             one_minus_value,

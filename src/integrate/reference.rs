@@ -229,7 +229,12 @@ fn weighted_below_smooth(
 ) -> ReferenceValue {
     let e = reference_albedo(model, alpha, mu, settings);
     let value = (h(mu) * e.value).clamp(0.0, 1.0);
-    let deviation = weighted_product_deviation(model, mu, h, settings);
+    // At alpha = 0 (here with mu = 0: the grazing mirror) the product is the exact limit.
+    let deviation = if alpha == 0.0 {
+        (0.0, 0)
+    } else {
+        weighted_product_deviation(model, mu, h, settings)
+    };
     ReferenceValue {
         value,
         one_minus_value: 1.0 - value,
