@@ -66,6 +66,7 @@
 pub mod bake;
 pub mod cache;
 pub mod error;
+pub mod fit;
 pub mod format;
 pub mod integrate;
 pub mod model;

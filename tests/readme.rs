@@ -2,7 +2,8 @@
 //! `README.md` and `docs/*.md` is run (in order, per page, in a fresh temporary folder holding
 //! copies of the repository's `tables/`, `tests/data/` and `examples/`) and must succeed; where
 //! the page shows the output under the command, the run must print the same lines, every number
-//! within one unit of the last digit the page prints.
+//! within one unit of the last digit the page prints; a picture a command draws into `docs/`
+//! must be the committed one.
 
 #![cfg(feature = "cli")]
 
@@ -192,9 +193,24 @@ fn every_documented_command_runs_and_prints_what_the_page_shows() {
         for folder in ["tables", "tests/data", "examples"] {
             copy_dir(&root.join(folder), &dir.path().join(folder));
         }
+        // A picture a page shows is drawn by a command on it into docs/: what the command draws
+        // now must be the committed picture, byte for byte.
+        std::fs::create_dir(dir.path().join("docs")).unwrap();
         for example in &examples {
             check(example, dir.path());
             ran += 1;
+        }
+        for drawn in std::fs::read_dir(dir.path().join("docs")).unwrap() {
+            let drawn = drawn.unwrap().path();
+            let name = drawn.file_name().unwrap();
+            let committed = root.join("docs").join(name);
+            assert!(
+                std::fs::read(&committed).ok() == Some(std::fs::read(&drawn).unwrap()),
+                "{}: docs/{} is not what its command draws now: run the command the page \
+                 shows from the repository's root",
+                page.display(),
+                name.to_string_lossy()
+            );
         }
     }
     // The README's quick start alone has three.

@@ -3,6 +3,7 @@
 //! between those coordinates.
 
 pub mod error_map;
+pub mod fit;
 pub mod furnace;
 pub mod input;
 pub mod verdict;

@@ -11,6 +11,8 @@ use kiln::verify::{Against, AuditSettings, Point, Progress, audit};
 use kiln::{Grid, Masking, Model, MuMapping, Ndf, Quantity, RoughnessConvention, Table};
 use std::path::{Path, PathBuf};
 
+mod fit;
+
 /// Audit a table against the deterministic reference (or another table).
 #[derive(Args, Debug, Clone)]
 #[command(
@@ -28,8 +30,25 @@ use std::path::{Path, PathBuf};
 )]
 pub struct VerifyArgs {
     /// The table to audit: a kiln output, a text file of numbers (whitespace or commas, '#'
-    /// comments), raw little-endian floats (--dtype) or an EXR channel (--channel).
-    file: PathBuf,
+    /// comments), raw little-endian floats (--dtype) or an EXR channel (--channel). Not with
+    /// --fit, which audits a formula instead of a file of numbers.
+    #[arg(required_unless_present = "fit")]
+    file: Option<PathBuf>,
+    /// Audit a texture-free fit instead of a table: karis (UE4 mobile EnvBRDFApprox), materialx
+    /// (mx_ggx_dir_albedo_analytic), unreal (UE5's analytic GGXEnergyLookup), or a formula
+    /// file (TOML: name = "...", optional define = ["k = max(r, 1e-3)", ...], and formulas
+    /// E, E_scale and/or E_bias in mu, r and alpha = r^2; see docs/fits.md). Reports each
+    /// quantity's maximum error over mu and r in [0, 1] against the reference for the model
+    /// of --ndf and --masking (default GGX height-correlated), and where it is.
+    #[arg(long, value_name = "NAME|FILE.toml", conflicts_with_all = ["file", "furnace",
+        "preset", "shape", "channel", "dtype", "order", "grid", "roughness_axis", "mu_axis",
+        "quantity", "average", "clamp_min", "density", "only", "form", "against"])]
+    fit: Option<String>,
+    /// With --fit: points per axis of the (sqrt(mu), r) grid the fit is compared on, the ends
+    /// included; a finer grid then surrounds each quantity's worst point.
+    #[arg(long, default_value_t = 129, requires = "fit",
+        value_parser = clap::value_parser!(u32).range(2..=1025))]
+    points: u32,
     /// What to compare with: 'reference' (the deterministic quadrature) or another table's file.
     #[arg(long, default_value = "reference")]
     against: String,
@@ -156,6 +175,11 @@ fn parse_shape(text: &str) -> Result<Shape, String> {
 }
 
 impl VerifyArgs {
+    /// The file audited (clap requires it unless --fit is given, which never asks for it).
+    pub fn file(&self) -> &Path {
+        self.file.as_deref().unwrap_or(Path::new("-"))
+    }
+
     /// The external-layout flags given on the command line: a kiln file carries its own layout,
     /// so these are errors with one.
     fn layout_flags_given(&self) -> Vec<&'static str> {
@@ -389,7 +413,7 @@ fn run_furnace(args: &VerifyArgs, table: &Table) -> kiln::Result<bool> {
         return Err(kiln::Error::InvalidInput(format!(
             "--furnace tests an E table with its normalisation: {} holds {}; give the E file \
              (NAME-E.EXT), whose f_ms_norm or E_avg is found beside it or given with --average",
-            args.file.display(),
+            args.file().display(),
             table.spec.quantity.symbol()
         )));
     }
@@ -402,7 +426,7 @@ fn run_furnace(args: &VerifyArgs, table: &Table) -> kiln::Result<bool> {
         return Err(kiln::Error::InvalidInput(format!(
             "{} is a glass table: kiln checks Turquin's 1 / E compensation of it (--form \
              turquin); the Kulla-Conty lobe of glass is not in this version",
-            args.file.display()
+            args.file().display()
         )));
     }
     let forms = args.form.clone().unwrap_or_else(|| {
@@ -417,7 +441,7 @@ fn run_furnace(args: &VerifyArgs, table: &Table) -> kiln::Result<bool> {
         true => {
             let average_path = match &args.average {
                 Some(path) => path.clone(),
-                None => sibling_normalisation(&args.file, table)?,
+                None => sibling_normalisation(args.file(), table)?,
             };
             let average = args.load(&average_path)?;
             Some((average_path, average))
@@ -514,7 +538,7 @@ fn run_furnace(args: &VerifyArgs, table: &Table) -> kiln::Result<bool> {
         println!(
             "{}: white furnace test of Turquin's 1 / E scaling: max |E_true / E_lookup - 1| = \
              {:.2e} at mu = {:.3e}, {} = {:.4}{} (the lookup audit's points against the reference)",
-            args.file.display(),
+            args.file().display(),
             t.max_deviation,
             t.worst_mu,
             table.spec.roughness_convention().name(),
@@ -556,7 +580,7 @@ fn print_kulla_conty(
     let convention = table.spec.roughness_convention().name();
     println!(
         "{} with {} ({}): white furnace test of the Kulla-Conty lobe, {} roughness values",
-        args.file.display(),
+        args.file().display(),
         average_path.display(),
         report.normalisation,
         report.rows.len()
@@ -598,7 +622,7 @@ fn quiet_verdict(args: &VerifyArgs, passed: bool, what: &str, value: f64) {
     if let (false, Some(bound)) = (passed, args.max_error) {
         eprintln!(
             "kiln: {}: {what} {value:.2e} exceeds --max-error {bound:e}",
-            args.file.display()
+            args.file().display()
         );
     }
 }
@@ -610,7 +634,7 @@ fn json_report(
     passed: bool,
 ) -> serde_json::Value {
     let mut object = serde_json::to_value(report).expect("a report serialises");
-    object["file"] = args.file.display().to_string().into();
+    object["file"] = args.file().display().to_string().into();
     if let Some(bound) = args.max_error {
         object["max_error"] = bound.into();
         object["passed"] = passed.into();
@@ -620,17 +644,20 @@ fn json_report(
 
 /// Returns whether the table passed `--max-error` (always true without it).
 pub fn run(args: VerifyArgs) -> kiln::Result<bool> {
+    if let Some(fit) = &args.fit {
+        return fit::run(&args, fit);
+    }
     if let Some(preset) = args.preset {
-        let bytes = kiln::format::read_file(&args.file)?;
+        let bytes = kiln::format::read_file(args.file())?;
         // Name the file in what the layout's reader says.
         let in_file = |e: kiln::Error| match e {
-            kiln::Error::InvalidInput(m) if !m.contains(&args.file.display().to_string()) => {
-                kiln::Error::InvalidInput(format!("{}: {m}", args.file.display()))
+            kiln::Error::InvalidInput(m) if !m.contains(&args.file().display().to_string()) => {
+                kiln::Error::InvalidInput(format!("{}: {m}", args.file().display()))
             }
             other => other,
         };
         let mut tables = preset
-            .read_tables(&bytes, &args.file.display().to_string())
+            .read_tables(&bytes, &args.file().display().to_string())
             .map_err(in_file)?;
         if let Some(only) = &args.only {
             if let Some(missing) = only
@@ -640,7 +667,7 @@ pub fn run(args: VerifyArgs) -> kiln::Result<bool> {
                 let held: Vec<&str> = tables.iter().map(|t| t.spec.quantity.cli_name()).collect();
                 return Err(kiln::Error::InvalidInput(format!(
                     "{}: --only names {}, but the file holds {} in the {} layout",
-                    args.file.display(),
+                    args.file().display(),
                     missing.cli_name(),
                     held.join(", "),
                     preset.name()
@@ -688,7 +715,7 @@ pub fn run(args: VerifyArgs) -> kiln::Result<bool> {
                 ..args.clone()
             };
             passed &= if table.spec.quantity == Quantity::FMsNorm {
-                let e_path = args.file.with_file_name(preset.file_name());
+                let e_path = args.file().with_file_name(preset.file_name());
                 let e_bytes = kiln::format::read_file(&e_path)?;
                 let e = preset
                     .read_tables(&e_bytes, &e_path.display().to_string())?
@@ -709,7 +736,7 @@ pub fn run(args: VerifyArgs) -> kiln::Result<bool> {
         return Ok(passed);
     }
     plot_kind(&args)?;
-    let table = args.load(&args.file)?;
+    let table = args.load(args.file())?;
     if args.furnace {
         return run_furnace(&args, &table);
     }
@@ -724,20 +751,23 @@ pub fn run(args: VerifyArgs) -> kiln::Result<bool> {
 /// (relative error of the lookup).
 fn run_normalisation_audit(args: &VerifyArgs, table: &Table) -> kiln::Result<bool> {
     let source = table.spec.lookup_of.as_deref().ok_or_else(|| {
-        kiln::Error::InvalidInput(format!("{}: no lookup_of in its spec", args.file.display()))
+        kiln::Error::InvalidInput(format!(
+            "{}: no lookup_of in its spec",
+            args.file().display()
+        ))
     })?;
     let extension = args
-        .file
+        .file()
         .extension()
         .and_then(|e| e.to_str())
         .unwrap_or("json");
     let e_path = args
-        .file
+        .file()
         .with_file_name(format!("{}.{extension}", source.id()));
     if !e_path.is_file() {
         return Err(kiln::Error::InvalidInput(format!(
             "{} is the normalisation of an E table's lookup: its E table {} must be beside it",
-            args.file.display(),
+            args.file().display(),
             e_path.display()
         )));
     }
@@ -769,7 +799,7 @@ fn normalisation_audit(
     } else {
         println!(
             "{}: f_ms_norm, {} entries, against the average of the lookup of {}",
-            args.file.display(),
+            args.file().display(),
             report.nodes + 1,
             e_path.display()
         );
@@ -801,7 +831,7 @@ fn audit_extra(args: &VerifyArgs, audit: &kiln::preset::ExtraAudit) -> bool {
     let passed = args.max_error.is_none_or(|bound| audit.max_error <= bound);
     if args.json {
         let mut object = serde_json::json!({
-            "file": args.file.display().to_string(),
+            "file": args.file().display().to_string(),
             "channel": audit.name,
             "texels": audit.texels,
             "node_max_error": audit.max_error,
@@ -820,7 +850,7 @@ fn audit_extra(args: &VerifyArgs, audit: &kiln::preset::ExtraAudit) -> bool {
     } else {
         println!(
             "{}: blue channel, {} ({} texels, against kiln's values, error estimate {:.0e})",
-            args.file.display(),
+            args.file().display(),
             audit.name,
             audit.texels,
             audit.reference_error
@@ -943,7 +973,7 @@ fn audit_one(
         if other.spec.quantity != table.spec.quantity {
             return Err(kiln::Error::InvalidInput(format!(
                 "{} holds {} but {} holds {}",
-                args.file.display(),
+                args.file().display(),
                 table.spec.quantity.symbol(),
                 args.against,
                 other.spec.quantity.symbol()
@@ -997,7 +1027,7 @@ fn audit_one(
         let shape: Vec<String> = report.shape.iter().map(|n| n.to_string()).collect();
         println!(
             "{}: {} {} {}, {} ({} grid, roughness axis {}{}{}) against {}",
-            args.file.display(),
+            args.file().display(),
             report.ndf,
             report.masking,
             report.quantity,

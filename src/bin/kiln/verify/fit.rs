@@ -1,0 +1,133 @@
+//! `kiln verify --fit`: the audit of a texture-free fit, an engine's or one given as a formula
+//! file ([`kiln::verify::fit`]).
+
+use super::{VerifyArgs, plot_kind, write_plot};
+use kiln::fit::engine::EngineFit;
+use kiln::fit::{Fit, FormulaFit};
+use kiln::verify::fit::{FitAuditSettings, FitReport, audit_fit, fit_audit_points};
+use kiln::{Masking, Model, Ndf};
+use std::path::Path;
+
+/// The fit `--fit` names: a built-in one, or a formula file.
+fn fit_named(name: &str) -> kiln::Result<Fit> {
+    if let Some(fit) = EngineFit::ALL.into_iter().find(|f| f.name() == name) {
+        return Ok(Fit::Engine(fit));
+    }
+    let path = Path::new(name);
+    if !path.exists() {
+        let names: Vec<&str> = EngineFit::ALL.iter().map(|f| f.name()).collect();
+        return Err(kiln::Error::InvalidInput(format!(
+            "--fit {name}: neither a fit kiln knows ({}) nor a formula file",
+            names.join(", ")
+        )));
+    }
+    Ok(Fit::Formula(FormulaFit::read(path)?))
+}
+
+pub fn run(args: &VerifyArgs, name: &str) -> kiln::Result<bool> {
+    if args.fresnel.given() {
+        return Err(kiln::Error::InvalidInput(
+            "--fit audits fits of E and its split-sum terms, which are for F = 1 (E_scale, \
+             E_bias are Schlick's weights): drop the Fresnel flags"
+                .into(),
+        ));
+    }
+    let fit = fit_named(name)?;
+    let model = Model {
+        ndf: args.ndf.unwrap_or(Ndf::Ggx),
+        masking: args.masking.unwrap_or(Masking::HeightCorrelated),
+    };
+    model.validate().map_err(kiln::Error::InvalidInput)?;
+    let svg = plot_kind(args)?;
+    let settings = FitAuditSettings {
+        model,
+        points: args.points as usize,
+        ..FitAuditSettings::default()
+    };
+    let quiet = args.quiet || args.json;
+    let bar = crate::progress_bar(quiet, fit_audit_points(&fit, &settings), "verifying");
+    let report = audit_fit(&fit, &settings, &|| bar.inc(1));
+    bar.finish_and_clear();
+    if let (Some(svg), Some(path)) = (svg, &args.plot) {
+        let maps: Vec<_> = report.quantities.iter().map(|q| q.map.clone()).collect();
+        let title = format!(
+            "{}: |fit - reference| for {} (ringed: the worst point)",
+            report.fit, report.model
+        );
+        write_plot(path, svg, crate::plot::error_map_plot(&title, &maps))?;
+    }
+    let worst = report
+        .quantities
+        .iter()
+        .map(|q| q.max_error)
+        .fold(0.0_f64, |a, b| {
+            if a.is_nan() || b.is_nan() {
+                f64::NAN
+            } else {
+                a.max(b)
+            }
+        });
+    let passed = args.max_error.is_none_or(|bound| worst <= bound);
+    if args.json {
+        let mut object = serde_json::to_value(&report).expect("a report serialises");
+        if let Some(bound) = args.max_error {
+            object["max_error"] = bound.into();
+            object["passed"] = passed.into();
+        }
+        println!("{object}");
+    } else if args.quiet {
+        if let (false, Some(bound)) = (passed, args.max_error) {
+            eprintln!(
+                "kiln: --fit {}: max error {worst:.2e} exceeds --max-error {bound:e}",
+                report.fit
+            );
+        }
+    } else {
+        print!("{}", text(&report));
+        if let Some(bound) = args.max_error {
+            println!(
+                "{}: max error {worst:.2e} {} --max-error {bound:e}",
+                if passed { "PASSED" } else { "FAILED" },
+                if passed { "within" } else { "exceeds" }
+            );
+        }
+    }
+    Ok(passed)
+}
+
+/// The report as text: what was compared, then one line per quantity.
+fn text(report: &FitReport) -> String {
+    let mut out = format!(
+        "{} ({})\nagainst the reference for {} (tolerance {:e}) at {} points: {} x {} over mu \
+         = t^2 and r in [0, 1] (alpha = r^2), then around each worst point\n",
+        report.fit,
+        report.source,
+        report.model,
+        report.reference_tolerance,
+        report.points_compared,
+        report.grid_points,
+        report.grid_points
+    );
+    for q in &report.quantities {
+        let w = &q.worst;
+        let nan = if q.non_finite_points > 0 {
+            format!(" ({} points NaN or infinite)", q.non_finite_points)
+        } else {
+            String::new()
+        };
+        out += &format!(
+            "  {:<8} max error {:.3e}{nan} at mu = {:.6}, r = {:.6} (alpha {:.3e}): fit {:.6}, \
+             reference {:.6}; mean {:.2e}, RMS {:.2e}\n",
+            q.quantity.symbol(),
+            q.max_error,
+            w.mu,
+            w.r,
+            w.alpha,
+            w.fit,
+            w.reference,
+            q.mean_error,
+            q.rms_error
+        );
+    }
+    out
+}
