@@ -12,7 +12,7 @@ use crate::integrate::{Estimate, QmcSettings};
 use crate::model::dielectric::TransmissionConvention;
 use crate::model::{Masking, Model, Ndf, RoughnessConvention};
 use crate::table::axis::{Axis, Grid, IorBound, IorMapping, MuMapping};
-use crate::table::{Method, Quantity, Table, TableSpec};
+use crate::table::{Method, Quantity, Table, TableSpec, Texels};
 use crate::verify::{MAX_AVERAGE_ENTRIES_CHECKED, spread_indices};
 use rayon::prelude::*;
 
@@ -63,6 +63,10 @@ pub struct BakeOptions {
     /// `method`, `samples`, `average_samples` and `check_against_reference`, then confirms the
     /// result against the reference on a sample of texels. `None` bakes with `method` as given.
     pub max_error: Option<f64>,
+    /// Point samples (the default) or texels fitted for the bilinear lookup
+    /// ([`crate::table::lookup_fit`]), for the tables over roughness and `mu` (not over IOR).
+    #[serde(default)]
+    pub texels: Texels,
 }
 
 impl Default for BakeOptions {
@@ -87,6 +91,7 @@ impl Default for BakeOptions {
             check_against_reference: true,
             method: Method::Qmc,
             max_error: Some(Self::DEFAULT_MAX_ERROR),
+            texels: Texels::Nodes,
         }
     }
 }
@@ -130,6 +135,16 @@ impl BakeOptions {
                 "ior-max must be above 1 and at most 100 (got {}): the IOR axis runs over \
                  [1, ior-max], and inside tables use 1 / eta",
                 crate::error::shown(self.ior_max)
+            )));
+        }
+        if self.texels == Texels::LookupFit
+            && let Some(q) = self.quantities().into_iter().find(|q| q.has_ior())
+        {
+            return Err(Error::InvalidInput(format!(
+                "--texels lookup-fit fits the tables over roughness and mu; {} is over the \
+                 IOR too, which it does not fit yet: bake it in a separate command without \
+                 --texels",
+                q.symbol()
             )));
         }
         if !self.transmission.is_default()
@@ -421,6 +436,11 @@ impl BakeOptions {
                         let spec = |quantity: Quantity| TableSpec {
                             reference_digits,
                             lookup_of: None,
+                            texels: if quantity.has_ior() {
+                                Texels::Nodes
+                            } else {
+                                self.texels
+                            },
                             transmission: if quantity.has_ior() && quantity != Quantity::FAvg {
                                 self.transmission
                             } else {
@@ -491,6 +511,14 @@ impl BakeOptions {
     /// every setting spelled out.
     #[must_use]
     pub fn command_for(&self, model: Model) -> String {
+        let command = self.command_without_texels(model);
+        match self.texels {
+            Texels::Nodes => command,
+            texels => format!("{command} --texels {}", texels.name()),
+        }
+    }
+
+    fn command_without_texels(&self, model: Model) -> String {
         if let Some(max_error) = self.max_error {
             return format!(
                 "kiln bake --max-error {max_error:e}{} --ndf {} --masking {} --size {} --seed {} \
@@ -677,6 +705,9 @@ impl BakeOptions {
                 table.spec.method.describe()
             )));
         }
+        if table.spec.texels == Texels::LookupFit {
+            fit_texels(&mut table);
+        }
         Ok(table)
     }
 
@@ -749,6 +780,31 @@ pub fn confirmation_settings(max_error: f64, spec: &TableSpec) -> ReferenceSetti
     }
 }
 
+/// Fits a confirmed table's texels for its lookup ([`crate::table::lookup_fit`]), over its
+/// own points and `kiln verify`'s audit points, and records what the fit measured. The node errors then bound the stored texels' distance from the
+/// truth: the point samples' measured error plus the largest correction (and the RMS is the
+/// corrections').
+pub fn fit_texels(table: &mut Table) {
+    let cells = table.spec.shape().into_iter().max().unwrap_or(1);
+    let settings = crate::table::lookup_fit::LookupFitSettings::for_cells(cells);
+    let before = table.value.clone();
+    // `kiln verify`'s own audit points are among the fit's: what it states, verify finds.
+    let audit =
+        crate::verify::lookup_coordinates(&table.spec, &crate::verify::AuditSettings::default());
+    let report = crate::table::lookup_fit::fit_for_lookup(table, &settings, &audit, &|| {});
+    let corrections = table
+        .value
+        .iter()
+        .zip(&before)
+        .map(|(a, b)| (a - b).powi(2));
+    let rms = (corrections.sum::<f64>() / before.len().max(1) as f64).sqrt();
+    if let Some(errors) = &mut table.node_errors {
+        errors.max += report.max_correction;
+        errors.rms = errors.rms.hypot(rms);
+    }
+    table.lookup_fit = Some(report);
+}
+
 /// Bakes one table, texels in parallel (deterministic for any thread count).
 #[must_use]
 pub fn bake_table(spec: TableSpec, command: String, progress: &(dyn Fn(u64) + Sync)) -> Table {
@@ -768,6 +824,7 @@ pub fn bake_table(spec: TableSpec, command: String, progress: &(dyn Fn(u64) + Sy
         command,
         node_errors: None,
         requested_max_error: None,
+        lookup_fit: None,
     }
 }
 

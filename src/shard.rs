@@ -615,6 +615,7 @@ pub fn merge(shards: &[(PathBuf, ShardFile)]) -> Result<(ShardedBake, Vec<Table>
             command,
             node_errors: None,
             requested_max_error: None,
+            lookup_fit: None,
         };
         // The check's texels are in ascending order and the shards' ranges too: the
         // concatenation is the unsharded bake's sequence of terms, summed in the same order.

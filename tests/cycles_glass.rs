@@ -62,6 +62,7 @@ fn numbered(spec: TableSpec) -> Table {
         command: "test".into(),
         node_errors: None,
         requested_max_error: None,
+        lookup_fit: None,
     }
 }
 

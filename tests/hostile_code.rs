@@ -152,6 +152,7 @@ fn table(spec: TableSpec, command: &str) -> Table {
         command: command.into(),
         node_errors: None,
         requested_max_error: None,
+        lookup_fit: None,
     }
 }
 

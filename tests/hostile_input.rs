@@ -277,6 +277,7 @@ fn engine_file(preset: Preset) -> Vec<u8> {
                 command: "hostile_input".into(),
                 node_errors: None,
                 requested_max_error: None,
+                lookup_fit: None,
             }
         })
         .collect();

@@ -88,6 +88,15 @@ pub struct Metadata {
     pub node_max_error: Option<f64>,
     pub node_rms_error: Option<f64>,
     pub node_error_texels: Option<usize>,
+    /// What the texels are ([`crate::table::Texels::describe`]): absent for point samples.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub texels: Option<String>,
+    /// For texels fitted for the lookup: the lookup's error over the fit's points (largest and
+    /// RMS, against the reference), the point samples' lookup error at the same points, and the
+    /// largest correction of a texel from its point sample. The node errors above then bound
+    /// the fitted texels' distance from the truth at their nodes.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lookup_fit: Option<crate::table::lookup_fit::LookupFitReport>,
     /// The `--max-error` the table was baked to meet, and the quadrature tolerance kiln chose for
     /// it (with the reference method); the measured error is `node_max_error`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -188,6 +197,9 @@ impl Metadata {
             node_max_error: table.node_errors.map(|e| e.max),
             node_rms_error: table.node_errors.map(|e| e.rms),
             node_error_texels: table.node_errors.map(|e| e.texels),
+            texels: (spec.texels != crate::table::Texels::Nodes)
+                .then(|| spec.texels.describe().to_string()),
+            lookup_fit: table.lookup_fit,
             requested_max_error: table.requested_max_error,
             reference_tolerance: spec
                 .reference_digits

@@ -588,6 +588,7 @@ impl Preset {
                 command: format!("{origin}, read in the {} layout", self.name()),
                 node_errors: None,
                 requested_max_error: None,
+                lookup_fit: None,
             })
             .collect();
         for table in &tables {

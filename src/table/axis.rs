@@ -391,6 +391,17 @@ impl Axis {
     }
 }
 
+/// The `mu` of the grazing probes `verify` adds on every roughness of its ladder, whatever the
+/// table's axis (and a lookup fit compares at, [`super::lookup_fit`]): exactly 0, 1e-12, and
+/// 1e-6 to 1 in 24 log steps (the boundary layer `mu ~ alpha` that a coarse texture-space ladder
+/// can step over).
+#[must_use]
+pub fn grazing_probes() -> Vec<f64> {
+    let mut probes = vec![0.0, 1e-12];
+    probes.extend((0..=24).map(|k| 10f64.powf(-6.0 + f64::from(k) / 4.0)));
+    probes
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

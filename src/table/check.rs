@@ -362,6 +362,7 @@ mod tests {
             command: String::new(),
             node_errors: None,
             requested_max_error: None,
+            lookup_fit: None,
         }
     }
 

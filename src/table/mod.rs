@@ -2,6 +2,7 @@
 
 pub mod axis;
 pub mod check;
+pub mod lookup_fit;
 pub mod normalisation;
 
 use crate::integrate::QmcSettings;
@@ -59,6 +60,51 @@ impl Method {
     }
 }
 
+/// What a table's texels are: point samples of the quantity at the nodes, or values fitted so
+/// that the lookup is closest to the quantity everywhere ([`lookup_fit`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+pub enum Texels {
+    /// Each texel is the quantity at its node (exact to the bake's max error): right for a
+    /// renderer that reads nodes (point sampling, or its own interpolation).
+    #[default]
+    Nodes,
+    /// Texels fitted for the bilinear lookup in the maximum norm: the lookup's largest error
+    /// over the whole domain is minimised, at the cost of nodes off the truth by about as much.
+    LookupFit,
+}
+
+impl Texels {
+    /// The name on the command line and in files.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Texels::Nodes => "nodes",
+            Texels::LookupFit => "lookup-fit",
+        }
+    }
+
+    /// A sentence for metadata.
+    #[must_use]
+    pub fn describe(self) -> &'static str {
+        match self {
+            Texels::Nodes => "point samples: each texel is the quantity at its node",
+            Texels::LookupFit => {
+                "fitted for the lookup: texels chosen so that the bilinear lookup (with this \
+                 file's coordinate mapping) is closest to the quantity over the whole domain in \
+                 the maximum norm (Lawson's algorithm); node_max_error bounds the texels' distance \
+                 from the truth at their nodes (the point samples' measured error plus \
+                 lookup_fit.max_correction)"
+            }
+        }
+    }
+
+    fn is_nodes(&self) -> bool {
+        *self == Texels::Nodes
+    }
+}
+
 /// Everything that determines a table's values.
 #[derive(Clone, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub struct TableSpec {
@@ -92,6 +138,9 @@ pub struct TableSpec {
     /// from every other quantity's spec.
     #[serde(default, skip_serializing_if = "TransmissionConvention::is_default")]
     pub transmission: TransmissionConvention,
+    /// Point samples (the default, absent from files) or texels fitted for the lookup.
+    #[serde(default, skip_serializing_if = "Texels::is_nodes")]
+    pub texels: Texels,
 }
 
 impl TableSpec {
@@ -230,6 +279,9 @@ impl TableSpec {
         if self.axes().iter().any(|axis| axis.grid() == Grid::Centers) {
             tags.push("centers");
         }
+        if self.texels == Texels::LookupFit {
+            tags.push("lookup-fit");
+        }
         match self.ior {
             Some(Axis::Ior {
                 mapping: IorMapping::Linear,
@@ -338,6 +390,9 @@ pub struct Table {
     pub node_errors: Option<NodeErrors>,
     /// The `--max-error` the table was baked to meet, if any.
     pub requested_max_error: Option<f64>,
+    /// For texels fitted for the lookup: what the fit measured ([`lookup_fit`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lookup_fit: Option<lookup_fit::LookupFitReport>,
 }
 
 impl Table {
@@ -409,16 +464,7 @@ impl Table {
         eta: f64,
     ) -> impl Fn(f64) -> f64 + 'a {
         let alpha = self.spec.roughness_convention().to_alpha(roughness);
-        let corner = move |axis: Axis, x: f64, stride: usize| {
-            let p = axis.position(x, alpha);
-            let i = (p.floor() as usize).min(axis.size().saturating_sub(2));
-            Corner {
-                low: i,
-                high: (i + 1).min(axis.size() - 1),
-                weight: p - i as f64,
-                stride,
-            }
-        };
+        let corner = move |axis: Axis, x: f64, stride: usize| Corner::new(axis, x, alpha, stride);
         // Per axis, slowest first: the two samples to blend, the second's weight, the stride
         // (the product of the faster axes' sizes). In place: a lookup allocates nothing (the
         // audits and `f_ms_norm` make millions).
@@ -447,6 +493,36 @@ impl Table {
         }
     }
 
+    /// The texels and weights of [`Table::lookup_channel_eta`] at `(mu, roughness, eta)`:
+    /// the same corners, so `weights.apply(channel)` is the lookup up to rounding.
+    #[must_use]
+    pub fn lookup_weights(&self, mu: f64, roughness: f64, eta: f64) -> LookupWeights {
+        let alpha = self.spec.roughness_convention().to_alpha(roughness);
+        let size = |axis: Option<Axis>| axis.map_or(1, |axis| axis.size());
+        let roughness_stride = size(self.spec.mu);
+        let ior_stride = roughness_stride * size(self.spec.roughness);
+        let mut out = LookupWeights {
+            terms: [(0, 1.0); 8],
+            count: 1,
+        };
+        for (axis, x, stride) in [
+            (self.spec.ior, eta, ior_stride),
+            (self.spec.roughness, roughness, roughness_stride),
+            (self.spec.mu, mu, 1),
+        ] {
+            let Some(axis) = axis else { continue };
+            let c = Corner::new(axis, x, alpha, stride);
+            let n = out.count;
+            for k in 0..n {
+                let (index, weight) = out.terms[k];
+                out.terms[k] = (index + c.low * stride, weight * (1.0 - c.weight));
+                out.terms[n + k] = (index + c.high * stride, weight * c.weight);
+            }
+            out.count = 2 * n;
+        }
+        out
+    }
+
     /// As [`Table::lookup`] with the IOR coordinate of a dielectric table.
     #[must_use]
     pub fn lookup_eta(&self, mu: f64, roughness: f64, eta: f64) -> f64 {
@@ -461,6 +537,44 @@ struct Corner {
     high: usize,
     weight: f64,
     stride: usize,
+}
+
+impl Corner {
+    /// Where a lookup of `axis` at the physical coordinate `x` (on the row of roughness
+    /// `alpha`) falls, for an axis of index stride `stride`.
+    fn new(axis: Axis, x: f64, alpha: f64, stride: usize) -> Self {
+        let p = axis.position(x, alpha);
+        let i = (p.floor() as usize).min(axis.size().saturating_sub(2));
+        Corner {
+            low: i,
+            high: (i + 1).min(axis.size() - 1),
+            weight: p - i as f64,
+            stride,
+        }
+    }
+}
+
+/// The texels a lookup blends and their weights: the lookup is `sum weight * texel` (up to
+/// eight terms, trilinear; a weight may be 0). What a fit of the texels for the lookup solves
+/// for ([`lookup_fit`]).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct LookupWeights {
+    pub terms: [(usize, f64); 8],
+    pub count: usize,
+}
+
+impl LookupWeights {
+    /// The terms.
+    #[must_use]
+    pub fn terms(&self) -> &[(usize, f64)] {
+        &self.terms[..self.count]
+    }
+
+    /// The lookup of `channel` these weights give.
+    #[must_use]
+    pub fn apply(&self, channel: &[f64]) -> f64 {
+        self.terms().iter().map(|&(k, w)| w * channel[k]).sum()
+    }
 }
 
 /// Blends the fastest axis first, then each slower one, as a GPU's filter does (for a 2-D table:
@@ -522,6 +636,7 @@ pub(crate) fn test_e_spec(
         qmc: QmcSettings::default(),
         reference_digits: None,
         lookup_of: None,
+        texels: Texels::Nodes,
         transmission: TransmissionConvention::SingleScattering,
     }
 }
@@ -543,6 +658,42 @@ mod tests {
             command: String::new(),
             node_errors: None,
             requested_max_error: None,
+            lookup_fit: None,
+        }
+    }
+
+    /// The weights a lookup fit solves with give the lookup itself, on 2-D tables of every
+    /// grid and mapping (an adaptive axis moves `mu` with the row) and a 3-D one.
+    #[test]
+    fn lookup_weights_give_the_lookup() {
+        let mut tables: Vec<Table> = [Grid::Nodes, Grid::Centers]
+            .into_iter()
+            .flat_map(|g| {
+                [MuMapping::Linear, MuMapping::Sqrt, MuMapping::Adaptive].map(|m| synthetic(g, m))
+            })
+            .collect();
+        let mut glass = synthetic(Grid::Nodes, MuMapping::Linear);
+        glass.spec.ior = Some(Axis::Ior {
+            size: 3,
+            mapping: IorMapping::Cycles,
+            max: axis::IorBound(3.0),
+            grid: Grid::Nodes,
+        });
+        glass.value = (0..60).map(|k| (k * k % 17) as f64).collect();
+        tables.push(glass);
+        for table in &tables {
+            for k in 0..200 {
+                let x = |m: usize| ((k * m) % 101) as f64 / 100.0;
+                let (mu, r, eta) = (x(37), x(53), 1.0 + 2.0 * x(71));
+                let w = table.lookup_weights(mu, r, eta);
+                let want = table.lookup_eta(mu, r, eta);
+                assert!(
+                    (w.apply(&table.value) - want).abs() < 1e-12,
+                    "{mu} {r} {eta}"
+                );
+                let total: f64 = w.terms().iter().map(|t| t.1).sum();
+                assert!((total - 1.0).abs() < 1e-12);
+            }
         }
     }
 

@@ -113,6 +113,8 @@ pub fn spec_for(e: &TableSpec) -> TableSpec {
             grid: Grid::Nodes,
         }),
         lookup_of: Some(Box::new(e.clone())),
+        // Derived exactly from the lookup (of fitted texels or not), not fitted itself.
+        texels: crate::table::Texels::Nodes,
         ..e.clone()
     }
 }
@@ -152,6 +154,7 @@ pub fn derive(e: &Table, command: String) -> Table {
         command,
         node_errors: None,
         requested_max_error: None,
+        lookup_fit: None,
     }
 }
 
@@ -189,6 +192,7 @@ mod tests {
             command: String::new(),
             node_errors: None,
             requested_max_error: None,
+            lookup_fit: None,
         }
     }
 

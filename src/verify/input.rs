@@ -77,6 +77,7 @@ pub(super) fn table_from_channel(spec: TableSpec, values: Vec<f64>, command: Str
         command,
         node_errors: None,
         requested_max_error: None,
+        lookup_fit: None,
     }
 }
 
@@ -522,6 +523,7 @@ fn spec_and_values(
     let spec = |roughness, mu| TableSpec {
         reference_digits: None,
         lookup_of: None,
+        texels: crate::table::Texels::Nodes,
         transmission: crate::model::dielectric::TransmissionConvention::SingleScattering,
         model: layout.model,
         quantity: layout.quantity,

@@ -479,14 +479,8 @@ fn storage_cost(
     }
 }
 
-/// The `mu` of the grazing probes [`audit`] adds on every roughness of its ladder, whatever the
-/// table's axis: exactly 0, 1e-12, and 1e-6 to 1 in 24 log steps (the boundary layer `mu ~ alpha`
-/// that a coarse texture-space ladder can step over).
-pub(crate) fn grazing_probes() -> Vec<f64> {
-    let mut probes = vec![0.0, 1e-12];
-    probes.extend((0..=24).map(|k| 10f64.powf(-6.0 + f64::from(k) / 4.0)));
-    probes
-}
+/// The grazing probes [`audit`] adds on every roughness of its ladder.
+pub(crate) use crate::table::axis::grazing_probes;
 
 /// The points at which [`audit`] compares lookups: a ladder over each axis' texture coordinate
 /// `t` in [0, 1], in steps of `1 / (density N)` (texel centres or nodes, the points halfway

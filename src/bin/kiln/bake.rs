@@ -98,6 +98,14 @@ pub struct BakeArgs {
     /// QMC: base seed of the scrambles [default: 0].
     #[arg(long)]
     seed: Option<u64>,
+    /// What the texels are: nodes (each the quantity at its node, exact to --max-error; for a
+    /// renderer that reads nodes) or lookup-fit (chosen so that the bilinear lookup, the way a
+    /// GPU samples the file, is closest to the quantity everywhere: about half the lookup
+    /// error, nodes off by as much; the metadata's lookup_fit says what the fit measured). For
+    /// the tables over roughness and mu; their names get -lookup-fit. See docs/accuracy.md
+    /// [default: nodes].
+    #[arg(long, value_enum, default_value = "nodes", hide_default_value = true)]
+    texels: kiln::table::Texels,
     /// Output directory, created if missing.
     /// [default: tables, or the scene's output.dir]
     #[arg(long)]
@@ -109,7 +117,7 @@ pub struct BakeArgs {
         conflicts_with_all = ["ndf", "masking", "quantity", "size", "samples", "avg_samples",
             "scrambles", "seed", "format", "precision", "roughness_axis", "mu_axis", "grid",
             "ior_size", "ior_axis", "ior_max", "transmission", "fresnel", "f0", "f90", "ior", "eta", "k",
-            "method", "no_reference_check", "max_error"]
+            "method", "no_reference_check", "max_error", "texels"]
     )]
     scene: Option<PathBuf>,
     /// Bake an engine's table in that engine's own layout, to drop in for its file: cycles
@@ -129,7 +137,7 @@ pub struct BakeArgs {
         conflicts_with_all = ["scene", "ndf", "masking", "quantity", "size", "samples",
             "avg_samples", "scrambles", "seed", "format", "precision", "roughness_axis", "mu_axis",
             "grid", "method", "no_reference_check", "ior_size", "ior_axis", "ior_max", "transmission", "fresnel",
-            "f0", "f90", "ior", "eta", "k"]
+            "f0", "f90", "ior", "eta", "k", "texels"]
     )]
     preset: Option<kiln::preset::Preset>,
     /// With --preset cycles: copy the arrays kiln does not compute (table_sheen_ltc, an LTC
@@ -268,6 +276,7 @@ pub fn run(args: BakeArgs) -> kiln::Result<()> {
         check_against_reference: !args.no_reference_check,
         method: args.method.unwrap_or(Method::Qmc),
         max_error,
+        texels: args.texels,
     };
     options.validate()?;
     let mut formats = args.format;
@@ -303,12 +312,17 @@ pub fn run(args: BakeArgs) -> kiln::Result<()> {
     if !args.quiet {
         for table in &tables {
             let shape: Vec<String> = table.spec.shape().iter().map(|n| n.to_string()).collect();
-            let measured = match table.node_errors {
-                Some(e) => format!(
+            let measured = match (table.lookup_fit, table.node_errors) {
+                (Some(fit), _) => format!(
+                    ", fitted: lookup max error {:.1e} (point samples' {:.1e}) at {} points, \
+                     texels moved up to {:.1e}",
+                    fit.lookup_max_error, fit.node_lookup_max_error, fit.points, fit.max_correction
+                ),
+                (None, Some(e)) => format!(
                     ", max error vs reference {:.1e} ({} texels)",
                     e.max, e.texels
                 ),
-                None => String::new(),
+                (None, None) => String::new(),
             };
             println!(
                 "{:<44} {:>9} max std error {:.1e}{measured}",
