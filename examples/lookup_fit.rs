@@ -16,6 +16,9 @@ fn main() {
     let before = audit(&table, &against, &settings, &|_| {});
     let cells = table.spec.shape().into_iter().max().unwrap();
     let mut fit_settings = LookupFitSettings::for_cells(cells);
+    if let Some(c) = std::env::args().nth(3) {
+        fit_settings.weight_cap = c.parse().unwrap();
+    }
     if let Some(n) = std::env::args().nth(2) {
         fit_settings.iterations = n.parse().unwrap();
     }

@@ -40,7 +40,7 @@ fn lookup_max_error(table: &Table) -> f64 {
 }
 
 /// At every size the fitted lookup beats the point samples' by at least 1.5x (measured
-/// 2026-12-04: 1.6x at 8, 1.9x at 16, 2.0x at 32, 1.8x at 64 and 128), for `E` and `E_avg`.
+/// 2026-12-04: 1.6x at 8, 1.9x at 16, 2.0x at 32, 1.9x at 64 and 128), for `E` and `E_avg`.
 #[test]
 fn a_fitted_table_beats_the_node_table_at_every_size() {
     for size in [8, 16, 64] {
@@ -51,12 +51,16 @@ fn a_fitted_table_beats_the_node_table_at_every_size() {
             fitted * 1.5 < nodes,
             "E {size}: fitted {fitted:.3e}, nodes {nodes:.3e}"
         );
-        // The fit states its own lookup error at its own points: the audit's, at others, is
-        // within 10% of it (both are samples of the same maximum).
+        // The fit's points include the audit's, so what it states is never below what the
+        // audit finds (up to the audit's reference tolerance, at most 1e-6), and not loose.
         let stated = fitted_table.lookup_fit.unwrap().lookup_max_error;
         assert!(
-            (fitted - stated).abs() < 0.1 * stated,
-            "{fitted:.3e} vs {stated:.3e}"
+            fitted <= stated + 2e-6,
+            "audit {fitted:.3e} above stated {stated:.3e}"
+        );
+        assert!(
+            stated < 1.25 * fitted,
+            "audit {fitted:.3e}, stated {stated:.3e}"
         );
     }
     let nodes = lookup_max_error(&bake(32, Quantity::EAvg, Texels::Nodes));
@@ -70,7 +74,8 @@ fn a_fitted_table_beats_the_node_table_at_every_size() {
 /// The committed fitted 32 x 32 table (`kiln bake --quantity e --texels lookup-fit --format
 /// rs,json --out tests/data/lookup-fit`) is what the code bakes now, its generated Rust lookup
 /// executed is within 3.4e-4 of the truth at the audit's 5980 points where the point samples'
-/// is 6.5e-4 off, and Turquin's furnace closes to 1e-3 with it (1.25e-3 with the point samples).
+/// is 6.5e-4 off, and Turquin's furnace closes to 1e-3 with it (6.5e-4; 1.25e-3 with the point
+/// samples).
 #[test]
 fn the_generated_lookup_of_a_fitted_table_halves_the_error() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -3,8 +3,10 @@
 //! and the perceptual roughness `r` (`alpha = r^2`) for some of `E`, `E_scale`, `E_bias`.
 //! `kiln verify --fit` audits them ([`crate::verify::fit`]).
 
+pub mod emit;
 pub mod engine;
 pub mod formula;
+pub mod polynomial;
 
 use crate::error::{Error, Result};
 use crate::integrate::quantity::Quantity;

@@ -15,6 +15,16 @@
 //! lookup blends neighbouring texels only (bandwidth one row plus one), by banded Cholesky.
 //! The best iterate (smallest maximum over the fit's points) is kept.
 //!
+//! No point's weight may exceed [`LookupFitSettings::weight_cap`] (30) times the mean, so the
+//! fit minimises, in effect, the mean of the worst few percent of errors rather than the single
+//! worst. Where the layout resolves the function that is the maximum within about 1% (the
+//! 32 x 32 `E`: 3.28e-4 against 3.24e-4 uncapped) with a third less RMS (8.2e-5 against
+//! 1.17e-4). Where a layer is narrower than a texel (the split-sum `E_bias`'s near-mirror
+//! grazing layer on a `sqrt` mu axis), an uncapped fit lowers the maximum only by moving error
+//! into the bulk (p99 6.8e-3 to 1.7e-2), while the capped fit improves all three against the
+//! point samples (max 9.6e-2 to 8.3e-2, RMS 2.3e-3 to 2.0e-3, p99 6.8e-3 to 5.1e-3; `kiln
+//! verify --density 4`, 2026-12-04).
+//!
 //! The fitted values stay within `[0, 1]` (clamped after the fit; the error stated is measured
 //! after clamping), and `one_minus_value` moves by the same correction, so that it keeps its
 //! relative precision near 1.
@@ -35,6 +45,9 @@ pub struct LookupFitSettings {
     pub iterations: usize,
     /// The reference's tolerance at the fit's points.
     pub tolerance: f64,
+    /// The largest weight a point may take, as a multiple of the mean weight (see the module
+    /// docs; infinite for the pure minimax).
+    pub weight_cap: f64,
 }
 
 impl LookupFitSettings {
@@ -47,6 +60,7 @@ impl LookupFitSettings {
             per_cell: (192 / cells.max(1)).clamp(3, 6),
             iterations: 60,
             tolerance: 1e-8,
+            weight_cap: 30.0,
         }
     }
 }
@@ -175,7 +189,13 @@ pub fn fit_for_lookup(
         .map(|(w, f)| f - w.apply(&table.value))
         .collect();
     let node_lookup_max_error = residual.iter().fold(0.0_f64, |m, r| m.max(r.abs()));
-    let correction = lawson(&weights, &residual, table.value.len(), settings.iterations);
+    let correction = lawson(
+        &weights,
+        &residual,
+        table.value.len(),
+        settings.iterations,
+        settings.weight_cap,
+    );
     let mut max_correction: f64 = 0.0;
     for (k, d) in correction.iter().enumerate() {
         let value = (table.value[k] + d).clamp(0.0, 1.0);
@@ -205,6 +225,7 @@ fn lawson(
     b: &[f64],
     unknowns: usize,
     iterations: usize,
+    weight_cap: f64,
 ) -> Vec<f64> {
     let bandwidth = rows
         .iter()
@@ -250,8 +271,9 @@ fn lawson(
         if total <= 0.0 {
             break;
         }
+        let cap = weight_cap / rows.len() as f64;
         for (w, e) in weight.iter_mut().zip(&errors) {
-            *w *= e / total;
+            *w = (*w * e / total).min(cap);
         }
     }
     best.1
@@ -362,7 +384,7 @@ mod tests {
             terms: [(0, 1.0); 8],
             count: 1,
         };
-        let x = lawson(&[one, one, one], &[0.0, 1.0, 3.0], 1, 200);
+        let x = lawson(&[one, one, one], &[0.0, 1.0, 3.0], 1, 200, f64::INFINITY);
         assert!((x[0] - 1.5).abs() < 1e-3, "{}", x[0]);
     }
 }

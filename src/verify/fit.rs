@@ -325,3 +325,20 @@ fn error_map(quantity: Quantity, found: &[FitPoint], worst: FitPoint) -> ErrorMa
         y_axis: "roughness r (alpha = r^2)".to_string(),
     }
 }
+
+/// Audits a polynomial fit kiln made ([`crate::fit::polynomial`]) as what it writes: the
+/// formula file's text ([`crate::fit::emit`]) parsed back and audited by [`audit_fit`], so that
+/// the maximum stated is that of the formula a user pastes.
+///
+/// # Panics
+/// If kiln's own formula file does not parse (a bug).
+#[must_use]
+pub fn audit_polynomial(
+    fit: &crate::fit::polynomial::PolynomialFit,
+    settings: &FitAuditSettings,
+    progress: &(dyn Fn() + Sync),
+) -> FitReport {
+    let text = crate::fit::emit::emit(fit, crate::fit::emit::FitFormat::Toml, "");
+    let formula = crate::fit::FormulaFit::parse(&text).expect("kiln's formula files parse");
+    audit_fit(&Fit::Formula(formula), settings, progress)
+}

@@ -3,6 +3,7 @@
 mod args;
 mod bake;
 mod eval;
+mod fit;
 mod fresnel_args;
 mod merge;
 mod plan;
@@ -40,6 +41,7 @@ enum Command {
     Verify(verify::VerifyArgs),
     Study(study::StudyArgs),
     Merge(merge::MergeArgs),
+    Fit(fit::FitArgs),
 }
 
 /// A progress bar on stderr, drawn only when stderr is a terminal; hidden with `quiet`.
@@ -182,6 +184,7 @@ fn main() -> ExitCode {
         Command::Verify(args) => verify::run(args),
         Command::Study(args) => study::run(args).map(|()| true),
         Command::Merge(args) => merge::run(args).map(|()| true),
+        Command::Fit(args) => fit::run(args).map(|()| true),
     };
     match result {
         Ok(true) => ExitCode::SUCCESS,
