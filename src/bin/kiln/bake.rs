@@ -102,8 +102,9 @@ pub struct BakeArgs {
     /// renderer that reads nodes) or lookup-fit (chosen so that the bilinear lookup, the way a
     /// GPU samples the file, is closest to the quantity everywhere: about half the lookup
     /// error, nodes off by as much; the metadata's lookup_fit says what the fit measured). For
-    /// the tables over roughness and mu; their names get -lookup-fit. See docs/accuracy.md
-    /// [default: nodes].
+    /// the tables over roughness and mu; their names get -lookup-fit. With --preset, the
+    /// engine's tables in its layout (the glass tables stay point samples). See
+    /// docs/accuracy.md [default: nodes].
     #[arg(long, value_enum, default_value = "nodes", hide_default_value = true)]
     texels: kiln::table::Texels,
     /// Output directory, created if missing.
@@ -137,7 +138,7 @@ pub struct BakeArgs {
         conflicts_with_all = ["scene", "ndf", "masking", "quantity", "size", "samples",
             "avg_samples", "scrambles", "seed", "format", "precision", "roughness_axis", "mu_axis",
             "grid", "method", "no_reference_check", "ior_size", "ior_axis", "ior_max", "transmission", "fresnel",
-            "f0", "f90", "ior", "eta", "k", "texels"]
+            "f0", "f90", "ior", "eta", "k"]
     )]
     preset: Option<kiln::preset::Preset>,
     /// With --preset cycles: copy the arrays kiln does not compute (table_sheen_ltc, an LTC
@@ -464,7 +465,17 @@ fn bake_preset(preset: kiln::preset::Preset, args: &BakeArgs) -> kiln::Result<()
     let out = args.out.clone().unwrap_or_else(|| PathBuf::from("tables"));
     // The engine's tables, and its glass tables to their own default max error unless one is
     // named.
-    let bakes = preset.bakes(args.max_error);
+    let mut bakes = preset.bakes(args.max_error);
+    // The engine's own tables (the first bake) get the texels asked for; glass tables, over
+    // the IOR, stay point samples.
+    bakes[0].texels = args.texels;
+    if args.texels != kiln::table::Texels::Nodes && bakes.len() > 1 && !args.quiet {
+        eprintln!(
+            "kiln: --texels {}: the {} glass tables (over the IOR) stay point samples",
+            args.texels.name(),
+            preset.name()
+        );
+    }
     for options in &bakes {
         options.validate()?;
     }
@@ -503,7 +514,16 @@ fn bake_preset(preset: kiln::preset::Preset, args: &BakeArgs) -> kiln::Result<()
     let written = format::write_files(&out, &files)?;
     if !args.quiet {
         for table in &tables {
-            if let Some(e) = table.node_errors {
+            if let Some(fit) = table.lookup_fit {
+                println!(
+                    "{:<32} fitted: lookup max error {:.1e} (point samples' {:.1e}), texels \
+                     moved up to {:.1e}",
+                    table.spec.id(),
+                    fit.lookup_max_error,
+                    fit.node_lookup_max_error,
+                    fit.max_correction
+                );
+            } else if let Some(e) = table.node_errors {
                 println!(
                     "{:<32} max error vs reference {:.1e} ({} texels)",
                     table.spec.id(),
