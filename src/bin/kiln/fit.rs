@@ -23,6 +23,10 @@ pub struct FitArgs {
     /// writing one.
     #[arg(long, conflicts_with_all = ["degrees", "out", "format"])]
     sweep: bool,
+    /// With --sweep: draw the maximum error against the coefficient count into FILE.svg or
+    /// FILE.png.
+    #[arg(long, requires = "sweep", value_name = "FILE")]
+    plot: Option<PathBuf>,
     /// Microfacet distribution [default: ggx].
     #[arg(long, value_enum)]
     ndf: Option<Ndf>,
@@ -99,6 +103,7 @@ pub fn run(args: FitArgs) -> kiln::Result<()> {
         masking: args.masking.unwrap_or(Masking::HeightCorrelated),
     };
     model.validate().map_err(kiln::Error::InvalidInput)?;
+    let svg = crate::verify::plot_kind_of(args.plot.as_deref())?;
     let quiet = args.quiet || args.json;
     let bar = crate::progress_bar(quiet, 0, "reference");
     let truth = truth_points(model, Quantity::E, &|| bar.inc(1));
@@ -123,6 +128,22 @@ pub fn run(args: FitArgs) -> kiln::Result<()> {
                 "max_error": a.max_error,
                 "worst": {"mu": a.worst.0, "r": a.worst.1},
             }));
+        }
+        if let (Some(svg), Some(path)) = (svg, &args.plot) {
+            let points: Vec<(usize, f64)> = rows
+                .iter()
+                .map(|r| {
+                    (
+                        r["coefficients"].as_u64().unwrap_or(0) as usize,
+                        r["max_error"].as_f64().unwrap_or(f64::NAN),
+                    )
+                })
+                .collect();
+            crate::verify::write_plot(
+                path,
+                svg,
+                crate::plot::fit_sweep_plot(&model.to_string(), &points),
+            )?;
         }
         if args.json {
             println!(

@@ -222,6 +222,21 @@ pub fn scaling_plot(
     )
 }
 
+/// `kiln fit --sweep`: the audited maximum error of each fit against its coefficient count.
+pub fn fit_sweep_plot(model: &str, fits: &[(usize, f64)]) -> Result<(String, Vec<u8>), String> {
+    let series = [Series {
+        name: "kiln fit: polynomial in (t, r), audited max error".to_string(),
+        points: fits.iter().map(|&(k, e)| (k as f64, e)).collect(),
+    }];
+    render(
+        &format!("Texture-free fits of {model} E: size against accuracy"),
+        "coefficients",
+        "max error over mu, r in [0, 1] (kiln verify --fit)",
+        &series,
+        None,
+    )
+}
+
 /// Lookup error against table size, one line per mu mapping.
 pub fn lookup_plot(report: &StudyReport) -> Result<(String, Vec<u8>), String> {
     let mut mappings: Vec<&str> = Vec::new();

@@ -885,22 +885,26 @@ fn plot_for(path: &Path, table: &Table) -> PathBuf {
 
 /// Whether `--plot` asks for SVG (true) or PNG (false); `None` without it.
 fn plot_kind(args: &VerifyArgs) -> kiln::Result<Option<bool>> {
+    plot_kind_of(args.plot.as_deref())
+}
+
+/// Whether a `--plot` path asks for SVG (`Some(true)`) or PNG; an error for a folder that does
+/// not exist or another extension.
+pub(crate) fn plot_kind_of(plot: Option<&Path>) -> kiln::Result<Option<bool>> {
     // A picture goes into a folder that exists: a mistyped path is an error now, before the
     // audit, not a chain of new folders after it.
-    if let Some(dir) = args
-        .plot
-        .as_deref()
+    if let Some(dir) = plot
         .and_then(Path::parent)
         .filter(|d| !d.as_os_str().is_empty() && !d.is_dir())
     {
         return Err(kiln::Error::InvalidInput(format!(
             "--plot {}: the folder {} does not exist; create it, or give a path in a folder \
              that does",
-            args.plot.as_deref().unwrap_or(dir).display(),
+            plot.unwrap_or(dir).display(),
             dir.display()
         )));
     }
-    match &args.plot {
+    match plot {
         Some(path) => match path.extension().and_then(|e| e.to_str()) {
             Some("svg") => Ok(Some(true)),
             Some("png") => Ok(Some(false)),
@@ -926,7 +930,7 @@ fn write_error_maps(path: &Path, table: &Table, report: &kiln::verify::Report) -
 }
 
 /// Writes a plot drawn as `(SVG text, PNG bytes)` to `path`, the SVG if `svg`.
-fn write_plot(
+pub(crate) fn write_plot(
     path: &Path,
     svg: bool,
     drawn: Result<(String, Vec<u8>), String>,
