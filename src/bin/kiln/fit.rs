@@ -8,7 +8,9 @@ use kiln::verify::fit::{FitAuditSettings, audit_polynomial};
 use kiln::{Masking, Model, Ndf, Quantity};
 use std::path::PathBuf;
 
-/// Fit E(mu, r) without a texture: a polynomial in kiln's adaptive coordinates (t = (mu (1 + 4
+/// Fit E(mu, r) without a texture, with its audited maximum error, as shader code
+///
+/// A polynomial in kiln's adaptive coordinates (t = (mu (1 + 4
 /// alpha) / (mu + 4 alpha))^0.4 and r, alpha = r^2) chosen in the maximum norm against kiln's
 /// reference, written as a formula file and as WGSL, GLSL, HLSL, Rust and C functions. The
 /// maximum error printed and written beside each fit is the audit's (`kiln verify --fit` of the

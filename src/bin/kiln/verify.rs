@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 
 mod fit;
 
-/// Audit a table against the deterministic reference (or another table).
+/// Audit a table (or a texture-free fit, --fit) against the deterministic reference (or another table).
 #[derive(Args, Debug, Clone)]
 #[command(
     long_about = "Audit a table, kiln's or an engine's. Reports the error of the stored values at \
