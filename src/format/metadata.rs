@@ -88,7 +88,8 @@ pub struct Metadata {
     pub node_max_error: Option<f64>,
     pub node_rms_error: Option<f64>,
     pub node_error_texels: Option<usize>,
-    /// What the texels are ([`crate::table::Texels::describe`]): absent for point samples.
+    /// What the texels are ([`crate::table::Texels::describe`]): point samples, or fitted for
+    /// the lookup (absent from files kiln wrote before it said).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub texels: Option<String>,
     /// For texels fitted for the lookup: the lookup's error over the fit's points (largest and
@@ -197,8 +198,7 @@ impl Metadata {
             node_max_error: table.node_errors.map(|e| e.max),
             node_rms_error: table.node_errors.map(|e| e.rms),
             node_error_texels: table.node_errors.map(|e| e.texels),
-            texels: (spec.texels != crate::table::Texels::Nodes)
-                .then(|| spec.texels.describe().to_string()),
+            texels: Some(spec.texels.describe().to_string()),
             lookup_fit: table.lookup_fit,
             requested_max_error: table.requested_max_error,
             reference_tolerance: spec
