@@ -226,6 +226,62 @@ fn a_kiln_fit_states_a_maximum_no_random_point_beats() {
     }
 }
 
+/// The emitted C header compiles (as C++, twice included: `#pragma once`) and computes the
+/// Rust function's values, when the machine has a compiler.
+#[test]
+fn the_emitted_c_header_computes_the_fit() {
+    #[path = "common/cxx.rs"]
+    mod cxx;
+    let Some(compiler) = cxx::compiler() else {
+        eprintln!("no C++ compiler: the emitted C header is not compiled");
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let header = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/fits/ggx_height_correlated_e_fit_t3_r2.h");
+    let points: Vec<(f32, f32)> = (0..50)
+        .map(|k| ((k % 10) as f32 / 9.0, (k / 10) as f32 / 4.0))
+        .collect();
+    let calls: String = points
+        .iter()
+        .map(|(mu, r)| {
+            format!(
+                "    printf(\"%.9g\\n\", ggx_height_correlated_e_fit_t3_r2({mu:?}f, {r:?}f));\n"
+            )
+        })
+        .collect();
+    let source = format!(
+        "#include <cstdio>\n#include \"{0}\"\n#include \"{0}\"\nint main() {{\n{calls}    \
+         return 0;\n}}\n",
+        header.display()
+    );
+    let main = dir.path().join("main.cpp");
+    std::fs::write(&main, source).unwrap();
+    let exe = dir.path().join("fit");
+    let build = std::process::Command::new(compiler)
+        .arg(&main)
+        .arg("-o")
+        .arg(&exe)
+        .output()
+        .unwrap();
+    assert!(
+        build.status.success(),
+        "{}",
+        String::from_utf8_lossy(&build.stderr)
+    );
+    let run = std::process::Command::new(&exe).output().unwrap();
+    let printed = String::from_utf8(run.stdout).unwrap();
+    for ((mu, r), line) in points.iter().zip(printed.lines()) {
+        let c: f64 = line.parse().unwrap();
+        let rust = emitted::ggx_height_correlated_e_fit_t3_r2(*mu, *r);
+        assert!(
+            (c - f64::from(rust)).abs() < 1e-6,
+            "{mu} {r}: C {c}, Rust {rust}"
+        );
+    }
+    assert_eq!(printed.lines().count(), points.len());
+}
+
 /// The emitted WGSL and GLSL parse and validate (naga), called from a fragment shader.
 #[test]
 fn emitted_shader_fits_validate() {

@@ -225,7 +225,7 @@ pub fn emit(fit: &PolynomialFit, format: FitFormat, description: &str) -> String
             code(fit, &GLSL, "", description)
         }
         FitFormat::Rs => code(fit, &RUST, "#[allow(clippy::all)]\n", description),
-        FitFormat::H => code(fit, &C, "#include <math.h>\n", description),
+        FitFormat::H => code(fit, &C, "#pragma once\n#include <math.h>\n", description),
     }
 }
 
