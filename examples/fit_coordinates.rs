@@ -4,7 +4,7 @@
 use kiln::fit::polynomial::{Degrees, fit_to};
 use kiln::integrate::reference::ReferenceSettings;
 use kiln::integrate::value::{Integral, Point};
-use kiln::{Masking, Model, Ndf, Quantity};
+use kiln::{Masking, Model, Ndf};
 use rayon::prelude::*;
 
 fn main() {
@@ -72,7 +72,7 @@ fn main() {
             .collect();
         print!("c {c} p {p}:");
         for (dt, dr) in [(3, 2), (2, 3), (4, 3), (5, 4), (7, 3), (7, 4), (4, 7)] {
-            let f = fit_to(model, Quantity::E, Degrees { t: dt, r: dr }, &truth);
+            let f = fit_to(model, Degrees { t: dt, r: dr }, &truth);
             print!("  {}: {:.2e}", (dt + 1) * (dr + 1), f.fit_max_error);
         }
         println!();

@@ -781,9 +781,9 @@ pub fn confirmation_settings(max_error: f64, spec: &TableSpec) -> ReferenceSetti
 }
 
 /// Fits a confirmed table's texels for its lookup ([`crate::table::lookup_fit`]), over its
-/// own points and `kiln verify`'s audit points, and records what the fit measured. The node errors then bound the stored texels' distance from the
-/// truth: the point samples' measured error plus the largest correction (and the RMS is the
-/// corrections').
+/// own points and `kiln verify`'s audit points, and records what the fit measured. The node
+/// errors then bound the stored texels' distance from the truth: the point samples' measured
+/// error plus the largest correction (and the RMS is the corrections').
 pub fn fit_texels(table: &mut Table) {
     let cells = table.spec.shape().into_iter().max().unwrap_or(1);
     let settings = crate::table::lookup_fit::LookupFitSettings::for_cells(cells);

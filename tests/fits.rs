@@ -174,7 +174,7 @@ fn materialx_is_near_its_filed_error_away_from_the_mirror() {
 fn a_kiln_fit_states_a_maximum_no_random_point_beats() {
     use kiln::fit::polynomial::{Degrees, fit};
     let model = FitAuditSettings::default().model;
-    let poly = fit(model, Quantity::E, Degrees { t: 3, r: 2 }, &|| {});
+    let poly = fit(model, Degrees { t: 3, r: 2 }, &|| {});
     let report = kiln::verify::fit::audit_polynomial(&poly, &FitAuditSettings::default(), &|| {});
     let stated = report.quantities[0].max_error;
     assert!((0.02..0.035).contains(&stated), "{stated}");

@@ -3,7 +3,6 @@
 //! the same formula in f32.
 
 use super::polynomial::PolynomialFit;
-use crate::integrate::quantity::Quantity;
 
 /// The languages a fit is written in, with their file extensions.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
@@ -47,12 +46,8 @@ impl FitFormat {
 /// The file stem and function name: `ggx_height_correlated_e_fit_t5_r4`.
 #[must_use]
 pub fn function_name(fit: &PolynomialFit) -> String {
-    let quantity = match fit.quantity {
-        Quantity::EAvg => "e_avg",
-        _ => "e",
-    };
     format!(
-        "{}_{}_{quantity}_fit_t{}_r{}",
+        "{}_{}_e_fit_t{}_r{}",
         fit.model.ndf,
         fit.model.masking.name().replace('-', "_"),
         fit.degrees.t,
@@ -65,11 +60,10 @@ pub fn function_name(fit: &PolynomialFit) -> String {
 #[must_use]
 pub fn description(fit: &PolynomialFit, max_error: f64, command: &str) -> String {
     format!(
-        "{} of {} (F = 1) as a polynomial of degree {} in u = 2 t - 1 and {} in v = 2 r - 1 \
+        "E of {} (F = 1) as a polynomial of degree {} in u = 2 t - 1 and {} in v = 2 r - 1 \
          ({} coefficients), t = (mu (1 + 4 alpha) / (mu + 4 alpha))^0.4, alpha = r^2 (kiln's \
          adaptive axis); max error {max_error:.2e} over mu in [0, 1], r in [0, 1] against kiln's \
          reference (kiln verify --fit); made by `{command}`",
-        fit.quantity.symbol(),
         fit.model,
         fit.degrees.t,
         fit.degrees.r,
@@ -81,8 +75,7 @@ pub fn description(fit: &PolynomialFit, max_error: f64, command: &str) -> String
 struct Syntax {
     /// The signature with `{name}` and `{params}` to fill.
     signature: &'static str,
-    params_2d: &'static str,
-    params_1d: &'static str,
+    params: &'static str,
     /// `let` of an immutable f32, a mutable one.
     constant: &'static str,
     variable: &'static str,
@@ -109,8 +102,7 @@ fn rust_number(c: f64) -> String {
 
 const WGSL: Syntax = Syntax {
     signature: "fn {name}({params}) -> f32 {",
-    params_2d: "mu: f32, r: f32",
-    params_1d: "r: f32",
+    params: "mu: f32, r: f32",
     constant: "let",
     variable: "var",
     t: "pow(min(mu * (1.0 + k) / max(mu + k, 1e-30), 1.0), 0.4)",
@@ -121,8 +113,7 @@ const WGSL: Syntax = Syntax {
 
 const GLSL: Syntax = Syntax {
     signature: "float {name}({params}) {",
-    params_2d: "float mu, float r",
-    params_1d: "float r",
+    params: "float mu, float r",
     constant: "float",
     variable: "float",
     t: "pow(min(mu * (1.0 + k) / max(mu + k, 1e-30), 1.0), 0.4)",
@@ -133,8 +124,7 @@ const GLSL: Syntax = Syntax {
 
 const RUST: Syntax = Syntax {
     signature: "pub fn {name}({params}) -> f32 {",
-    params_2d: "mu: f32, r: f32",
-    params_1d: "r: f32",
+    params: "mu: f32, r: f32",
     constant: "let",
     variable: "let mut",
     t: "(mu * (1.0 + k) / (mu + k).max(1e-30)).min(1.0).powf(0.4)",
@@ -145,8 +135,7 @@ const RUST: Syntax = Syntax {
 
 const C: Syntax = Syntax {
     signature: "static inline float {name}({params}) {",
-    params_2d: "float mu, float r",
-    params_1d: "float r",
+    params: "float mu, float r",
     constant: "const float",
     variable: "float",
     t: "powf(fminf(mu * (1.0f + k) / fmaxf(mu + k, 1e-30f), 1.0f), 0.4f)",
@@ -169,7 +158,6 @@ fn horner(coefficients: &[f64], variable: &str, number: fn(f64) -> String) -> St
 
 fn code(fit: &PolynomialFit, syntax: &Syntax, header: &str, text: &str) -> String {
     let name = function_name(fit);
-    let two_d = fit.quantity == Quantity::E;
     let number = syntax.number;
     let nr = fit.degrees.r + 1;
     let rows: Vec<&[f64]> = fit.coefficients.chunks(nr).collect();
@@ -178,24 +166,17 @@ fn code(fit: &PolynomialFit, syntax: &Syntax, header: &str, text: &str) -> Strin
         out += &format!("{} {line}\n", syntax.comment);
     }
     out += header;
-    let params = if two_d {
-        syntax.params_2d
-    } else {
-        syntax.params_1d
-    };
     out += &syntax
         .signature
         .replace("{name}", &name)
-        .replace("{params}", params);
+        .replace("{params}", syntax.params);
     out += "\n";
     let c = syntax.constant;
     let one = number(1.0);
     let two = number(2.0);
-    if two_d {
-        out += &format!("    {c} k = {} * r * r;\n", number(4.0));
-        out += &format!("    {c} t = {};\n", syntax.t);
-        out += &format!("    {c} u = {two} * t - {one};\n");
-    }
+    out += &format!("    {c} k = {} * r * r;\n", number(4.0));
+    out += &format!("    {c} t = {};\n", syntax.t);
+    out += &format!("    {c} u = {two} * t - {one};\n");
     out += &format!("    {c} v = {two} * r - {one};\n");
     let last = rows.len() - 1;
     out += &format!(
@@ -212,8 +193,7 @@ fn code(fit: &PolynomialFit, syntax: &Syntax, header: &str, text: &str) -> Strin
     out
 }
 
-/// The fit in `format`; `description` (from [`description`]) heads the file. The formula file
-/// is for fits of `E` (what `kiln verify --fit` audits).
+/// The fit in `format`; `description` (from [`description`]) heads the file.
 #[must_use]
 pub fn emit(fit: &PolynomialFit, format: FitFormat, description: &str) -> String {
     match format {
@@ -235,14 +215,12 @@ fn formula_file(fit: &PolynomialFit, description: &str) -> String {
     let number = |c: f64| format!("{c:?}");
     let nr = fit.degrees.r + 1;
     let rows: Vec<&[f64]> = fit.coefficients.chunks(nr).collect();
-    let mut defines = Vec::new();
-    let two_d = fit.quantity == Quantity::E;
-    if two_d {
-        defines.push("k = 4 * alpha".to_string());
-        defines.push("t = pow(min(mu * (1 + k) / max(mu + k, 1e-30), 1), 0.4)".to_string());
-        defines.push("u = 2 * t - 1".to_string());
-    }
-    defines.push("v = 2 * r - 1".to_string());
+    let mut defines = vec![
+        "k = 4 * alpha".to_string(),
+        "t = pow(min(mu * (1 + k) / max(mu + k, 1e-30), 1), 0.4)".to_string(),
+        "u = 2 * t - 1".to_string(),
+        "v = 2 * r - 1".to_string(),
+    ];
     for (i, row) in rows.iter().enumerate() {
         defines.push(format!("p{i} = {}", horner(row, "v", number)));
     }

@@ -1,4 +1,4 @@
-//! Texture-free fits of `E(mu, r)` and `E_avg(r)` found by kiln (`kiln fit`): polynomials in
+//! Texture-free fits of `E(mu, r)` found by kiln (`kiln fit`): polynomials in
 //! kiln's own coordinates, fitted in the maximum norm, whose maximum error the fit audit
 //! ([`crate::verify::fit`]) states.
 //!
@@ -11,16 +11,16 @@
 //! (power basis on the centred interval: its coefficients stay small, so an f32 evaluation
 //! adds little).
 //!
-//! The coefficients are found by Lawson's iteratively reweighted least squares (as
-//! [`crate::table::lookup_fit`], the pure minimax) in the Chebyshev basis, over a dense grid in
+//! The coefficients are found by Lawson's iteratively reweighted least squares
+//! ([`crate::numerics::minimax`], the pure minimax) in the Chebyshev basis, over a dense grid in
 //! `(t, r)` and the grazing probes of every row, against the reference; then converted to the
 //! power basis. The maximum error the fit states is not the fit's own: it is the audit's of the
 //! formula file written (the same text a shader pastes), [`crate::verify::fit::audit_fit`].
 
-use crate::integrate::quantity::Quantity;
 use crate::integrate::reference::ReferenceSettings;
 use crate::integrate::value::{Integral, Point};
 use crate::model::Model;
+use crate::numerics::minimax::{Lawson, dot, lawson};
 use rayon::prelude::*;
 
 /// The shape of a polynomial fit: degrees in `t` (absent for `E_avg`) and in `r`.
@@ -42,7 +42,6 @@ impl Degrees {
 #[derive(Clone, Debug, PartialEq)]
 pub struct PolynomialFit {
     pub model: Model,
-    pub quantity: Quantity,
     pub degrees: Degrees,
     pub coefficients: Vec<f64>,
     /// The largest error over the fit's own points (the audit's figure is the one to state).
@@ -108,13 +107,9 @@ impl PolynomialFit {
 
 /// The fit's points in `(t, r)`: a `(n + 1) x (n + 1)` grid, and on every row the grazing
 /// probes (`mu` from 0 to 1, [`crate::table::axis::grazing_probes`]) mapped to `t`.
-fn fit_points(quantity: Quantity, n: usize) -> Vec<(f64, f64)> {
-    let rs: Vec<f64> = (0..=n).map(|j| j as f64 / n as f64).collect();
-    if quantity == Quantity::EAvg {
-        return rs.into_iter().map(|r| (0.0, r)).collect();
-    }
+fn fit_points(n: usize) -> Vec<(f64, f64)> {
     let mut points = Vec::new();
-    for &r in &rs {
+    for r in (0..=n).map(|j| j as f64 / n as f64) {
         for i in 0..=n {
             points.push((i as f64 / n as f64, r));
         }
@@ -125,60 +120,34 @@ fn fit_points(quantity: Quantity, n: usize) -> Vec<(f64, f64)> {
     points
 }
 
-/// Fits `quantity` (`E` or `E_avg`) of `model` with the given degrees (the `t` degree is
-/// ignored for `E_avg`). `progress` hears of each reference evaluation.
-///
-/// # Panics
-/// For another quantity.
+/// Fits `E` of `model` with the given degrees. `progress` hears of each reference evaluation.
 #[must_use]
-pub fn fit(
-    model: Model,
-    quantity: Quantity,
-    degrees: Degrees,
-    progress: &(dyn Fn() + Sync),
-) -> PolynomialFit {
-    assert!(matches!(quantity, Quantity::E | Quantity::EAvg));
-    let degrees = Degrees {
-        t: if quantity == Quantity::EAvg {
-            0
-        } else {
-            degrees.t
-        },
-        r: degrees.r,
-    };
-    let truth = truth_points(model, quantity, progress);
-    fit_to(model, quantity, degrees, &truth)
+pub fn fit(model: Model, degrees: Degrees, progress: &(dyn Fn() + Sync)) -> PolynomialFit {
+    let truth = truth_points(model, progress);
+    fit_to(model, degrees, &truth)
 }
 
 /// The reference at the fit's points, `((t, r), value)`: computed once for every shape a
 /// sweep tries.
 #[must_use]
-pub fn truth_points(
-    model: Model,
-    quantity: Quantity,
-    progress: &(dyn Fn() + Sync),
-) -> Vec<((f64, f64), f64)> {
-    let integral = Integral {
-        quantity,
-        ..Integral::albedo(model)
-    };
+pub fn truth_points(model: Model, progress: &(dyn Fn() + Sync)) -> Vec<((f64, f64), f64)> {
+    let integral = Integral::albedo(model);
     let settings = ReferenceSettings {
         tolerance: 1e-8,
         ..ReferenceSettings::default()
     };
-    fit_points(quantity, 96)
+    fit_points(96)
         .into_par_iter()
         .map(|(t, r)| {
             // At r = 0 the adaptive axis reaches only t = 0 and 1 (E = 1 at both); between
             // them the fit follows the layer's limit alpha -> 0+, as a table's row 0 holds it
             // (`TableSpec::point`), so that it stays continuous in r.
-            let alpha = if r == 0.0 && quantity == Quantity::E {
+            let alpha = if r == 0.0 {
                 crate::table::axis::LAYER_LIMIT_ALPHA
             } else {
                 r * r
             };
-            let mu = (quantity == Quantity::E)
-                .then(|| crate::table::axis::MuMapping::Adaptive.mu(t, alpha));
+            let mu = Some(crate::table::axis::MuMapping::Adaptive.mu(t, alpha));
             let v = integral
                 .reference(
                     Point {
@@ -197,64 +166,37 @@ pub fn truth_points(
 
 /// [`fit`] against precomputed truth ([`truth_points`]).
 #[must_use]
-pub fn fit_to(
-    model: Model,
-    quantity: Quantity,
-    degrees: Degrees,
-    truth: &[((f64, f64), f64)],
-) -> PolynomialFit {
+pub fn fit_to(model: Model, degrees: Degrees, truth: &[((f64, f64), f64)]) -> PolynomialFit {
     let (nt, nr) = (degrees.t, degrees.r);
     let k = degrees.coefficients();
-    let rows: Vec<Vec<f64>> = truth
+    let rows: Vec<Vec<(usize, f64)>> = truth
         .iter()
         .map(|&((t, r), _)| {
             let (ct, cr) = (chebyshev(2.0 * t - 1.0, nt), chebyshev(2.0 * r - 1.0, nr));
             ct.iter()
                 .flat_map(|a| cr.iter().map(move |b| a * b))
+                .enumerate()
                 .collect()
         })
         .collect();
     let b: Vec<f64> = truth.iter().map(|p| p.1).collect();
-    let mut weight = vec![1.0 / rows.len() as f64; rows.len()];
-    let mut best = (f64::INFINITY, vec![0.0; k]);
-    for _ in 0..100 {
-        let mut a = vec![0.0; k * k];
-        let mut rhs = vec![0.0; k];
-        for ((row, &w), &bj) in rows.iter().zip(&weight).zip(&b) {
-            for i in 0..k {
-                let wi = w * row[i];
-                rhs[i] += wi * bj;
-                for j in 0..=i {
-                    a[i * k + j] += wi * row[j];
-                }
-            }
-        }
-        let Some(x) = solve_dense(&mut a, &rhs, k) else {
-            break;
-        };
-        let errors: Vec<f64> = rows
-            .iter()
-            .zip(&b)
-            .map(|(row, bj)| (row.iter().zip(&x).map(|(p, c)| p * c).sum::<f64>() - bj).abs())
-            .collect();
-        let max = errors.iter().fold(0.0_f64, |m, &e| m.max(e));
-        if max < best.0 {
-            best = (max, x);
-        }
-        let total: f64 = weight.iter().zip(&errors).map(|(w, e)| w * e).sum();
-        if total.is_nan() || total <= 0.0 {
-            break;
-        }
-        for (w, e) in weight.iter_mut().zip(&errors) {
-            *w *= e / total;
-        }
-    }
+    let settings = Lawson {
+        iterations: 100,
+        weight_cap: f64::INFINITY,
+        regularisation: 1e-13,
+    };
+    let chebyshev_coefficients = lawson(&rows, &b, k, &settings);
+    let fit_max_error = rows
+        .iter()
+        .zip(&b)
+        .map(|(row, bj)| (dot(row, &chebyshev_coefficients) - bj).abs())
+        .fold(0.0_f64, f64::max);
     // Chebyshev coefficients c_pq of T_p(u) T_q(v) to power coefficients of u^i v^j.
     let (mt, mr) = (chebyshev_to_power(nt), chebyshev_to_power(nr));
     let mut coefficients = vec![0.0; k];
     for (p, row_t) in mt.iter().enumerate() {
         for (q, row_r) in mr.iter().enumerate() {
-            let c = best.1[p * (nr + 1) + q];
+            let c = chebyshev_coefficients[p * (nr + 1) + q];
             for (i, a) in row_t.iter().enumerate() {
                 for (j, b) in row_r.iter().enumerate() {
                     coefficients[i * (nr + 1) + j] += c * a * b;
@@ -264,50 +206,10 @@ pub fn fit_to(
     }
     PolynomialFit {
         model,
-        quantity,
         degrees,
         coefficients,
-        fit_max_error: best.0,
+        fit_max_error,
     }
-}
-
-/// Solves the symmetric positive definite `a x = b` (lower triangle of `a` filled, row-major
-/// `k x k`) by Cholesky with a tiny diagonal shift; `None` if it fails.
-fn solve_dense(a: &mut [f64], b: &[f64], k: usize) -> Option<Vec<f64>> {
-    let trace: f64 = (0..k).map(|i| a[i * k + i]).sum::<f64>() / k as f64;
-    for i in 0..k {
-        a[i * k + i] += 1e-13 * trace;
-    }
-    for i in 0..k {
-        for j in 0..=i {
-            let mut sum = a[i * k + j];
-            for p in 0..j {
-                sum -= a[i * k + p] * a[j * k + p];
-            }
-            if i == j {
-                if sum.is_nan() || sum <= 0.0 {
-                    return None;
-                }
-                a[i * k + i] = sum.sqrt();
-            } else {
-                a[i * k + j] = sum / a[j * k + j];
-            }
-        }
-    }
-    let mut y = b.to_vec();
-    for i in 0..k {
-        for p in 0..i {
-            y[i] -= a[i * k + p] * y[p];
-        }
-        y[i] /= a[i * k + i];
-    }
-    for i in (0..k).rev() {
-        for p in i + 1..k {
-            y[i] -= a[p * k + i] * y[p];
-        }
-        y[i] /= a[i * k + i];
-    }
-    Some(y)
 }
 
 #[cfg(test)]
@@ -339,7 +241,7 @@ mod tests {
             ndf: crate::model::Ndf::Ggx,
             masking: crate::model::Masking::HeightCorrelated,
         };
-        let fit = fit_to(model, Quantity::E, Degrees { t: 1, r: 2 }, &truth);
+        let fit = fit_to(model, Degrees { t: 1, r: 2 }, &truth);
         assert!(fit.fit_max_error < 1e-12, "{}", fit.fit_max_error);
         for &((t, r), v) in &truth {
             assert!((fit.value_at(2.0 * t - 1.0, 2.0 * r - 1.0) - v).abs() < 1e-12);

@@ -5,3 +5,4 @@
 pub mod elementary;
 pub mod gauss_kronrod;
 pub mod gauss_legendre;
+pub mod minimax;

@@ -7,13 +7,9 @@
 //! fit is a linear Chebyshev problem: over a dense set of points `x_j` covering every cell of
 //! the texture (the axis ends included), find the corrections `d` to the node values that
 //! minimise `max_j |sum_k w_k(x_j) d_k - (f(x_j) - lookup(x_j))|`, with `f` the deterministic
-//! reference. It is solved by Lawson's iteratively reweighted least squares (C. L. Lawson,
-//! "Contributions to the theory of linear least maximum approximation", PhD thesis, UCLA 1961;
-//! see Rice and Usow, Math. Comp. 22 (1968) 118-127): weighted least squares, each point's
-//! weight then multiplied by its absolute error and renormalised, which converges to the
-//! minimax weights. Each least-squares step solves the normal equations, banded because a
-//! lookup blends neighbouring texels only (bandwidth one row plus one), by banded Cholesky.
-//! The best iterate (smallest maximum over the fit's points) is kept.
+//! reference. It is solved by Lawson's iteratively reweighted least squares
+//! ([`crate::numerics::minimax`]), whose normal equations are banded because a lookup blends
+//! neighbouring texels only (bandwidth one row plus one).
 //!
 //! No point's weight may exceed [`LookupFitSettings::weight_cap`] (30) times the mean, so the
 //! fit minimises, in effect, the mean of the worst few percent of errors rather than the single
@@ -37,6 +33,7 @@
 use super::Table;
 use crate::integrate::reference::ReferenceSettings;
 use crate::integrate::value::Point;
+use crate::numerics::minimax::{Lawson, lawson};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -194,7 +191,13 @@ pub fn fit_for_lookup(
         .map(|(w, f)| f - w.apply(&table.value))
         .collect();
     let node_lookup_max_error = residual.iter().fold(0.0_f64, |m, r| m.max(r.abs()));
-    let correction = blend_capped(&weights, &residual, table.value.len(), settings);
+    let correction = blend_capped(
+        &weights,
+        &residual,
+        node_lookup_max_error,
+        table.value.len(),
+        settings,
+    );
     let mut max_correction: f64 = 0.0;
     for (k, d) in correction.iter().enumerate() {
         let value = (table.value[k] + d).clamp(0.0, 1.0);
@@ -218,26 +221,34 @@ pub fn fit_for_lookup(
 }
 
 /// The corrections: the capped fit's where its maximum is no worse than the point samples'
-/// (`max_j |b_j|`), else the blend `l capped + (1 - l) uncapped` with the largest `l` in steps
+/// (`nodes = max_j |b_j|`), else the blend `l capped + (1 - l) uncapped` with the largest `l` in steps
 /// of 1/20 that is (the uncapped minimax is; the errors are linear in `l`), else none.
 fn blend_capped(
     rows: &[super::LookupWeights],
     b: &[f64],
+    nodes: f64,
     unknowns: usize,
     settings: &LookupFitSettings,
 ) -> Vec<f64> {
-    let capped = lawson(rows, b, unknowns, settings.iterations, settings.weight_cap);
+    let solve = |weight_cap| {
+        let lawson_settings = Lawson {
+            iterations: settings.iterations,
+            weight_cap,
+            regularisation: 1e-12,
+        };
+        lawson(rows, b, unknowns, &lawson_settings)
+    };
+    let capped = solve(settings.weight_cap);
     let max_error = |x: &[f64]| {
         rows.iter()
             .zip(b)
             .map(|(row, bj)| (row.apply(x) - bj).abs())
             .fold(0.0_f64, f64::max)
     };
-    let nodes = b.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
     if max_error(&capped) <= nodes || settings.weight_cap.is_infinite() {
         return capped;
     }
-    let uncapped = lawson(rows, b, unknowns, settings.iterations, f64::INFINITY);
+    let uncapped = solve(f64::INFINITY);
     for step in (0..20).rev() {
         let l = f64::from(step) / 20.0;
         let blend: Vec<f64> = capped
@@ -250,175 +261,4 @@ fn blend_capped(
         }
     }
     vec![0.0; unknowns]
-}
-
-/// Lawson's algorithm for `min_d max_j |a_j . d - b_j|` with sparse rows `a_j` (see the module
-/// docs); returns the iterate with the smallest maximum.
-fn lawson(
-    rows: &[super::LookupWeights],
-    b: &[f64],
-    unknowns: usize,
-    iterations: usize,
-    weight_cap: f64,
-) -> Vec<f64> {
-    let bandwidth = rows
-        .iter()
-        .map(|w| {
-            let (lo, hi) = w
-                .terms()
-                .iter()
-                .fold((usize::MAX, 0), |(lo, hi), &(k, _)| (lo.min(k), hi.max(k)));
-            hi - lo
-        })
-        .max()
-        .unwrap_or(0);
-    let mut weight = vec![1.0 / rows.len() as f64; rows.len()];
-    let mut best = (f64::INFINITY, vec![0.0; unknowns]);
-    for _ in 0..iterations.max(1) {
-        let mut matrix = Banded::new(unknowns, bandwidth);
-        let mut rhs = vec![0.0; unknowns];
-        for ((row, &w), &bj) in rows.iter().zip(&weight).zip(b) {
-            for &(i, wi) in row.terms() {
-                rhs[i] += w * wi * bj;
-                for &(j, wj) in row.terms() {
-                    if j <= i {
-                        matrix.add(i, j, w * wi * wj);
-                    }
-                }
-            }
-        }
-        matrix.regularise(1e-12);
-        let Some(x) = matrix.solve(&rhs) else { break };
-        let errors: Vec<f64> = rows
-            .iter()
-            .zip(b)
-            .map(|(row, &bj)| (row.apply(&x) - bj).abs())
-            .collect();
-        let max = errors.iter().fold(0.0_f64, |m, &e| m.max(e));
-        if !max.is_finite() {
-            break;
-        }
-        if max < best.0 {
-            best = (max, x);
-        }
-        let total: f64 = weight.iter().zip(&errors).map(|(w, e)| w * e).sum();
-        if total <= 0.0 {
-            break;
-        }
-        let cap = weight_cap / rows.len() as f64;
-        for (w, e) in weight.iter_mut().zip(&errors) {
-            *w = (*w * e / total).min(cap);
-        }
-    }
-    best.1
-}
-
-/// A symmetric positive definite band matrix, lower triangle stored by rows: entry `(i, j)`,
-/// `i - bandwidth <= j <= i`, at `i * (bandwidth + 1) + (j + bandwidth - i)`.
-struct Banded {
-    n: usize,
-    bandwidth: usize,
-    data: Vec<f64>,
-}
-
-impl Banded {
-    fn new(n: usize, bandwidth: usize) -> Self {
-        Self {
-            n,
-            bandwidth,
-            data: vec![0.0; n * (bandwidth + 1)],
-        }
-    }
-
-    fn at(&self, i: usize, j: usize) -> usize {
-        i * (self.bandwidth + 1) + (j + self.bandwidth - i)
-    }
-
-    fn add(&mut self, i: usize, j: usize, v: f64) {
-        let k = self.at(i, j);
-        self.data[k] += v;
-    }
-
-    /// Adds `relative` times the mean diagonal to the diagonal (so that a texel no point
-    /// constrains keeps its node value, correction 0).
-    fn regularise(&mut self, relative: f64) {
-        let mean = (0..self.n).map(|i| self.data[self.at(i, i)]).sum::<f64>() / self.n as f64;
-        let shift = relative * mean.max(f64::MIN_POSITIVE);
-        for i in 0..self.n {
-            let k = self.at(i, i);
-            self.data[k] += shift;
-        }
-    }
-
-    /// Solves `A x = b` by banded Cholesky `A = L L^T`; `None` if `A` is not positive definite.
-    fn solve(mut self, b: &[f64]) -> Option<Vec<f64>> {
-        let (n, bw) = (self.n, self.bandwidth);
-        for i in 0..n {
-            let j0 = i.saturating_sub(bw);
-            for j in j0..=i {
-                let mut sum = self.data[self.at(i, j)];
-                let k0 = j0.max(j.saturating_sub(bw));
-                for k in k0..j {
-                    sum -= self.data[self.at(i, k)] * self.data[self.at(j, k)];
-                }
-                if i == j {
-                    if sum <= 0.0 || !sum.is_finite() {
-                        return None;
-                    }
-                    let k = self.at(i, i);
-                    self.data[k] = sum.sqrt();
-                } else {
-                    let k = self.at(i, j);
-                    self.data[k] = sum / self.data[self.at(j, j)];
-                }
-            }
-        }
-        let mut y = b.to_vec();
-        for i in 0..n {
-            for k in i.saturating_sub(bw)..i {
-                y[i] -= self.data[self.at(i, k)] * y[k];
-            }
-            y[i] /= self.data[self.at(i, i)];
-        }
-        for i in (0..n).rev() {
-            for k in i + 1..(i + bw + 1).min(n) {
-                y[i] -= self.data[self.at(k, i)] * y[k];
-            }
-            y[i] /= self.data[self.at(i, i)];
-        }
-        Some(y)
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The banded solver against a dense system solved by hand: a tridiagonal matrix.
-    #[test]
-    fn banded_cholesky_solves_a_tridiagonal_system() {
-        // [[4, 1, 0], [1, 4, 1], [0, 1, 4]] x = [5, 6, 5] has x = [1, 1, 1].
-        let mut a = Banded::new(3, 1);
-        for i in 0..3 {
-            a.add(i, i, 4.0);
-        }
-        a.add(1, 0, 1.0);
-        a.add(2, 1, 1.0);
-        let x = a.solve(&[5.0, 6.0, 5.0]).unwrap();
-        for v in x {
-            assert!((v - 1.0).abs() < 1e-14, "{v}");
-        }
-    }
-
-    /// Lawson on the textbook case: the best constant for three points 0, 1, 3 is 1.5 (the
-    /// midrange, max error 1.5), where least squares gives the mean 4/3.
-    #[test]
-    fn lawson_finds_the_midrange() {
-        let one = crate::table::LookupWeights {
-            terms: [(0, 1.0); 8],
-            count: 1,
-        };
-        let x = lawson(&[one, one, one], &[0.0, 1.0, 3.0], 1, 200, f64::INFINITY);
-        assert!((x[0] - 1.5).abs() < 1e-3, "{}", x[0]);
-    }
 }

@@ -468,9 +468,7 @@ impl Table {
         // Per axis, slowest first: the two samples to blend, the second's weight, the stride
         // (the product of the faster axes' sizes). In place: a lookup allocates nothing (the
         // audits and `f_ms_norm` make millions).
-        let size = |axis: Option<Axis>| axis.map_or(1, |axis| axis.size());
-        let roughness_stride = size(self.spec.mu);
-        let ior_stride = roughness_stride * size(self.spec.roughness);
+        let (roughness_stride, ior_stride) = self.strides();
         let mut corners = [Corner::default(); 3];
         let mut slower = 0;
         for (axis, x, stride) in [
@@ -493,14 +491,22 @@ impl Table {
         }
     }
 
+    /// The index strides of the roughness and IOR axes: the product of the faster axes' sizes.
+    fn strides(&self) -> (usize, usize) {
+        let size = |axis: Option<Axis>| axis.map_or(1, |axis| axis.size());
+        let roughness_stride = size(self.spec.mu);
+        (
+            roughness_stride,
+            roughness_stride * size(self.spec.roughness),
+        )
+    }
+
     /// The texels and weights of [`Table::lookup_channel_eta`] at `(mu, roughness, eta)`:
     /// the same corners, so `weights.apply(channel)` is the lookup up to rounding.
     #[must_use]
     pub fn lookup_weights(&self, mu: f64, roughness: f64, eta: f64) -> LookupWeights {
         let alpha = self.spec.roughness_convention().to_alpha(roughness);
-        let size = |axis: Option<Axis>| axis.map_or(1, |axis| axis.size());
-        let roughness_stride = size(self.spec.mu);
-        let ior_stride = roughness_stride * size(self.spec.roughness);
+        let (roughness_stride, ior_stride) = self.strides();
         let mut out = LookupWeights {
             terms: [(0, 1.0); 8],
             count: 1,
@@ -573,7 +579,13 @@ impl LookupWeights {
     /// The lookup of `channel` these weights give.
     #[must_use]
     pub fn apply(&self, channel: &[f64]) -> f64 {
-        self.terms().iter().map(|&(k, w)| w * channel[k]).sum()
+        crate::numerics::minimax::dot(self.terms(), channel)
+    }
+}
+
+impl AsRef<[(usize, f64)]> for LookupWeights {
+    fn as_ref(&self) -> &[(usize, f64)] {
+        self.terms()
     }
 }
 

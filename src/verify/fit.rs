@@ -4,9 +4,9 @@
 //! and where it is, with an error map (`kiln verify --fit`).
 //!
 //! The points: `mu = t^2` and `r` on an `n x n` product grid in `(t, r)` (dense where the
-//! grazing layer and the near-mirror are), then around each quantity's worst point a finer grid
-//! over the two grid cells either side of it, so that the stated maximum is the largest error
-//! found, not a grid's sample of it.
+//! grazing layer and the near-mirror are), then around each quantity's worst point finer grids
+//! over the two cells either side of it, four rounds each a quarter the span of the last, so
+//! that the stated maximum is the peak found, not a grid's sample of it.
 
 use super::error_map::{ErrorMap, MAX_MAP_CELLS};
 use crate::fit::Fit;

@@ -5,7 +5,7 @@ use clap::Args;
 use kiln::fit::emit::{FitFormat, description, emit, function_name};
 use kiln::fit::polynomial::{Degrees, PolynomialFit, fit_to, truth_points};
 use kiln::verify::fit::{FitAuditSettings, audit_polynomial};
-use kiln::{Masking, Model, Ndf, Quantity};
+use kiln::{Masking, Model, Ndf};
 use std::path::PathBuf;
 
 /// Fit E(mu, r) without a texture, with its audited maximum error, as shader code
@@ -85,18 +85,18 @@ struct Audited {
     worst: (f64, f64),
 }
 
-fn audited(fit: PolynomialFit, model: Model) -> kiln::Result<Audited> {
+fn audited(fit: PolynomialFit, model: Model) -> Audited {
     let settings = FitAuditSettings {
         model,
         ..FitAuditSettings::default()
     };
     let report = audit_polynomial(&fit, &settings, &|| {});
     let e = &report.quantities[0];
-    Ok(Audited {
+    Audited {
         fit,
         max_error: e.max_error,
         worst: (e.worst.mu, e.worst.r),
-    })
+    }
 }
 
 pub fn run(args: FitArgs) -> kiln::Result<()> {
@@ -105,16 +105,20 @@ pub fn run(args: FitArgs) -> kiln::Result<()> {
         masking: args.masking.unwrap_or(Masking::HeightCorrelated),
     };
     model.validate().map_err(kiln::Error::InvalidInput)?;
+    // A bad --plot or --out is refused before the reference is computed.
     let svg = crate::verify::plot_kind_of(args.plot.as_deref())?;
+    let out = args.out.clone().unwrap_or_else(|| PathBuf::from("fits"));
+    if !args.sweep {
+        kiln::format::check_output_dir(&out)?;
+    }
     let quiet = args.quiet || args.json;
     let bar = crate::progress_bar(quiet, 0, "reference");
-    let truth = truth_points(model, Quantity::E, &|| bar.inc(1));
+    let truth = truth_points(model, &|| bar.inc(1));
     bar.finish_and_clear();
     if args.sweep {
-        let mut rows = Vec::new();
+        let mut fits = Vec::new();
         for (t, r) in SWEEP {
-            let fit = fit_to(model, Quantity::E, Degrees { t, r }, &truth);
-            let a = audited(fit, model)?;
+            let a = audited(fit_to(model, Degrees { t, r }, &truth), model);
             if !quiet {
                 println!(
                     "{:>3} coefficients (degrees {t}, {r}): max error {:.2e} at mu = {:.6}, r = {:.6}",
@@ -124,22 +128,12 @@ pub fn run(args: FitArgs) -> kiln::Result<()> {
                     a.worst.1
                 );
             }
-            rows.push(serde_json::json!({
-                "degrees": [t, r],
-                "coefficients": a.fit.degrees.coefficients(),
-                "max_error": a.max_error,
-                "worst": {"mu": a.worst.0, "r": a.worst.1},
-            }));
+            fits.push(a);
         }
         if let (Some(svg), Some(path)) = (svg, &args.plot) {
-            let points: Vec<(usize, f64)> = rows
+            let points: Vec<(usize, f64)> = fits
                 .iter()
-                .map(|r| {
-                    (
-                        r["coefficients"].as_u64().unwrap_or(0) as usize,
-                        r["max_error"].as_f64().unwrap_or(f64::NAN),
-                    )
-                })
+                .map(|a| (a.fit.degrees.coefficients(), a.max_error))
                 .collect();
             crate::verify::write_plot(
                 path,
@@ -148,6 +142,17 @@ pub fn run(args: FitArgs) -> kiln::Result<()> {
             )?;
         }
         if args.json {
+            let rows: Vec<serde_json::Value> = fits
+                .iter()
+                .map(|a| {
+                    serde_json::json!({
+                        "degrees": [a.fit.degrees.t, a.fit.degrees.r],
+                        "coefficients": a.fit.degrees.coefficients(),
+                        "max_error": a.max_error,
+                        "worst": {"mu": a.worst.0, "r": a.worst.1},
+                    })
+                })
+                .collect();
             println!(
                 "{}",
                 serde_json::json!({"model": model.to_string(), "fits": rows})
@@ -155,8 +160,7 @@ pub fn run(args: FitArgs) -> kiln::Result<()> {
         }
         return Ok(());
     }
-    let fit = fit_to(model, Quantity::E, args.degrees, &truth);
-    let a = audited(fit, model)?;
+    let a = audited(fit_to(model, args.degrees, &truth), model);
     let command = format!(
         "kiln fit --ndf {} --masking {} --degrees {},{}",
         model.ndf, model.masking, args.degrees.t, args.degrees.r
@@ -175,8 +179,6 @@ pub fn run(args: FitArgs) -> kiln::Result<()> {
             )
         })
         .collect();
-    let out = args.out.unwrap_or_else(|| PathBuf::from("fits"));
-    kiln::format::check_output_dir(&out)?;
     let written = kiln::format::write_files(&out, &files)?;
     if args.json {
         println!(

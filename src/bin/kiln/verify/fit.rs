@@ -56,17 +56,7 @@ pub fn run(args: &VerifyArgs, name: &str) -> kiln::Result<bool> {
         );
         write_plot(path, svg, crate::plot::error_map_plot(&title, &maps))?;
     }
-    let worst = report
-        .quantities
-        .iter()
-        .map(|q| q.max_error)
-        .fold(0.0_f64, |a, b| {
-            if a.is_nan() || b.is_nan() {
-                f64::NAN
-            } else {
-                a.max(b)
-            }
-        });
+    let worst = kiln::stats::max_or_nan(report.quantities.iter().map(|q| q.max_error));
     let passed = args.max_error.is_none_or(|bound| worst <= bound);
     if args.json {
         let mut object = serde_json::to_value(&report).expect("a report serialises");
