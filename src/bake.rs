@@ -619,7 +619,7 @@ impl BakeOptions {
                 continue;
             }
             let table = bake_table(spec, command, progress);
-            let table = self.confirm(&options, table)?;
+            let table = self.confirm(&options, table, progress)?;
             if let Some(cache) = cache {
                 cache.store(&key, &table)?;
             }
@@ -637,7 +637,12 @@ impl BakeOptions {
     ///
     /// # Errors
     /// A non-finite texel, a NaN check or a measured error beyond `--max-error`.
-    pub fn confirm(&self, options: &BakeOptions, table: Table) -> Result<Table> {
+    pub fn confirm(
+        &self,
+        options: &BakeOptions,
+        table: Table,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> Result<Table> {
         let terms = self
             .check_plan(options, &table.spec)
             .map(|(indices, settings)| {
@@ -648,7 +653,7 @@ impl BakeOptions {
                     &settings,
                 )
             });
-        self.confirm_with(table, terms.as_deref())
+        self.confirm_with(table, terms.as_deref(), progress)
     }
 
     /// The check against the reference a table gets ([`BakeOptions::confirm`]): the texels and
@@ -680,7 +685,12 @@ impl BakeOptions {
     ///
     /// # Errors
     /// As [`BakeOptions::confirm`].
-    pub fn confirm_with(&self, mut table: Table, terms: Option<&[(f64, bool)]>) -> Result<Table> {
+    pub fn confirm_with(
+        &self,
+        mut table: Table,
+        terms: Option<&[(f64, bool)]>,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> Result<Table> {
         check_computed(&table)?;
         table.requested_max_error = self.max_error;
         table.node_errors = terms.map(crate::verify::summarise_node_errors);
@@ -706,7 +716,7 @@ impl BakeOptions {
             )));
         }
         if table.spec.texels == Texels::LookupFit {
-            fit_texels(&mut table);
+            fit_texels(&mut table, progress);
         }
         Ok(table)
     }
@@ -722,9 +732,24 @@ impl BakeOptions {
             .sum()
     }
 
-    /// The integrand evaluations [`BakeOptions::bake`] will spend, for a progress bar.
+    /// The work [`BakeOptions::bake`] will report to its progress callback, for a progress
+    /// bar: each texel's integrand samples ([`BakeOptions::integration_samples`]), and for
+    /// fitted texels each reference evaluation of the fit counted as one texel's samples.
     #[must_use]
     pub fn total_samples(&self) -> u64 {
+        self.integration_samples()
+            + self
+                .resolved()
+                .specs()
+                .iter()
+                .map(|s| lookup_fit_evaluations(s) * s.qmc.samples)
+                .sum::<u64>()
+    }
+
+    /// The integrand samples of the texels alone (what a shard reports: the lookup fit runs
+    /// where the shards are merged).
+    #[must_use]
+    pub fn integration_samples(&self) -> u64 {
         self.resolved()
             .specs()
             .iter()
@@ -784,14 +809,17 @@ pub fn confirmation_settings(max_error: f64, spec: &TableSpec) -> ReferenceSetti
 /// own points and `kiln verify`'s audit points, and records what the fit measured. The node
 /// errors then bound the stored texels' distance from the truth: the point samples' measured
 /// error plus the largest correction (and the RMS is the corrections').
-pub fn fit_texels(table: &mut Table) {
-    let cells = table.spec.shape().into_iter().max().unwrap_or(1);
-    let settings = crate::table::lookup_fit::LookupFitSettings::for_cells(cells);
+/// `progress` hears of each reference evaluation of the fit with the samples of one texel of
+/// the bake (`spec.qmc.samples`, the unit of [`BakeOptions::total_samples`]).
+pub fn fit_texels(table: &mut Table, progress: &(dyn Fn(u64) + Sync)) {
+    let settings = lookup_fit_settings(&table.spec);
     let before = table.value.clone();
     // `kiln verify`'s own audit points are among the fit's: what it states, verify finds.
     let audit =
         crate::verify::lookup_coordinates(&table.spec, &crate::verify::AuditSettings::default());
-    let report = crate::table::lookup_fit::fit_for_lookup(table, &settings, &audit, &|| {});
+    let samples = table.spec.qmc.samples;
+    let report =
+        crate::table::lookup_fit::fit_for_lookup(table, &settings, &audit, &|| progress(samples));
     let corrections = table
         .value
         .iter()
@@ -803,6 +831,23 @@ pub fn fit_texels(table: &mut Table) {
         errors.rms = errors.rms.hypot(rms);
     }
     table.lookup_fit = Some(report);
+}
+
+/// The settings of [`fit_texels`] for a table of `spec`.
+fn lookup_fit_settings(spec: &TableSpec) -> crate::table::lookup_fit::LookupFitSettings {
+    let cells = spec.shape().into_iter().max().unwrap_or(1);
+    crate::table::lookup_fit::LookupFitSettings::for_cells(cells)
+}
+
+/// The reference evaluations [`fit_texels`] makes for a table of `spec`: 0 for point samples.
+#[must_use]
+pub fn lookup_fit_evaluations(spec: &TableSpec) -> u64 {
+    if spec.texels != Texels::LookupFit {
+        return 0;
+    }
+    let audit = crate::verify::lookup_coordinates(spec, &crate::verify::AuditSettings::default());
+    crate::table::lookup_fit::planned_evaluations(spec, &lookup_fit_settings(spec), audit.len())
+        as u64
 }
 
 /// Bakes one table, texels in parallel (deterministic for any thread count).
@@ -944,6 +989,29 @@ pub fn check_computed(table: &Table) -> Result<()> {
 /// estimate to within a factor of two or three: enough to tell seconds from minutes.
 #[must_use]
 pub fn estimated_core_seconds(spec: &TableSpec) -> f64 {
+    integration_core_seconds(spec) + lookup_fit_core_seconds(spec)
+}
+
+/// The cost of a lookup fit ([`fit_texels`]; 0 for point samples), in seconds of one core: its
+/// reference evaluations at the fit's tolerance 1e-8, each at 0.45 of a texel's figure of
+/// [`reference_seconds_per_point`] (the fit's points are between the texels, where the
+/// integrands are tamer; measured on 32 x 32 and 64 x 64 `E` bakes, 3.4 s and 5.3 s whole
+/// process on 2 cores, 2026-12-04), and its Lawson iterations, each a banded Cholesky solve of
+/// about `texels x (band + 1)^2` multiply-adds at 1.2 ns (fitted to a 128 x 128 bake, 26 s).
+#[must_use]
+pub fn lookup_fit_core_seconds(spec: &TableSpec) -> f64 {
+    let evaluations = lookup_fit_evaluations(spec);
+    if evaluations == 0 {
+        return 0.0;
+    }
+    let band = spec.mu.map_or(1, |mu| mu.size()) as f64 + 1.0;
+    let iterations = lookup_fit_settings(spec).iterations as f64;
+    let solve = iterations * spec.len() as f64 * band * band * 1.2e-9;
+    0.45 * evaluations as f64 * reference_seconds_per_point(spec, 8) + solve
+}
+
+/// [`estimated_core_seconds`] of the texels' integration alone.
+fn integration_core_seconds(spec: &TableSpec) -> f64 {
     let texels = spec.len() as f64;
     let beckmann = spec.model.ndf == crate::model::Ndf::Beckmann;
     match spec.method {

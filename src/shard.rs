@@ -620,7 +620,12 @@ pub fn merge(shards: &[(PathBuf, ShardFile)]) -> Result<(ShardedBake, Vec<Table>
         // The check's texels are in ascending order and the shards' ranges too: the
         // concatenation is the unsharded bake's sequence of terms, summed in the same order.
         let terms = plan.map(|_| check);
-        tables.push(first.bake.options.confirm_with(table, terms.as_deref())?);
+        tables.push(
+            first
+                .bake
+                .options
+                .confirm_with(table, terms.as_deref(), &|_| {})?,
+        );
         t += 1;
     }
     Ok((first.bake.clone(), tables))

@@ -98,8 +98,7 @@ struct FitPoint {
 /// `centers` lookup reads included), as physical coordinates; with a `mu` axis, every row
 /// also at the grazing probes (`mu` = 0, 1e-12, 1e-6 to 1), where a boundary layer can fall
 /// between texture points.
-fn fit_points(table: &Table, per_cell: usize) -> Vec<FitPoint> {
-    let spec = &table.spec;
+fn fit_points(spec: &super::TableSpec, per_cell: usize) -> Vec<FitPoint> {
     let ts = |axis: Option<super::Axis>| -> Vec<f64> {
         match axis {
             None => vec![0.0],
@@ -149,6 +148,17 @@ fn fit_points(table: &Table, per_cell: usize) -> Vec<FitPoint> {
     points
 }
 
+/// The reference evaluations [`fit_for_lookup`] makes for a table of `spec` with `extra`
+/// points of the caller's: what a progress bar and a cost estimate count.
+#[must_use]
+pub fn planned_evaluations(
+    spec: &super::TableSpec,
+    settings: &LookupFitSettings,
+    extra: usize,
+) -> usize {
+    fit_points(spec, settings.per_cell).len() + extra
+}
+
 /// Fits `table`'s texels for its lookup (see the module docs), in place: `value` and
 /// `one_minus_value` move by the fitted corrections; `std_error` (the node estimates') stays.
 /// `extra` are physical points compared as well (the caller's audit points, so that the error
@@ -161,7 +171,7 @@ pub fn fit_for_lookup(
     progress: &(dyn Fn() + Sync),
 ) -> LookupFitReport {
     let convention = table.spec.roughness_convention();
-    let mut points = fit_points(table, settings.per_cell);
+    let mut points = fit_points(&table.spec, settings.per_cell);
     points.extend(extra.iter().map(|&at| FitPoint {
         mu: at.mu.unwrap_or(0.0),
         roughness: convention.from_alpha(at.alpha),

@@ -355,7 +355,7 @@ fn bake_shard(
     );
     let bar = crate::progress_bar(
         quiet,
-        bake.options.total_samples() / shard.count as u64,
+        bake.options.integration_samples() / shard.count as u64,
         "integrating",
     );
     let start = Instant::now();
