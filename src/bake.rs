@@ -737,13 +737,11 @@ impl BakeOptions {
     /// fitted texels each reference evaluation of the fit counted as one texel's samples.
     #[must_use]
     pub fn total_samples(&self) -> u64 {
-        self.integration_samples()
-            + self
-                .resolved()
-                .specs()
-                .iter()
-                .map(|s| lookup_fit_evaluations(s) * s.qmc.samples)
-                .sum::<u64>()
+        self.resolved()
+            .specs()
+            .iter()
+            .map(|s| (integrated_texels(s) + lookup_fit_evaluations(s)) * s.qmc.samples)
+            .sum()
     }
 
     /// The integrand samples of the texels alone (what a shard reports: the lookup fit runs
@@ -753,8 +751,7 @@ impl BakeOptions {
         self.resolved()
             .specs()
             .iter()
-            .filter(|s| s.quantity != Quantity::FMsNorm)
-            .map(|s| s.len() as u64 * s.qmc.samples)
+            .map(|s| integrated_texels(s) * s.qmc.samples)
             .sum()
     }
 }
@@ -831,6 +828,15 @@ pub fn fit_texels(table: &mut Table, progress: &(dyn Fn(u64) + Sync)) {
         errors.rms = errors.rms.hypot(rms);
     }
     table.lookup_fit = Some(report);
+}
+
+/// The texels of `spec` that a bake integrates (none of `f_ms_norm`, derived from a lookup).
+fn integrated_texels(spec: &TableSpec) -> u64 {
+    if spec.quantity == Quantity::FMsNorm {
+        0
+    } else {
+        spec.len() as u64
+    }
 }
 
 /// The settings of [`fit_texels`] for a table of `spec`.
