@@ -89,7 +89,7 @@ pub struct VerifyArgs {
         "order", "grid", "roughness_axis", "mu_axis", "ndf", "masking", "quantity"])]
     preset: Option<kiln::preset::Preset>,
     /// With --preset: audit only these of the file's tables, comma-separated (e,e-avg of a
-    /// Cycles shader.tables skips its four glass arrays, whose audit takes minutes).
+    /// Cycles shader.tables skips its four glass arrays, whose audit takes most of a minute).
     #[arg(long, value_enum, value_delimiter = ',', requires = "preset")]
     only: Option<Vec<Quantity>>,
     /// Exit with status 1 when node_max_error exceeds this (lookup_max_error for a table of
@@ -1110,7 +1110,7 @@ fn audit_one(
                 report.node_reference_tolerance,
                 report.lookup_reference_tolerance,
                 ReferenceSettings::default().tolerance,
-                kiln::verify::SCOUT_TOLERANCE
+                kiln::verify::COARSEST_TOLERANCE
             );
         }
         if !report.reference_converged {
