@@ -238,7 +238,10 @@ fn the_stated_error_bounds_the_actual_error() {
 /// - GGX alpha 0.01, mu 0.3, eta 0.95 at 1e-6: 5.7e-8 off, 4.8e-8 stated, once that break was
 ///   in but the refracted direction's sign change beside the critical angle went unseen;
 /// - `E_avg` in the nested order at GGX alpha 1, eta 1/3 at 1e-6: 2.9e-7 off, 1.4e-7 stated (no
-///   break in mu at mu = eta, below which the critical curve reaches the horizon).
+///   break in mu at mu = eta, below which the critical curve reaches the horizon);
+/// - GGX alpha 0.45^2, mu 0.7, eta 2/3 at 1e-8: 1.8e-8 off, 3.5e-9 stated (numerics version 11:
+///   no break in phi where an end of the refracting range crosses the reflected direction's
+///   horizon).
 #[test]
 fn the_stated_error_holds_where_the_critical_angle_meets_the_horizon() {
     let model = Model {
@@ -267,6 +270,7 @@ fn the_stated_error_holds_where_the_critical_angle_meets_the_horizon() {
             1e-7,
         ),
         (0.01, 0.3, 0.95, 1e-6),
+        (0.45 * 0.45, 0.7, 2.0 / 3.0, 1e-8),
     ] {
         check(
             &format!("E alpha {alpha} mu {mu} eta {eta} at {tolerance:e}"),

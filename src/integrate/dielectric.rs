@@ -648,6 +648,52 @@ fn dielectric_lanes<N: MicrofacetDistribution>(
     values
 }
 
+/// The azimuths in `(0, pi)` where an end of a slice's refracting range `o.m > c` (`c` the
+/// critical angle's cosine; `o.m = rho cos(theta - delta)` along the slice, so the ends are
+/// `theta = delta +- acos(c / rho)`) crosses the reflected direction's horizon `theta* = (pi -
+/// atan2(mu, so cos phi)) / 2`, where the inner integral is broken with a ladder of rungs: the
+/// critical angle's square root then moves through the masking layer, a kink in `phi` that a
+/// piece stepping over it does not see (GGX r 0.45, mu 0.7, eta 2/3: 1.8e-8 off where 3.5e-9
+/// was stated, at tolerance 1e-8). A scan of 128 steps, then bisection.
+fn critical_crossings(mu: f64, so: f64, c: f64) -> Vec<f64> {
+    const SCAN: usize = 128;
+    // The signed gaps of both ends from the horizon at `phi`, where the slice refracts.
+    let gaps = |phi: f64| -> Option<[f64; 2]> {
+        let cos_phi = phi.cos();
+        let rho = (mu * mu + so * so * cos_phi * cos_phi).sqrt();
+        if rho <= c {
+            return None;
+        }
+        let delta = (so * cos_phi).atan2(mu);
+        let spread = (c / rho).acos();
+        let theta_star = 0.5 * (PI - mu.atan2(so * cos_phi));
+        Some([delta - spread - theta_star, delta + spread - theta_star])
+    };
+    let mut crossings = Vec::new();
+    let mut previous: Option<(f64, [f64; 2])> = None;
+    for k in 0..=SCAN {
+        let phi = PI * k as f64 / SCAN as f64;
+        let here = gaps(phi);
+        if let (Some((phi0, g0)), Some(g1)) = (previous, here) {
+            for j in 0..2 {
+                if (g0[j] < 0.0) != (g1[j] < 0.0) {
+                    let (mut lo, mut hi) = (phi0, phi);
+                    for _ in 0..50 {
+                        let mid = 0.5 * (lo + hi);
+                        match gaps(mid) {
+                            Some(g) if (g[j] < 0.0) == (g0[j] < 0.0) => lo = mid,
+                            _ => hi = mid,
+                        }
+                    }
+                    crossings.push(0.5 * (lo + hi));
+                }
+            }
+        }
+        previous = here.map(|g| (phi, g));
+    }
+    crossings
+}
+
 /// `[R, T, 1 - E]` for one distribution (see the module docs).
 fn quadrature<N: MicrofacetDistribution>(
     ndf: N,
@@ -847,6 +893,7 @@ fn quadrature<N: MicrofacetDistribution>(
         if c < so {
             breaks.push((c / so).acos());
         }
+        breaks.extend(critical_crossings(mu, so, c));
         breaks.sort_by(f64::total_cmp);
     }
     let outer = integrate_pieces(
