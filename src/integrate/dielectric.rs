@@ -49,6 +49,7 @@ use crate::model::fresnel::dielectric;
 use crate::model::{
     Beckmann, Ggx, Masking, MicrofacetDistribution, Model, Ndf, SMOOTH_ALPHA, Vec3,
 };
+use crate::numerics::bisection::bisect;
 use crate::numerics::elementary::exp_lane;
 use serde::Serialize;
 use std::f64::consts::PI;
@@ -677,15 +678,9 @@ fn critical_crossings(mu: f64, so: f64, c: f64) -> Vec<f64> {
         if let (Some((phi0, g0)), Some(g1)) = (previous, here) {
             for j in 0..2 {
                 if (g0[j] < 0.0) != (g1[j] < 0.0) {
-                    let (mut lo, mut hi) = (phi0, phi);
-                    for _ in 0..50 {
-                        let mid = 0.5 * (lo + hi);
-                        match gaps(mid) {
-                            Some(g) if (g[j] < 0.0) == (g0[j] < 0.0) => lo = mid,
-                            _ => hi = mid,
-                        }
-                    }
-                    crossings.push(0.5 * (lo + hi));
+                    crossings.push(bisect(phi0, phi, 50, |mid| {
+                        gaps(mid).is_some_and(|g| (g[j] < 0.0) == (g0[j] < 0.0))
+                    }));
                 }
             }
         }
@@ -793,15 +788,9 @@ fn quadrature<N: MicrofacetDistribution>(
             if let (Some((x0, z0)), Some(z1)) = (previous, z)
                 && (z0 < 0.0) != (z1 < 0.0)
             {
-                let (mut lo, mut hi) = (x0, x);
-                for _ in 0..40 {
-                    let mid = 0.5 * (lo + hi);
-                    match refracted_z(mid, cos_phi, sin_phi) {
-                        Some(zm) if (zm < 0.0) == (z0 < 0.0) => lo = mid,
-                        _ => hi = mid,
-                    }
-                }
-                let root = 0.5 * (lo + hi);
+                let root = bisect(x0, x, 40, |mid| {
+                    refracted_z(mid, cos_phi, sin_phi).is_some_and(|zm| (zm < 0.0) == (z0 < 0.0))
+                });
                 breaks.push(root);
                 // The refracted direction grazes the horizon here: its masking layer, on both
                 // sides.

@@ -33,6 +33,7 @@ use super::gauss_kronrod::{KRONROD_NODES, integrate_pieces, integrate_pieces_bat
 use super::reference::{ReferenceSettings, ladder, s_of_x, t_of_s};
 use crate::model::dielectric::{TransmissionConvention, scatterings_at_cos};
 use crate::model::{Masking, MicrofacetDistribution, Vec3};
+use crate::numerics::bisection::bisect;
 use crate::numerics::elementary::sin_cos_lane;
 use std::f64::consts::{FRAC_PI_2, PI};
 
@@ -280,18 +281,7 @@ pub(crate) fn average<N: MicrofacetDistribution>(
         };
         let g = |theta_h: f64| eta * cos_t(theta_h) * cos_m - theta_h.sin() * sin_m;
         let top = critical.unwrap_or(FRAC_PI_2);
-        let refracted_entry = (g(top) < 0.0).then(|| {
-            let (mut lo, mut hi) = (0.0, top);
-            for _ in 0..60 {
-                let mid = 0.5 * (lo + hi);
-                if g(mid) > 0.0 {
-                    lo = mid;
-                } else {
-                    hi = mid;
-                }
-            }
-            0.5 * (lo + hi)
-        });
+        let refracted_entry = (g(top) < 0.0).then(|| bisect(0.0, top, 60, |t| g(t) > 0.0));
         let mut breaks = vec![0.0, FRAC_PI_2, entry];
         let mut singular = vec![entry];
         if let Some(c) = critical {

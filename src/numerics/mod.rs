@@ -2,6 +2,7 @@
 //! Disney diffuse albedo), the integrators and the tables all use. Nothing here knows about
 //! microfacets.
 
+pub mod bisection;
 pub mod elementary;
 pub mod gauss_kronrod;
 pub mod gauss_legendre;
