@@ -1,8 +1,9 @@
-//! A polynomial fit ([`super::polynomial`]) as text: a formula file kiln audits
-//! (`kiln verify --fit FILE.toml`) and functions in WGSL, GLSL, HLSL, Rust and C that compute
-//! the same formula in f32.
+//! A fit kiln made ([`super::polynomial`], [`super::rational`]) as text: a formula file kiln
+//! audits (`kiln verify --fit FILE.toml`) and functions in WGSL, GLSL, HLSL, Rust and C that
+//! compute the same formula in f32.
 
 use super::polynomial::PolynomialFit;
+use super::rational::{R_POWER, RationalFit, T_POWER, T_SCALE};
 
 /// The languages a fit is written in, with their file extensions.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
@@ -43,44 +44,231 @@ impl FitFormat {
     }
 }
 
+/// What a fit kiln made says of itself in the files it is written to.
+pub trait FitText {
+    /// The file stem and function name: `ggx_height_correlated_e_fit_t5_r4`.
+    fn function_name(&self) -> String;
+    /// What the fit is, in which coordinates, with its audited maximum error and the command
+    /// that made it.
+    fn description(&self, max_error: f64, command: &str) -> String;
+    /// The function's body in `syntax`, after its signature.
+    fn body(&self, syntax: &Syntax) -> String;
+    /// The formula file's `source`, `define` lines and `E`.
+    fn formula(&self) -> (String, Vec<String>, String);
+}
+
+fn model_stem(model: crate::model::Model) -> String {
+    format!("{}_{}", model.ndf, model.masking.name().replace('-', "_"))
+}
+
 /// The file stem and function name: `ggx_height_correlated_e_fit_t5_r4`.
 #[must_use]
-pub fn function_name(fit: &PolynomialFit) -> String {
-    format!(
-        "{}_{}_e_fit_t{}_r{}",
-        fit.model.ndf,
-        fit.model.masking.name().replace('-', "_"),
-        fit.degrees.t,
-        fit.degrees.r
-    )
+pub fn function_name(fit: &impl FitText) -> String {
+    fit.function_name()
 }
 
 /// What every emitted file says of the fit: what it approximates, in which coordinates, and
 /// its audited maximum error with the command that reproduces it.
 #[must_use]
-pub fn description(fit: &PolynomialFit, max_error: f64, command: &str) -> String {
-    format!(
-        "E of {} (F = 1) as a polynomial of degree {} in u = 2 t - 1 and {} in v = 2 r - 1 \
-         ({} coefficients), t = (mu (1 + 4 alpha) / (mu + 4 alpha))^0.4, alpha = r^2 (kiln's \
-         adaptive axis); max error {max_error:.2e} over mu in [0, 1], r in [0, 1] against kiln's \
-         reference (kiln verify --fit); made by `{command}`",
-        fit.model,
-        fit.degrees.t,
-        fit.degrees.r,
-        fit.degrees.coefficients()
-    )
+pub fn description(fit: &impl FitText, max_error: f64, command: &str) -> String {
+    fit.description(max_error, command)
+}
+
+impl FitText for PolynomialFit {
+    fn function_name(&self) -> String {
+        format!(
+            "{}_e_fit_t{}_r{}",
+            model_stem(self.model),
+            self.degrees.t,
+            self.degrees.r
+        )
+    }
+
+    fn description(&self, max_error: f64, command: &str) -> String {
+        format!(
+            "E of {} (F = 1) as a polynomial of degree {} in u = 2 t - 1 and {} in v = 2 r - 1 \
+             ({} coefficients), t = (mu (1 + 4 alpha) / (mu + 4 alpha))^0.4, alpha = r^2 \
+             (kiln's adaptive axis); max error {max_error:.2e} over mu in [0, 1], r in [0, 1] \
+             against kiln's reference (kiln verify --fit); made by `{command}`",
+            self.model,
+            self.degrees.t,
+            self.degrees.r,
+            self.degrees.coefficients()
+        )
+    }
+
+    fn body(&self, syntax: &Syntax) -> String {
+        let number = syntax.number;
+        let c = syntax.constant;
+        let (one, two) = (number(1.0), number(2.0));
+        let mut out = format!("    {c} k = {} * r * r;\n", number(4.0));
+        out += &format!("    {c} t = {};\n", syntax.t.replace("{p}", "0.4"));
+        out += &format!("    {c} u = {two} * t - {one};\n");
+        out += &format!("    {c} v = {two} * r - {one};\n");
+        out += &polynomial_lines(syntax, "e", &self.coefficients, self.degrees.r + 1, "v");
+        out + "    return e;\n"
+    }
+
+    fn formula(&self) -> (String, Vec<String>, String) {
+        let number = |c: f64| format!("{c:?}");
+        let nr = self.degrees.r + 1;
+        let rows: Vec<&[f64]> = self.coefficients.chunks(nr).collect();
+        let mut defines = vec![
+            "k = 4 * alpha".to_string(),
+            "t = pow(min(mu * (1 + k) / max(mu + k, 1e-30), 1), 0.4)".to_string(),
+            "u = 2 * t - 1".to_string(),
+            "v = 2 * r - 1".to_string(),
+        ];
+        for (i, row) in rows.iter().enumerate() {
+            defines.push(format!("p{i} = {}", horner(row, "v", number)));
+        }
+        let source = format!(
+            "kiln fit: {} coefficients, degrees {} in u and {} in v",
+            self.degrees.coefficients(),
+            self.degrees.t,
+            self.degrees.r
+        );
+        (source, defines, nested("p", rows.len()))
+    }
+}
+
+impl FitText for RationalFit {
+    fn function_name(&self) -> String {
+        let (p, q) = (self.shape.numerator, self.shape.denominator);
+        format!(
+            "{}_e_fit_p{}_{}_q{}_{}",
+            model_stem(self.model),
+            p.t,
+            p.r,
+            q.t,
+            q.r
+        )
+    }
+
+    fn description(&self, max_error: f64, command: &str) -> String {
+        let (p, q) = (self.shape.numerator, self.shape.denominator);
+        let c = if T_SCALE == 1.0 {
+            String::new()
+        } else {
+            format!("{T_SCALE} ")
+        };
+        format!(
+            "E of {} (F = 1) as the rational 1 - t^2 P(u, s) / Q(u, s), P of degree {} in \
+             u = 2 t - 1 and {} in s = 2 r^{R_POWER} - 1, Q of degrees {} and {} with constant \
+             term 1 ({} coefficients), t = (mu (1 + {c}alpha) / (mu + {c}alpha))^{T_POWER}, \
+             alpha = r^2; max error {max_error:.2e} over mu in [0, 1], r in \
+             [0, 1] against kiln's reference (kiln verify --fit); made by `{command}`",
+            self.model,
+            p.t,
+            p.r,
+            q.t,
+            q.r,
+            self.shape.coefficients()
+        )
+    }
+
+    fn body(&self, syntax: &Syntax) -> String {
+        let number = syntax.number;
+        let c = syntax.constant;
+        let (one, two) = (number(1.0), number(2.0));
+        let mut out = if T_SCALE == 1.0 {
+            format!("    {c} k = r * r;\n")
+        } else {
+            format!("    {c} k = {} * r * r;\n", number(T_SCALE))
+        };
+        out += &format!(
+            "    {c} t = {};\n",
+            syntax.t.replace("{p}", &format!("{T_POWER:?}"))
+        );
+        out += &format!("    {c} u = {two} * t - {one};\n");
+        out += &format!(
+            "    {c} s = {two} * {} - {one};\n",
+            syntax.power_of_r.replace("{p}", &format!("{R_POWER:?}"))
+        );
+        let (p, q) = (self.shape.numerator, self.shape.denominator);
+        out += &polynomial_lines(syntax, "n", &self.numerator, p.r + 1, "s");
+        out += &polynomial_lines(syntax, "d", &self.denominator, q.r + 1, "s");
+        out + &format!("    return {one} - t * t * n / d;\n")
+    }
+
+    fn formula(&self) -> (String, Vec<String>, String) {
+        let number = |c: f64| format!("{c:?}");
+        let mut defines = vec![
+            format!("k = {T_SCALE:?} * alpha").replace("1.0 * ", ""),
+            format!("t = pow(min(mu * (1 + k) / max(mu + k, 1e-30), 1), {T_POWER:?})"),
+            "u = 2 * t - 1".to_string(),
+            format!("s = 2 * pow(r, {R_POWER:?}) - 1"),
+        ];
+        let (p, q) = (self.shape.numerator, self.shape.denominator);
+        let numerator: Vec<&[f64]> = self.numerator.chunks(p.r + 1).collect();
+        let denominator: Vec<&[f64]> = self.denominator.chunks(q.r + 1).collect();
+        for (i, row) in numerator.iter().enumerate() {
+            defines.push(format!("n{i} = {}", horner(row, "s", number)));
+        }
+        for (i, row) in denominator.iter().enumerate() {
+            defines.push(format!("d{i} = {}", horner(row, "s", number)));
+        }
+        defines.push(format!("n = {}", nested("n", numerator.len())));
+        defines.push(format!("d = {}", nested("d", denominator.len())));
+        let source = format!(
+            "kiln fit: {} coefficients, P of degrees {} in u and {} in s, Q of degrees {} and {}",
+            self.shape.coefficients(),
+            p.t,
+            p.r,
+            q.t,
+            q.r
+        );
+        (source, defines, "1 - t * t * n / d".to_string())
+    }
+}
+
+/// `{name}0 + u * ({name}1 + u * (...))` of `rows` named rows.
+fn nested(name: &str, rows: usize) -> String {
+    let mut e = format!("{name}{}", rows - 1);
+    for i in (0..rows - 1).rev() {
+        e = format!("{name}{i} + u * ({e})");
+    }
+    e
+}
+
+/// `variable` as a polynomial in `u` (outer) and `inner` by Horner's rule, rows of `width`
+/// coefficients, one statement per row.
+fn polynomial_lines(
+    syntax: &Syntax,
+    variable: &str,
+    coefficients: &[f64],
+    width: usize,
+    inner: &str,
+) -> String {
+    let number = syntax.number;
+    let rows: Vec<&[f64]> = coefficients.chunks(width).collect();
+    let last = rows.len() - 1;
+    let mut out = format!(
+        "    {} {variable} = {};\n",
+        syntax.variable,
+        horner(rows[last], inner, number)
+    );
+    for row in rows[..last].iter().rev() {
+        out += &format!(
+            "    {variable} = {variable} * u + {};\n",
+            horner(row, inner, number)
+        );
+    }
+    out
 }
 
 /// One language's spelling of the statements a fit needs.
-struct Syntax {
+pub struct Syntax {
     /// The signature with `{name}` and `{params}` to fill.
     signature: &'static str,
     params: &'static str,
     /// `let` of an immutable f32, a mutable one.
     constant: &'static str,
     variable: &'static str,
-    /// The adaptive `t` of `mu` given `k = 4 alpha`.
+    /// The adaptive `t` of `mu` given `k` (`c alpha`), its power `{p}`.
     t: &'static str,
+    /// `r^{p}`.
+    power_of_r: &'static str,
     comment: &'static str,
     close: &'static str,
     /// How a number is written.
@@ -105,7 +293,8 @@ const WGSL: Syntax = Syntax {
     params: "mu: f32, r: f32",
     constant: "let",
     variable: "var",
-    t: "pow(min(mu * (1.0 + k) / max(mu + k, 1e-30), 1.0), 0.4)",
+    t: "pow(min(mu * (1.0 + k) / max(mu + k, 1e-30), 1.0), {p})",
+    power_of_r: "pow(r, {p})",
     comment: "//",
     close: "}",
     number: shader_number,
@@ -116,7 +305,8 @@ const GLSL: Syntax = Syntax {
     params: "float mu, float r",
     constant: "float",
     variable: "float",
-    t: "pow(min(mu * (1.0 + k) / max(mu + k, 1e-30), 1.0), 0.4)",
+    t: "pow(min(mu * (1.0 + k) / max(mu + k, 1e-30), 1.0), {p})",
+    power_of_r: "pow(r, {p})",
     comment: "//",
     close: "}",
     number: shader_number,
@@ -127,7 +317,8 @@ const RUST: Syntax = Syntax {
     params: "mu: f32, r: f32",
     constant: "let",
     variable: "let mut",
-    t: "(mu * (1.0 + k) / (mu + k).max(1e-30)).min(1.0).powf(0.4)",
+    t: "(mu * (1.0 + k) / (mu + k).max(1e-30)).min(1.0).powf({p})",
+    power_of_r: "r.powf({p})",
     comment: "//",
     close: "}",
     number: rust_number,
@@ -138,7 +329,8 @@ const C: Syntax = Syntax {
     params: "float mu, float r",
     constant: "const float",
     variable: "float",
-    t: "powf(fminf(mu * (1.0f + k) / fmaxf(mu + k, 1e-30f), 1.0f), 0.4f)",
+    t: "powf(fminf(mu * (1.0f + k) / fmaxf(mu + k, 1e-30f), 1.0f), {p}f)",
+    power_of_r: "powf(r, {p}f)",
     comment: "//",
     close: "}",
     number: c_number,
@@ -156,11 +348,7 @@ fn horner(coefficients: &[f64], variable: &str, number: fn(f64) -> String) -> St
     out + &")".repeat(coefficients.len().saturating_sub(1))
 }
 
-fn code(fit: &PolynomialFit, syntax: &Syntax, header: &str, text: &str) -> String {
-    let name = function_name(fit);
-    let number = syntax.number;
-    let nr = fit.degrees.r + 1;
-    let rows: Vec<&[f64]> = fit.coefficients.chunks(nr).collect();
+fn code(fit: &impl FitText, syntax: &Syntax, header: &str, text: &str) -> String {
     let mut out = String::new();
     for line in text.split(". ") {
         out += &format!("{} {line}\n", syntax.comment);
@@ -168,26 +356,10 @@ fn code(fit: &PolynomialFit, syntax: &Syntax, header: &str, text: &str) -> Strin
     out += header;
     out += &syntax
         .signature
-        .replace("{name}", &name)
+        .replace("{name}", &fit.function_name())
         .replace("{params}", syntax.params);
     out += "\n";
-    let c = syntax.constant;
-    let one = number(1.0);
-    let two = number(2.0);
-    out += &format!("    {c} k = {} * r * r;\n", number(4.0));
-    out += &format!("    {c} t = {};\n", syntax.t);
-    out += &format!("    {c} u = {two} * t - {one};\n");
-    out += &format!("    {c} v = {two} * r - {one};\n");
-    let last = rows.len() - 1;
-    out += &format!(
-        "    {} e = {};\n",
-        syntax.variable,
-        horner(rows[last], "v", number)
-    );
-    for row in rows[..last].iter().rev() {
-        out += &format!("    e = e * u + {};\n", horner(row, "v", number));
-    }
-    out += "    return e;\n";
+    out += &fit.body(syntax);
     out += syntax.close;
     out += "\n";
     out
@@ -195,7 +367,7 @@ fn code(fit: &PolynomialFit, syntax: &Syntax, header: &str, text: &str) -> Strin
 
 /// The fit in `format`; `description` (from [`description`]) heads the file.
 #[must_use]
-pub fn emit(fit: &PolynomialFit, format: FitFormat, description: &str) -> String {
+pub fn emit(fit: &impl FitText, format: FitFormat, description: &str) -> String {
     match format {
         FitFormat::Toml => formula_file(fit, description),
         FitFormat::Wgsl => code(fit, &WGSL, "", description),
@@ -209,33 +381,13 @@ pub fn emit(fit: &PolynomialFit, format: FitFormat, description: &str) -> String
     }
 }
 
-/// The formula file: the same polynomial in kiln's formula language ([`super::formula`]),
+/// The formula file: the same fit in kiln's formula language ([`super::formula`]),
 /// coefficients with every digit of their f64 value.
-fn formula_file(fit: &PolynomialFit, description: &str) -> String {
-    let number = |c: f64| format!("{c:?}");
-    let nr = fit.degrees.r + 1;
-    let rows: Vec<&[f64]> = fit.coefficients.chunks(nr).collect();
-    let mut defines = vec![
-        "k = 4 * alpha".to_string(),
-        "t = pow(min(mu * (1 + k) / max(mu + k, 1e-30), 1), 0.4)".to_string(),
-        "u = 2 * t - 1".to_string(),
-        "v = 2 * r - 1".to_string(),
-    ];
-    for (i, row) in rows.iter().enumerate() {
-        defines.push(format!("p{i} = {}", horner(row, "v", number)));
-    }
-    let mut e = format!("p{}", rows.len() - 1);
-    for i in (0..rows.len() - 1).rev() {
-        e = format!("p{i} + u * ({e})");
-    }
+fn formula_file(fit: &impl FitText, description: &str) -> String {
+    let (source, defines, e) = fit.formula();
     let mut out = format!("# {description}\n");
-    out += &format!("name = \"{}\"\n", function_name(fit));
-    out += &format!(
-        "source = \"kiln fit: {} coefficients, degrees {} in u and {} in v\"\n",
-        fit.degrees.coefficients(),
-        fit.degrees.t,
-        fit.degrees.r
-    );
+    out += &format!("name = \"{}\"\n", fit.function_name());
+    out += &format!("source = \"{source}\"\n");
     out += "define = [\n";
     for d in &defines {
         out += &format!("  \"{d}\",\n");
@@ -243,4 +395,73 @@ fn formula_file(fit: &PolynomialFit, description: &str) -> String {
     out += "]\n";
     out += &format!("E = \"{e}\"\n");
     out
+}
+
+/// Either kind of fit kiln makes.
+#[derive(Clone, Debug, PartialEq)]
+pub enum MadeFit {
+    Polynomial(PolynomialFit),
+    Rational(RationalFit),
+}
+
+impl MadeFit {
+    /// The number of coefficients.
+    #[must_use]
+    pub fn coefficients(&self) -> usize {
+        match self {
+            MadeFit::Polynomial(fit) => fit.degrees.coefficients(),
+            MadeFit::Rational(fit) => fit.shape.coefficients(),
+        }
+    }
+
+    /// The shape as `--degrees` spells it: `T,R` or `PT,PR/QT,QR`.
+    #[must_use]
+    pub fn degrees_text(&self) -> String {
+        match self {
+            MadeFit::Polynomial(fit) => format!("{},{}", fit.degrees.t, fit.degrees.r),
+            MadeFit::Rational(fit) => {
+                let (p, q) = (fit.shape.numerator, fit.shape.denominator);
+                format!("{},{}/{},{}", p.t, p.r, q.t, q.r)
+            }
+        }
+    }
+
+    /// The value at `mu` and the perceptual roughness `r`, in f64.
+    #[must_use]
+    pub fn value(&self, mu: f64, r: f64) -> f64 {
+        match self {
+            MadeFit::Polynomial(fit) => fit.value(mu, r),
+            MadeFit::Rational(fit) => fit.value(mu, r),
+        }
+    }
+}
+
+impl FitText for MadeFit {
+    fn function_name(&self) -> String {
+        match self {
+            MadeFit::Polynomial(fit) => fit.function_name(),
+            MadeFit::Rational(fit) => fit.function_name(),
+        }
+    }
+
+    fn description(&self, max_error: f64, command: &str) -> String {
+        match self {
+            MadeFit::Polynomial(fit) => fit.description(max_error, command),
+            MadeFit::Rational(fit) => fit.description(max_error, command),
+        }
+    }
+
+    fn body(&self, syntax: &Syntax) -> String {
+        match self {
+            MadeFit::Polynomial(fit) => fit.body(syntax),
+            MadeFit::Rational(fit) => fit.body(syntax),
+        }
+    }
+
+    fn formula(&self) -> (String, Vec<String>, String) {
+        match self {
+            MadeFit::Polynomial(fit) => fit.formula(),
+            MadeFit::Rational(fit) => fit.formula(),
+        }
+    }
 }

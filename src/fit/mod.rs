@@ -1,12 +1,14 @@
 //! Texture-free fits of the directional albedo: the ones engines ship ([`engine`]) and any given
 //! as a formula file ([`FormulaFit`], in the language of [`formula`]), each a function of `mu`
 //! and the perceptual roughness `r` (`alpha = r^2`) for some of `E`, `E_scale`, `E_bias`.
-//! `kiln verify --fit` audits them ([`crate::verify::fit`]).
+//! `kiln verify --fit` audits them ([`crate::verify::fit`]). The fits kiln makes itself are
+//! [`polynomial`] and [`rational`], written out by [`emit`].
 
 pub mod emit;
 pub mod engine;
 pub mod formula;
 pub mod polynomial;
+pub mod rational;
 
 use crate::error::{Error, Result};
 use crate::integrate::quantity::Quantity;

@@ -55,7 +55,7 @@ pub fn adaptive_t(mu: f64, alpha: f64) -> f64 {
 }
 
 /// Chebyshev polynomials `T_0..=T_n` at `x`.
-fn chebyshev(x: f64, n: usize) -> Vec<f64> {
+pub(crate) fn chebyshev(x: f64, n: usize) -> Vec<f64> {
     let mut t = vec![1.0; n + 1];
     if n >= 1 {
         t[1] = x;
@@ -67,7 +67,7 @@ fn chebyshev(x: f64, n: usize) -> Vec<f64> {
 }
 
 /// The power-basis coefficients of `T_0..=T_n` (row `k`: `T_k = sum_i m[k][i] x^i`).
-fn chebyshev_to_power(n: usize) -> Vec<Vec<f64>> {
+pub(crate) fn chebyshev_to_power(n: usize) -> Vec<Vec<f64>> {
     let mut m = vec![vec![0.0; n + 1]; n + 1];
     m[0][0] = 1.0;
     if n >= 1 {

@@ -7,3 +7,4 @@ pub mod elementary;
 pub mod gauss_kronrod;
 pub mod gauss_legendre;
 pub mod minimax;
+pub mod simplex;

@@ -326,15 +326,15 @@ fn error_map(quantity: Quantity, found: &[FitPoint], worst: FitPoint) -> ErrorMa
     }
 }
 
-/// Audits a polynomial fit kiln made ([`crate::fit::polynomial`]) as what it writes: the
-/// formula file's text ([`crate::fit::emit`]) parsed back and audited by [`audit_fit`], so that
-/// the maximum stated is that of the formula a user pastes.
+/// Audits a fit kiln made ([`crate::fit::polynomial`], [`crate::fit::rational`]) as what it
+/// writes: the formula file's text ([`crate::fit::emit`]) parsed back and audited by
+/// [`audit_fit`], so that the maximum stated is that of the formula a user pastes.
 ///
 /// # Panics
 /// If kiln's own formula file does not parse (a bug).
 #[must_use]
-pub fn audit_polynomial(
-    fit: &crate::fit::polynomial::PolynomialFit,
+pub fn audit_emitted(
+    fit: &impl crate::fit::emit::FitText,
     settings: &FitAuditSettings,
     progress: &(dyn Fn() + Sync),
 ) -> FitReport {

@@ -1,28 +1,34 @@
-//! `kiln fit`: a texture-free polynomial fit of `E` with its audited maximum error
-//! ([`kiln::fit::polynomial`], [`kiln::fit::emit`]).
+//! `kiln fit`: a texture-free polynomial or rational fit of `E` with its audited maximum error
+//! ([`kiln::fit::polynomial`], [`kiln::fit::rational`], [`kiln::fit::emit`]).
 
 use clap::Args;
-use kiln::fit::emit::{FitFormat, description, emit, function_name};
-use kiln::fit::polynomial::{Degrees, PolynomialFit, fit_to, truth_points};
-use kiln::verify::fit::{FitAuditSettings, audit_polynomial};
+use kiln::fit::emit::{FitFormat, FitText, MadeFit, emit};
+use kiln::fit::polynomial::{Degrees, fit_to, truth_points};
+use kiln::fit::rational::{RationalShape, coordinates_of};
+use kiln::verify::fit::{FitAuditSettings, audit_emitted};
 use kiln::{Masking, Model, Ndf};
 use std::path::PathBuf;
 
 /// Fit E(mu, r) without a texture, with its audited maximum error, as shader code
 ///
-/// A polynomial in kiln's adaptive coordinates (t = (mu (1 + 4
-/// alpha) / (mu + 4 alpha))^0.4 and r, alpha = r^2) chosen in the maximum norm against kiln's
+/// A polynomial in kiln's adaptive coordinates (t = (mu (1 + 4 alpha) / (mu + 4 alpha))^0.4
+/// and r, alpha = r^2), or a rational 1 - t^2 P / Q in coordinates of the same kind (t = (mu
+/// (1 + alpha) / (mu + alpha))^0.3 and r^3.2), chosen in the maximum norm against kiln's
 /// reference, written as a formula file and as WGSL, GLSL, HLSL, Rust and C functions. The
 /// maximum error printed and written beside each fit is the audit's (`kiln verify --fit` of the
 /// formula file written), over mu in [0, 1] and r in [0, 1], both ends included. `--sweep`
 /// prints what each size costs instead. See docs/fits.md.
 #[derive(Args, Debug)]
 pub struct FitArgs {
-    /// Degrees in t and in r, as T,R: (T + 1) (R + 1) coefficients, each 1 to 12.
-    #[arg(long, default_value = "5,4", value_parser = parse_degrees)]
-    degrees: Degrees,
-    /// Print the maximum error of fits of several sizes (12 to 64 coefficients) instead of
-    /// writing one.
+    /// The fit's shape. T,R: a polynomial of degree T in t and R in r, (T + 1) (R + 1)
+    /// coefficients. PT,PR/QT,QR: the rational 1 - t^2 P / Q, P of degrees PT, PR and Q of
+    /// degrees QT, QR (in t and r^3.2), (PT + 1) (PR + 1) + (QT + 1) (QR + 1) - 1
+    /// coefficients; 3,3/3,3 is 31 coefficients within 1e-3. Each degree 1 to 12 (R, PR, QR
+    /// from 0).
+    #[arg(long, default_value = "5,4", value_parser = parse_shape)]
+    degrees: Shape,
+    /// Print the maximum error of fits of several sizes, polynomial (12 to 64 coefficients)
+    /// and rational (7 to 31), instead of writing one.
     #[arg(long, conflicts_with_all = ["degrees", "out", "format"])]
     sweep: bool,
     /// With --sweep: draw the maximum error against the coefficient count into FILE.svg or
@@ -50,19 +56,41 @@ pub struct FitArgs {
     quiet: bool,
 }
 
-fn parse_degrees(text: &str) -> Result<Degrees, String> {
-    let bad = || format!("'{text}': give the degrees in t and r as T,R, each 1 to 12 (5,4)");
-    let (t, r) = text.split_once(',').ok_or_else(bad)?;
-    let parse = |s: &str| {
-        s.trim()
-            .parse::<usize>()
-            .ok()
-            .filter(|d| (1..=12).contains(d))
+/// What `--degrees` asks for.
+#[derive(Clone, Copy, Debug)]
+pub enum Shape {
+    Polynomial(Degrees),
+    Rational(RationalShape),
+}
+
+fn parse_shape(text: &str) -> Result<Shape, String> {
+    let bad = || {
+        format!(
+            "'{text}': give the degrees in t and r as T,R (a polynomial, 5,4) or as \
+             PT,PR/QT,QR (the rational 1 - t^2 P / Q, 3,3/3,3), each 1 to 12 in t and 0 to 12 \
+             in r (1 to 12 for a polynomial)"
+        )
     };
-    Ok(Degrees {
-        t: parse(t).ok_or_else(bad)?,
-        r: parse(r).ok_or_else(bad)?,
-    })
+    let degrees = |part: &str, lowest_r: usize| {
+        let (t, r) = part.split_once(',')?;
+        let parse = |s: &str, lowest: usize| {
+            s.trim()
+                .parse::<usize>()
+                .ok()
+                .filter(|d| (lowest..=12).contains(d))
+        };
+        Some(Degrees {
+            t: parse(t, 1)?,
+            r: parse(r, lowest_r)?,
+        })
+    };
+    match text.split_once('/') {
+        None => degrees(text, 1).map(Shape::Polynomial).ok_or_else(bad),
+        Some((p, q)) => Ok(Shape::Rational(RationalShape {
+            numerator: degrees(p, 0).ok_or_else(bad)?,
+            denominator: degrees(q, 0).ok_or_else(bad)?,
+        })),
+    }
 }
 
 /// The shapes `--sweep` tries, by coefficient count.
@@ -78,19 +106,52 @@ const SWEEP: [(usize, usize); 9] = [
     (7, 7),
 ];
 
+/// The rational shapes `--sweep` tries, as (P, Q) degrees.
+const RATIONAL_SWEEP: [((usize, usize), (usize, usize)); 5] = [
+    ((1, 1), (1, 1)),
+    ((1, 1), (2, 2)),
+    ((2, 2), (2, 2)),
+    ((3, 3), (2, 2)),
+    ((3, 3), (3, 3)),
+];
+
 /// A fit and its audit: the formula file's text and the audited maximum.
 struct Audited {
-    fit: PolynomialFit,
+    fit: MadeFit,
     max_error: f64,
     worst: (f64, f64),
 }
 
-fn audited(fit: PolynomialFit, model: Model) -> Audited {
+/// Makes the fit of `shape` against `truth` (the polynomial fit's points).
+fn make(
+    model: Model,
+    shape: Shape,
+    truth: &[((f64, f64), f64)],
+    quiet: bool,
+) -> kiln::Result<MadeFit> {
+    Ok(match shape {
+        Shape::Polynomial(degrees) => MadeFit::Polynomial(fit_to(model, degrees, truth)),
+        Shape::Rational(shape) => {
+            let bar = crate::progress_bar(quiet, 0, "rational fit steps");
+            let fit =
+                kiln::fit::rational::fit_to(model, shape, &coordinates_of(truth), &|| bar.inc(1));
+            bar.finish_and_clear();
+            MadeFit::Rational(fit.map_err(|e| {
+                kiln::Error::InvalidInput(format!(
+                    "the rational fit's linear program failed ({e}); a smaller shape may \
+                     succeed, and this is worth reporting"
+                ))
+            })?)
+        }
+    })
+}
+
+fn audited(fit: MadeFit, model: Model) -> Audited {
     let settings = FitAuditSettings {
         model,
         ..FitAuditSettings::default()
     };
-    let report = audit_polynomial(&fit, &settings, &|| {});
+    let report = audit_emitted(&fit, &settings, &|| {});
     let e = &report.quantities[0];
     Audited {
         fit,
@@ -116,13 +177,27 @@ pub fn run(args: FitArgs) -> kiln::Result<()> {
     let truth = truth_points(model, &|| bar.inc(1));
     bar.finish_and_clear();
     if args.sweep {
+        let shapes = SWEEP
+            .iter()
+            .map(|&(t, r)| Shape::Polynomial(Degrees { t, r }))
+            .chain(RATIONAL_SWEEP.iter().map(|&((pt, pr), (qt, qr))| {
+                Shape::Rational(RationalShape {
+                    numerator: Degrees { t: pt, r: pr },
+                    denominator: Degrees { t: qt, r: qr },
+                })
+            }));
         let mut fits = Vec::new();
-        for (t, r) in SWEEP {
-            let a = audited(fit_to(model, Degrees { t, r }, &truth), model);
+        for shape in shapes {
+            let a = audited(make(model, shape, &truth, quiet)?, model);
             if !quiet {
+                let kind = match a.fit {
+                    MadeFit::Polynomial(_) => "polynomial",
+                    MadeFit::Rational(_) => "rational",
+                };
                 println!(
-                    "{:>3} coefficients (degrees {t}, {r}): max error {:.2e} at mu = {:.6}, r = {:.6}",
-                    a.fit.degrees.coefficients(),
+                    "{:>3} coefficients ({kind} {}): max error {:.2e} at mu = {:.6}, r = {:.6}",
+                    a.fit.coefficients(),
+                    a.fit.degrees_text(),
                     a.max_error,
                     a.worst.0,
                     a.worst.1
@@ -131,14 +206,16 @@ pub fn run(args: FitArgs) -> kiln::Result<()> {
             fits.push(a);
         }
         if let (Some(svg), Some(path)) = (svg, &args.plot) {
-            let points: Vec<(usize, f64)> = fits
-                .iter()
-                .map(|a| (a.fit.degrees.coefficients(), a.max_error))
-                .collect();
+            let points = |rational: bool| -> Vec<(usize, f64)> {
+                fits.iter()
+                    .filter(|a| matches!(a.fit, MadeFit::Rational(_)) == rational)
+                    .map(|a| (a.fit.coefficients(), a.max_error))
+                    .collect()
+            };
             crate::verify::write_plot(
                 path,
                 svg,
-                crate::plot::fit_sweep_plot(&model.to_string(), &points),
+                crate::plot::fit_sweep_plot(&model.to_string(), &points(false), &points(true)),
             )?;
         }
         if args.json {
@@ -146,8 +223,8 @@ pub fn run(args: FitArgs) -> kiln::Result<()> {
                 .iter()
                 .map(|a| {
                     serde_json::json!({
-                        "degrees": [a.fit.degrees.t, a.fit.degrees.r],
-                        "coefficients": a.fit.degrees.coefficients(),
+                        "degrees": a.fit.degrees_text(),
+                        "coefficients": a.fit.coefficients(),
                         "max_error": a.max_error,
                         "worst": {"mu": a.worst.0, "r": a.worst.1},
                     })
@@ -160,16 +237,18 @@ pub fn run(args: FitArgs) -> kiln::Result<()> {
         }
         return Ok(());
     }
-    let a = audited(fit_to(model, args.degrees, &truth), model);
+    let a = audited(make(model, args.degrees, &truth, quiet)?, model);
     let command = format!(
-        "kiln fit --ndf {} --masking {} --degrees {},{}",
-        model.ndf, model.masking, args.degrees.t, args.degrees.r
+        "kiln fit --ndf {} --masking {} --degrees {}",
+        model.ndf,
+        model.masking,
+        a.fit.degrees_text()
     );
-    let text = description(&a.fit, a.max_error, &command);
+    let text = a.fit.description(a.max_error, &command);
     let mut formats = args.format.unwrap_or_else(|| FitFormat::ALL.to_vec());
     formats.sort();
     formats.dedup();
-    let name = function_name(&a.fit);
+    let name = a.fit.function_name();
     let files: Vec<(String, Vec<u8>)> = formats
         .iter()
         .map(|&f| {
@@ -186,8 +265,8 @@ pub fn run(args: FitArgs) -> kiln::Result<()> {
             serde_json::json!({
                 "name": name,
                 "model": model.to_string(),
-                "degrees": [a.fit.degrees.t, a.fit.degrees.r],
-                "coefficients": a.fit.coefficients,
+                "degrees": a.fit.degrees_text(),
+                "coefficients": coefficients_json(&a.fit),
                 "max_error": a.max_error,
                 "worst": {"mu": a.worst.0, "r": a.worst.1},
                 "files": written,
@@ -197,7 +276,7 @@ pub fn run(args: FitArgs) -> kiln::Result<()> {
         println!(
             "{name}: {} coefficients, max error {:.2e} at mu = {:.6}, r = {:.6} (the audit of \
              {}/{name}.toml)",
-            a.fit.degrees.coefficients(),
+            a.fit.coefficients(),
             a.max_error,
             a.worst.0,
             a.worst.1,
@@ -206,4 +285,14 @@ pub fn run(args: FitArgs) -> kiln::Result<()> {
         println!("wrote {} files to {}", written.len(), out.display());
     }
     Ok(())
+}
+
+/// The fit's coefficients in `--json`: the polynomial's list, or the rational's `P` and `Q`.
+fn coefficients_json(fit: &MadeFit) -> serde_json::Value {
+    match fit {
+        MadeFit::Polynomial(fit) => serde_json::json!(fit.coefficients),
+        MadeFit::Rational(fit) => {
+            serde_json::json!({"numerator": fit.numerator, "denominator": fit.denominator})
+        }
+    }
 }

@@ -223,11 +223,21 @@ pub fn scaling_plot(
 }
 
 /// `kiln fit --sweep`: the audited maximum error of each fit against its coefficient count.
-pub fn fit_sweep_plot(model: &str, fits: &[(usize, f64)]) -> Result<(String, Vec<u8>), String> {
-    let series = [Series {
-        name: "kiln fit: polynomial in (t, r), audited max error".to_string(),
-        points: fits.iter().map(|&(k, e)| (k as f64, e)).collect(),
-    }];
+pub fn fit_sweep_plot(
+    model: &str,
+    polynomial: &[(usize, f64)],
+    rational: &[(usize, f64)],
+) -> Result<(String, Vec<u8>), String> {
+    let series = [
+        Series {
+            name: "kiln fit: polynomial in (t, r), audited max error".to_string(),
+            points: polynomial.iter().map(|&(k, e)| (k as f64, e)).collect(),
+        },
+        Series {
+            name: "kiln fit: rational 1 - t^2 P / Q in (t, r^3.2), audited max error".to_string(),
+            points: rational.iter().map(|&(k, e)| (k as f64, e)).collect(),
+        },
+    ];
     render(
         &format!("Texture-free fits of {model} E: size against accuracy"),
         "coefficients",
