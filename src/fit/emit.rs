@@ -3,7 +3,7 @@
 //! compute the same formula in f32.
 
 use super::polynomial::PolynomialFit;
-use super::rational::{R_POWER, RationalFit, T_POWER, T_SCALE};
+use super::rational::{R_POWER, RationalFit, T_POWER};
 
 /// The languages a fit is written in, with their file extensions.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
@@ -59,19 +59,6 @@ pub trait FitText {
 
 fn model_stem(model: crate::model::Model) -> String {
     format!("{}_{}", model.ndf, model.masking.name().replace('-', "_"))
-}
-
-/// The file stem and function name: `ggx_height_correlated_e_fit_t5_r4`.
-#[must_use]
-pub fn function_name(fit: &impl FitText) -> String {
-    fit.function_name()
-}
-
-/// What every emitted file says of the fit: what it approximates, in which coordinates, and
-/// its audited maximum error with the command that reproduces it.
-#[must_use]
-pub fn description(fit: &impl FitText, max_error: f64, command: &str) -> String {
-    fit.description(max_error, command)
 }
 
 impl FitText for PolynomialFit {
@@ -147,15 +134,10 @@ impl FitText for RationalFit {
 
     fn description(&self, max_error: f64, command: &str) -> String {
         let (p, q) = (self.shape.numerator, self.shape.denominator);
-        let c = if T_SCALE == 1.0 {
-            String::new()
-        } else {
-            format!("{T_SCALE} ")
-        };
         format!(
             "E of {} (F = 1) as the rational 1 - t^2 P(u, s) / Q(u, s), P of degree {} in \
              u = 2 t - 1 and {} in s = 2 r^{R_POWER} - 1, Q of degrees {} and {} with constant \
-             term 1 ({} coefficients), t = (mu (1 + {c}alpha) / (mu + {c}alpha))^{T_POWER}, \
+             term 1 ({} coefficients), t = (mu (1 + alpha) / (mu + alpha))^{T_POWER}, \
              alpha = r^2; max error {max_error:.2e} over mu in [0, 1], r in \
              [0, 1] against kiln's reference (kiln verify --fit); made by `{command}`",
             self.model,
@@ -171,11 +153,7 @@ impl FitText for RationalFit {
         let number = syntax.number;
         let c = syntax.constant;
         let (one, two) = (number(1.0), number(2.0));
-        let mut out = if T_SCALE == 1.0 {
-            format!("    {c} k = r * r;\n")
-        } else {
-            format!("    {c} k = {} * r * r;\n", number(T_SCALE))
-        };
+        let mut out = format!("    {c} k = r * r;\n");
         out += &format!(
             "    {c} t = {};\n",
             syntax.t.replace("{p}", &format!("{T_POWER:?}"))
@@ -194,7 +172,7 @@ impl FitText for RationalFit {
     fn formula(&self) -> (String, Vec<String>, String) {
         let number = |c: f64| format!("{c:?}");
         let mut defines = vec![
-            format!("k = {T_SCALE:?} * alpha").replace("1.0 * ", ""),
+            "k = alpha".to_string(),
             format!("t = pow(min(mu * (1 + k) / max(mu + k, 1e-30), 1), {T_POWER:?})"),
             "u = 2 * t - 1".to_string(),
             format!("s = 2 * pow(r, {R_POWER:?}) - 1"),

@@ -25,8 +25,6 @@ use super::polynomial::{Degrees, chebyshev, chebyshev_to_power};
 use crate::model::Model;
 use crate::numerics::simplex::{LpError, minimize_from};
 
-/// `c` of the fit's `t`.
-pub const T_SCALE: f64 = 1.0;
 /// `p` of the fit's `t`.
 pub const T_POWER: f64 = 0.3;
 /// The power of `r` in the fit's roughness coordinate.
@@ -65,11 +63,10 @@ pub struct RationalFit {
     pub fit_max_error: f64,
 }
 
-/// The fit's `t` of `mu` at roughness `alpha`, as the emitted code computes it.
+/// The fit's `t` of `mu` at roughness `alpha` (`c = 1`), as the emitted code computes it.
 #[must_use]
 pub fn rational_t(mu: f64, alpha: f64) -> f64 {
-    let k = T_SCALE * alpha;
-    (mu * (1.0 + k) / (mu + k).max(1e-30))
+    (mu * (1.0 + alpha) / (mu + alpha).max(1e-30))
         .min(1.0)
         .powf(T_POWER)
 }
@@ -186,23 +183,21 @@ pub fn fit_to(
         let n: f64 = p.iter().zip(&x[..np]).map(|(a, b)| a * b).sum();
         (1.0 - n / d, d)
     };
-    let max_error = |x: &[f64]| {
+    let errors_of = |x: &[f64]| -> Vec<f64> {
         rows.iter()
             .map(|row| (at(x, row).0 - row.2).abs())
-            .fold(0.0_f64, f64::max)
+            .collect()
     };
+    let largest = |errors: &[f64]| errors.iter().copied().fold(0.0_f64, f64::max);
     // Start from P = 0, Q = 1: E = 1.
     let mut x = vec![0.0; unknowns];
     x[np] = 1.0;
-    let mut best = (max_error(&x), x.clone());
+    let mut errors = errors_of(&x);
+    let mut best = (largest(&errors), x.clone());
     let mut objective = vec![0.0; unknowns];
     objective[unknowns - 1] = 1.0;
     for _ in 0..MAX_STEPS {
-        let errors: Vec<f64> = rows
-            .iter()
-            .map(|row| (at(&x, row).0 - row.2).abs())
-            .collect();
-        let delta = errors.iter().copied().fold(0.0_f64, f64::max);
+        let delta = largest(&errors);
         let previous: Vec<f64> = rows.iter().map(|row| at(&x, row).1).collect();
         // A point's three constraints: |E Q - N| - delta Q <= z Q_k (E Q - N = (E - 1) Q +
         // t^2 P) and Q >= the floor.
@@ -279,7 +274,8 @@ pub fn fit_to(
         progress();
         let next = solution.x;
         let z = next[unknowns - 1];
-        let error = max_error(&next);
+        errors = errors_of(&next);
+        let error = largest(&errors);
         if error < best.0 {
             best = (error, next.clone());
         }

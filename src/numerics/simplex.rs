@@ -154,7 +154,7 @@ pub fn minimize_from(
         simplex.values.clone_from(&rhs);
         // Phase 1: drive the artificial columns (indices m..m+n) out; cost -1 on each.
         let phase_one = |j: usize| if j < m { 0.0 } else { -1.0 };
-        simplex.run(m + n, &phase_one, &column, &rhs, limit, true)?;
+        simplex.run(m + n, &phase_one, &column, &rhs, limit)?;
         if simplex
             .values
             .iter()
@@ -168,7 +168,7 @@ pub fn minimize_from(
     }
     // Phase 2: the dual objective -h . y; artificials may not re-enter.
     let phase_two = |j: usize| if j < m { -h[j] } else { 0.0 };
-    simplex.run(m, &phase_two, &column, &rhs, limit, false)?;
+    simplex.run(m, &phase_two, &column, &rhs, limit)?;
     let multipliers = simplex.multipliers(&phase_two);
     Ok(Solution {
         x: multipliers
@@ -238,7 +238,6 @@ impl Simplex {
         column: &(dyn Fn(usize, &mut [f64]) + Sync),
         rhs: &[f64],
         limit: usize,
-        phase_one: bool,
     ) -> Result<(), LpError> {
         let n = self.n;
         let mut a = vec![0.0; n];
@@ -295,12 +294,9 @@ impl Simplex {
                 }
             }
             if step == f64::INFINITY {
-                // The dual is unbounded: the primal has no feasible point. (Phase 1 is bounded.)
-                return Err(if phase_one {
-                    LpError::IterationLimit
-                } else {
-                    LpError::Infeasible
-                });
+                // The dual is unbounded: the primal has no feasible point. (Phase 1's objective
+                // is at most 0, so only phase 2 gets here.)
+                return Err(LpError::Infeasible);
             }
             let mut leaving = None;
             let mut pivot = 0.0;
