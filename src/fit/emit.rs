@@ -343,7 +343,7 @@ fn code(fit: &impl FitText, syntax: &Syntax, header: &str, text: &str) -> String
     out
 }
 
-/// The fit in `format`; `description` (from [`description`]) heads the file.
+/// The fit in `format`; `description` (from [`FitText::description`]) heads the file.
 #[must_use]
 pub fn emit(fit: &impl FitText, format: FitFormat, description: &str) -> String {
     match format {
