@@ -13,8 +13,10 @@
 //!     32    16  axis 0 descriptor  \  each: u32 quantity (1 = mu, 2 = r with alpha = r^2,
 //!     48    16  axis 1 descriptor  /  3 = alpha, 4 = eta), u32 mapping (mu: 0 = linear,
 //!                                     1 = sqrt: mu = t^2, 2 = adaptive:
-//!                                     t = (mu (1 + 4a) / (mu + 4a))^0.4; eta: 0 = linear,
-//!                                     1 = cycles: linear in sqrt((eta - 1) / (eta + 1))),
+//!                                     t = (mu (1 + 4a) / (mu + 4a))^0.4, 3 = glass: kiln's
+//!                                     glass layout, `table::glass_layout`; eta: 0 = linear,
+//!                                     1 = cycles: linear in sqrt((eta - 1) / (eta + 1)),
+//!                                     2 = blender, 3 = glass),
 //!                                     u32 grid (0 = centers (i + 0.5)/N, 1 = nodes i/(N - 1)),
 //!                                     u32: for eta the f32 bits of the axis' top eta_max,
 //!                                     otherwise 0; all zero for an absent axis
@@ -81,6 +83,7 @@ fn axis_descriptor(axis: Option<&Axis>) -> [u32; 4] {
                 MuMapping::Linear => 0,
                 MuMapping::Sqrt => 1,
                 MuMapping::Adaptive => 2,
+                MuMapping::Glass => 3,
             };
             [1, m, grid(g), 0]
         }
@@ -105,6 +108,7 @@ fn axis_descriptor(axis: Option<&Axis>) -> [u32; 4] {
                 IorMapping::Linear => 0,
                 IorMapping::Cycles => 1,
                 IorMapping::Blender => 2,
+                IorMapping::Glass => 3,
             };
             [4, m, grid(g), (max.0 as f32).to_bits()]
         }

@@ -8,6 +8,7 @@ use super::metadata::{KILN_VERSION, Metadata};
 use crate::model::RoughnessConvention;
 use crate::table::Table;
 use crate::table::axis::{ADAPTIVE_POWER, ADAPTIVE_SCALE, Axis, Grid, IorMapping, MuMapping};
+use crate::table::glass_layout;
 use std::fmt::Write as _;
 
 /// On every generated array: a measured value may happen to print like a mathematical constant
@@ -94,6 +95,16 @@ fn coordinate_code(axis: &Axis) -> String {
                 "if mu <= 0.0 {{\n        0.0\n    }} else {{\n        let k = {ADAPTIVE_SCALE:?} * alpha;\n        \
                  (mu * (1.0 + k) / (mu + k)).min(1.0).powf({ADAPTIVE_POWER:?})\n    }}"
             ),
+            MuMapping::Glass => format!(
+                "{{\n        {SATURATION}\n        let e = (eta - 1.0).max(0.0);\n        \
+                 let kappa = {:?} * e / (alpha + {:?} * e.sqrt()).max(1e-30);\n        \
+                 {:?} * a(mu, kappa, {:?}) + {:?} * a(mu, {ADAPTIVE_SCALE:?} * alpha, {ADAPTIVE_POWER:?})\n    }}",
+                glass_layout::LAYER_SCALE as f32,
+                glass_layout::LAYER_SQRT_WEIGHT as f32,
+                glass_layout::LAYER_SHARE as f32,
+                glass_layout::LAYER_POWER as f32,
+                (1.0 - glass_layout::LAYER_SHARE) as f32,
+            ),
         },
         Axis::Roughness { .. } => "roughness".to_string(),
         Axis::Ior { mapping, max, .. } => match mapping {
@@ -106,9 +117,24 @@ fn coordinate_code(axis: &Axis) -> String {
                 )
             }
             IorMapping::Blender => "((eta - 1.0) / (eta + 1.0)).max(0.0).sqrt()".to_string(),
+            IorMapping::Glass => format!(
+                "{{\n        {SATURATION}\n        \
+                 let x = (((eta - 1.0) / (eta + 1.0)).max(0.0) / {:?}_f32).min(1.0);\n        \
+                 {:?} * a(x, {:?} * alpha * alpha, {:?}) + {:?} * x.powf({:?})\n    }}",
+                glass_layout::reflectance_root(max.0) as f32,
+                glass_layout::IOR_SHARE as f32,
+                glass_layout::IOR_SCALE as f32,
+                glass_layout::IOR_POWER as f32,
+                (1.0 - glass_layout::IOR_SHARE) as f32,
+                glass_layout::IOR_POWER as f32,
+            ),
         },
     }
 }
+
+/// The glass layout's `A(y; k, p)` ([`glass_layout::saturation`]) as a local closure.
+const SATURATION: &str = "let a = |y: f32, k: f32, p: f32| if y <= 0.0 { 0.0 } else { \
+                          (y * (1.0 + k) / (y + k).max(1e-30)).min(1.0).powf(p) };";
 
 /// Each axis with its formula, for the lookups' doc comments.
 fn axis_formulas(spec: &crate::table::TableSpec) -> String {
@@ -249,6 +275,18 @@ fn write_ior_lookup(out: &mut String, table: &Table, prefix: &str, ty: &str) {
         out,
         "    let eta = if eta < 1.0 {{ 1.0 / eta }} else {{ eta }};"
     );
+    let alpha = match spec.roughness_convention() {
+        RoughnessConvention::Perceptual => "roughness * roughness",
+        RoughnessConvention::Alpha => "roughness",
+    };
+    if spec
+        .mu
+        .into_iter()
+        .chain(spec.ior)
+        .any(|axis| axis.depends_on_row())
+    {
+        let _ = writeln!(out, "    let alpha = {alpha};");
+    }
     let _ = writeln!(out, "    let t_eta = {};", coordinate_code(&ior));
     let _ = writeln!(
         out,
@@ -263,10 +301,6 @@ fn write_ior_lookup(out: &mut String, table: &Table, prefix: &str, ty: &str) {
         }
         (Some(roughness), mu) => {
             let n_r = roughness.size();
-            let alpha = match spec.roughness_convention() {
-                RoughnessConvention::Perceptual => "roughness * roughness",
-                RoughnessConvention::Alpha => "roughness",
-            };
             let _ = writeln!(
                 out,
                 "    let p_r = {};",
@@ -283,10 +317,6 @@ fn write_ior_lookup(out: &mut String, table: &Table, prefix: &str, ty: &str) {
                 }
                 Some(mu_axis) => {
                     let n_mu = mu_axis.size();
-                    if matches!(mu_axis, Axis::Mu { mapping, .. } if mapping.depends_on_roughness())
-                    {
-                        let _ = writeln!(out, "    let alpha = {alpha};");
-                    }
                     let _ = writeln!(out, "    let t_mu = {};", coordinate_code(&mu_axis));
                     let _ = writeln!(
                         out,

@@ -17,6 +17,7 @@ use super::metadata::{KILN_VERSION, Metadata};
 use crate::model::RoughnessConvention;
 use crate::table::Table;
 use crate::table::axis::{ADAPTIVE_POWER, ADAPTIVE_SCALE, Axis, Grid, IorMapping, MuMapping};
+use crate::table::glass_layout;
 use std::fmt::Write as _;
 
 /// A shading language.
@@ -100,6 +101,21 @@ fn coordinate(language: Language, axis: &Axis) -> String {
                 );
                 language.select("mu <= 0.0", "0.0", &t)
             }
+            MuMapping::Glass => {
+                let share = glass_layout::LAYER_SHARE;
+                format!(
+                    "{} * {} + {} * {}",
+                    literal(share),
+                    saturation(language, "mu", "kappa", glass_layout::LAYER_POWER),
+                    literal(1.0 - share),
+                    saturation(
+                        language,
+                        "mu",
+                        &format!("{} * alpha", literal(ADAPTIVE_SCALE)),
+                        ADAPTIVE_POWER
+                    )
+                )
+            }
         },
         Axis::Roughness { .. } => "roughness".to_string(),
         Axis::Ior { mapping, max, .. } => match mapping {
@@ -112,8 +128,37 @@ fn coordinate(language: Language, axis: &Axis) -> String {
                 )
             }
             IorMapping::Blender => "sqrt(max((eta_up - 1.0) / (eta_up + 1.0), 0.0))".to_string(),
+            IorMapping::Glass => {
+                let x = format!(
+                    "min(max((eta_up - 1.0) / (eta_up + 1.0), 0.0) / {}, 1.0)",
+                    literal(glass_layout::reflectance_root(max.0))
+                );
+                let share = glass_layout::IOR_SHARE;
+                format!(
+                    "{} * {} + {} * pow({x}, {})",
+                    literal(share),
+                    saturation(
+                        language,
+                        &x,
+                        &format!("{} * alpha * alpha", literal(glass_layout::IOR_SCALE)),
+                        glass_layout::IOR_POWER
+                    ),
+                    literal(1.0 - share),
+                    literal(glass_layout::IOR_POWER)
+                )
+            }
         },
     }
+}
+
+/// `A(y; k, p) = (y (1 + k) / (y + k))^p`, 0 at `y <= 0` (1 at `k = 0`, `y > 0`):
+/// [`glass_layout::saturation`].
+fn saturation(language: Language, y: &str, k: &str, p: f64) -> String {
+    let t = format!(
+        "pow(min(({y}) * (1.0 + {k}) / max(({y}) + {k}, 1e-30), 1.0), {})",
+        literal(p)
+    );
+    language.select(&format!("({y}) <= 0.0"), "0.0", &t)
 }
 
 /// The GPU texture coordinate of texture coordinate `t` on an axis of `n` samples.
@@ -148,7 +193,12 @@ fn parameters(language: Language, table: &Table) -> Vec<(&'static str, String)> 
 fn preamble(language: Language, table: &Table) -> String {
     let spec = &table.spec;
     let mut out = String::new();
-    if matches!(spec.mu, Some(Axis::Mu { mapping, .. }) if mapping.depends_on_roughness()) {
+    if spec
+        .mu
+        .into_iter()
+        .chain(spec.ior)
+        .any(|axis| axis.depends_on_row())
+    {
         let alpha = match spec.roughness_convention() {
             RoughnessConvention::Perceptual => "roughness * roughness",
             RoughnessConvention::Alpha => "roughness",
@@ -157,6 +207,17 @@ fn preamble(language: Language, table: &Table) -> String {
     }
     if spec.ior.is_some() {
         out += &language.local("eta_up", &language.select("eta < 1.0", "1.0 / eta", "eta"));
+    }
+    if matches!(spec.mu, Some(Axis::Mu { mapping, .. }) if mapping.depends_on_ior()) {
+        // The eta layer's width (table::glass_layout::layer_width).
+        out += &language.local(
+            "kappa",
+            &format!(
+                "{} * max(eta_up - 1.0, 0.0) / max(alpha + {} * sqrt(max(eta_up - 1.0, 0.0)), 1e-30)",
+                literal(glass_layout::LAYER_SCALE),
+                literal(glass_layout::LAYER_SQRT_WEIGHT)
+            ),
+        );
     }
     out
 }

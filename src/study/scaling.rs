@@ -13,7 +13,7 @@ use crate::bake::BakeOptions;
 use crate::integrate::reference::ReferenceSettings;
 use crate::integrate::value::Point;
 use crate::model::Model;
-use crate::table::axis::MuMapping;
+use crate::table::axis::{IorMapping, MuMapping};
 use crate::table::{Quantity, Table};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -179,13 +179,13 @@ pub fn log_log_slope(points: &[(f64, f64)]) -> f64 {
 
 /// The fixed lookup points of a table of `quantity`: `k` per axis at `(j + 0.37) / k` of each
 /// axis' physical range (roughness `r`, `mu`, and for the dielectric tables `eta` from 1 to the
-/// axis' top along kiln's default IOR mapping), off every node of the sizes studied.
+/// axis' top along Cycles' IOR mapping, whatever the layout studied), off every node of the sizes studied.
 fn lookup_points(quantity: Quantity, k: usize) -> Vec<Point> {
     let t = |j: usize| (j as f64 + 0.37) / k as f64;
     let etas: Vec<Option<f64>> = if quantity.has_ior() {
         let options = BakeOptions::default();
         (0..k)
-            .map(|j| Some(options.ior_mapping.eta(t(j), options.ior_max)))
+            .map(|j| Some(IorMapping::Cycles.eta(t(j), options.ior_max, 1.0)))
             .collect()
     } else {
         vec![None]

@@ -97,7 +97,7 @@ pub fn cycles_style_table(size: usize, samples: u32) -> Vec<f64> {
         .map(|k| {
             let (row, column) = (k / size, k % size);
             let alpha = roughness.alpha(row).max(1e-4) as f32;
-            let mu = mu_axis.value_at(column, 0.0).max(1e-4) as f32;
+            let mu = mu_axis.value_at(column, 0.0, 1.0).max(1e-4) as f32;
             cycles_style_albedo(alpha, mu, samples, mix_seed(&[0x6379_636c, k as u64]))
         })
         .collect()

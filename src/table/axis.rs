@@ -99,6 +99,11 @@ pub enum MuMapping {
     /// boundary layer `mu ~ alpha` at every roughness (see the module docs); kiln's default
     /// for the tables it bakes.
     Adaptive,
+    /// kiln's glass layout ([`super::glass_layout`]): `t = w A(mu; kappa, 1/2) + (1 - w)
+    /// A(mu; 4 alpha, 0.4)`, the adaptive coordinate with a share `w = 0.2` given to the layer of
+    /// width `kappa = (eta - 1) / (alpha + sqrt(eta - 1))` that opens near grazing as
+    /// `eta -> 1+`; depends on roughness and on the IOR, so only on a table over the IOR.
+    Glass,
 }
 
 impl MuMapping {
@@ -109,22 +114,38 @@ impl MuMapping {
             MuMapping::Linear => "linear",
             MuMapping::Sqrt => "sqrt",
             MuMapping::Adaptive => "adaptive",
+            MuMapping::Glass => "glass",
         }
     }
 
     /// Whether the texture coordinate depends on `alpha` as well as `mu`.
     #[must_use]
     pub fn depends_on_roughness(self) -> bool {
-        self == MuMapping::Adaptive
+        matches!(self, MuMapping::Adaptive | MuMapping::Glass)
     }
 
-    /// `mu` at texture coordinate `t` on the row of slope-space roughness `alpha`.
+    /// Whether the texture coordinate depends on the index of refraction (only on a table over
+    /// the IOR).
+    #[must_use]
+    pub fn depends_on_ior(self) -> bool {
+        self == MuMapping::Glass
+    }
+
+    /// `mu` at texture coordinate `t` on the row of slope-space roughness `alpha` (a `glass`
+    /// axis at `eta = 1`: see [`MuMapping::mu_at`]).
     #[must_use]
     pub fn mu(self, t: f64, alpha: f64) -> f64 {
+        self.mu_at(t, alpha, 1.0)
+    }
+
+    /// `mu` at texture coordinate `t` at roughness `alpha` and axis index `eta_up >= 1`.
+    #[must_use]
+    pub fn mu_at(self, t: f64, alpha: f64, eta_up: f64) -> f64 {
         match self {
             MuMapping::Linear => t,
             MuMapping::Sqrt => t * t,
             MuMapping::Adaptive => crate::integrate::grazing::mu_of_t(t, alpha),
+            MuMapping::Glass => super::glass_layout::mu_at(t, alpha, eta_up),
         }
     }
 
@@ -132,10 +153,18 @@ impl MuMapping {
     /// For `adaptive`, `mu = 0` gives 0 whatever `alpha`, and `alpha = 0` gives 1 for `mu > 0`.
     #[must_use]
     pub fn coordinate(self, mu: f64, alpha: f64) -> f64 {
+        self.coordinate_at(mu, alpha, 1.0)
+    }
+
+    /// The texture coordinate of `mu` at roughness `alpha` and axis index `eta_up >= 1` (the
+    /// inverse of [`MuMapping::mu_at`]).
+    #[must_use]
+    pub fn coordinate_at(self, mu: f64, alpha: f64, eta_up: f64) -> f64 {
         match self {
             MuMapping::Linear => mu,
             MuMapping::Sqrt => mu.sqrt(),
             MuMapping::Adaptive => crate::integrate::grazing::t_of_mu(mu, alpha),
+            MuMapping::Glass => super::glass_layout::mu_coordinate(mu, alpha, eta_up),
         }
     }
 
@@ -149,6 +178,13 @@ impl MuMapping {
                 "lookup coordinate t = (mu (1 + 4 alpha) / (mu + 4 alpha))^0.4 (t = 0 at mu = 0; \
                  t = 1 at alpha = 0, mu > 0); mu = s k / (1 + k - s) with s = t^2.5, k = 4 alpha; \
                  the row at alpha = 0 holds the limit alpha -> 0+ (computed at alpha = 1e-7)"
+            }
+            MuMapping::Glass => {
+                "lookup coordinate t = 0.2 A(mu; kappa, 0.5) + 0.8 A(mu; 4 alpha, 0.4) with \
+                 A(y; k, p) = (y (1 + k) / (y + k))^p (1 at k = 0, y > 0; 0 at y = 0), \
+                 kappa = (eta - 1) / (alpha + sqrt(eta - 1)), eta >= 1 the IOR axis' index (1 / the \
+                 relative index of light from inside); mu at t by bisection; the row at alpha = 0 \
+                 holds the limit alpha -> 0+ (computed at alpha = 1e-7)"
             }
         }
     }
@@ -167,6 +203,11 @@ pub enum IorMapping {
     /// nodes, so the axis runs from `eta = 1 + 2e-8` to `eta = 99.5` whatever `eta_max`, and
     /// the lookup reads `t = z` unclamped (`microfacet_ggx_glass_E`).
     Blender,
+    /// kiln's glass layout ([`super::glass_layout`]): `z = A(x; 0.3 alpha^2, 1/2) / 2 + x^(1/2) / 2`
+    /// with `x = u(eta) / u(eta_max)`, `u = (eta - 1) / (eta + 1)`, `A` as [`MuMapping::Glass`]:
+    /// half the IOR texels below `eta - 1 ~ alpha^2` at every roughness; the slice `z = 0` holds
+    /// the limit `eta -> 1+`. Depends on roughness.
+    Glass,
 }
 
 /// The ends of [`IorMapping::Blender`]'s `z` (`ior_parameterization` in Cycles'
@@ -181,17 +222,26 @@ impl IorMapping {
             IorMapping::Linear => "linear",
             IorMapping::Cycles => "cycles",
             IorMapping::Blender => "blender",
+            IorMapping::Glass => "glass",
         }
+    }
+
+    /// Whether the coordinate depends on roughness as well as `eta`.
+    #[must_use]
+    pub fn depends_on_roughness(self) -> bool {
+        self == IorMapping::Glass
     }
 
     fn z(eta: f64) -> f64 {
         ((eta - 1.0) / (eta + 1.0)).max(0.0).sqrt()
     }
 
-    /// `eta` at texture coordinate `t` on an axis up to `max`.
+    /// `eta` at texture coordinate `t` on an axis up to `max`, at slope-space roughness `alpha`
+    /// (only the `glass` mapping depends on it).
     #[must_use]
-    pub fn eta(self, t: f64, max: f64) -> f64 {
+    pub fn eta(self, t: f64, max: f64, alpha: f64) -> f64 {
         match self {
+            IorMapping::Glass => super::glass_layout::ior_at(t, max, alpha),
             IorMapping::Linear => 1.0 + t * (max - 1.0),
             IorMapping::Cycles => {
                 let z = t * Self::z(max);
@@ -205,11 +255,13 @@ impl IorMapping {
     }
 
     /// The texture coordinate of `eta` (the inverse of [`IorMapping::eta`]); an `eta < 1` is
-    /// looked up at `1 / eta`, as the axis lists indices from 1 up.
+    /// looked up at `1 / eta`, as the axis lists indices from 1 up; at roughness `alpha` (only the
+    /// `glass` mapping depends on it).
     #[must_use]
-    pub fn coordinate(self, eta: f64, max: f64) -> f64 {
+    pub fn coordinate(self, eta: f64, max: f64, alpha: f64) -> f64 {
         let eta = if eta < 1.0 { 1.0 / eta } else { eta };
         match self {
+            IorMapping::Glass => super::glass_layout::ior_coordinate(eta, max, alpha),
             IorMapping::Linear => (eta - 1.0) / (max - 1.0),
             IorMapping::Cycles => Self::z(eta) / Self::z(max),
             IorMapping::Blender => Self::z(eta),
@@ -228,6 +280,13 @@ impl IorMapping {
             IorMapping::Blender => {
                 "z = clamp(t, 1e-4, 0.99), eta = (1 + z^2) / (1 - z^2) (Blender's glass tables; \
                  a lookup reads t = sqrt((eta - 1) / (eta + 1)))"
+            }
+            IorMapping::Glass => {
+                "lookup coordinate t = A(x; 0.3 alpha^2, 0.5) / 2 + x^0.5 / 2 with x = u(eta) / \
+                 u(eta_max), u(eta) = (eta - 1) / (eta + 1), A(y; k, p) = (y (1 + k) / (y + k))^p \
+                 (1 at k = 0, y > 0; 0 at y = 0); eta at t by bisection; the slice t = 0 holds the \
+                 one-sided limit eta -> 1+ at fixed coordinates (computed at eta = 1 + 1e-7; a \
+                 renderer passes an exactly index-matched interface straight through)"
             }
         }
     }
@@ -306,24 +365,37 @@ impl Axis {
         self.grid().coordinate(i, self.size())
     }
 
-    /// The physical coordinate (`mu`, `r` or `alpha`, as [`Axis::name`] says) of sample `i`, on
-    /// the row of roughness `alpha` (only the `adaptive` mu mapping depends on it).
+    /// The physical coordinate (`mu`, `r`, `alpha` or `eta`, as [`Axis::name`] says) of sample
+    /// `i`, on the row of roughness `alpha` (the `adaptive` and `glass` mappings depend on it)
+    /// and, for a `mu` axis, at the IOR axis' index `eta_up >= 1` (only `glass` depends on it).
     #[must_use]
-    pub fn value_at(&self, i: usize, alpha: f64) -> f64 {
+    pub fn value_at(&self, i: usize, alpha: f64, eta_up: f64) -> f64 {
         match *self {
-            Axis::Mu { mapping, .. } => mapping.mu(self.coordinate(i), alpha),
+            Axis::Mu { mapping, .. } => mapping.mu_at(self.coordinate(i), alpha, eta_up),
             Axis::Roughness { .. } => self.coordinate(i),
-            Axis::Ior { mapping, max, .. } => mapping.eta(self.coordinate(i), max.0),
+            Axis::Ior { mapping, max, .. } => mapping.eta(self.coordinate(i), max.0, alpha),
+        }
+    }
+
+    /// Whether the physical coordinate of a sample depends on the row (roughness or IOR).
+    #[must_use]
+    pub fn depends_on_row(&self) -> bool {
+        match *self {
+            Axis::Mu { mapping, .. } => mapping.depends_on_roughness(),
+            Axis::Ior { mapping, .. } => mapping.depends_on_roughness(),
+            Axis::Roughness { .. } => false,
         }
     }
 
     /// What metadata lists for sample `i`: the physical coordinate, or for an axis whose
-    /// physical coordinate depends on the row (the `adaptive` mu mapping) the texture coordinate.
+    /// physical coordinate depends on the row (the `adaptive` and `glass` mappings) the texture
+    /// coordinate.
     #[must_use]
     pub fn listed_value(&self, i: usize) -> f64 {
-        match *self {
-            Axis::Mu { mapping, .. } if mapping.depends_on_roughness() => self.coordinate(i),
-            _ => self.value_at(i, 1.0),
+        if self.depends_on_row() {
+            self.coordinate(i)
+        } else {
+            self.value_at(i, 1.0, 1.0)
         }
     }
 
@@ -373,14 +445,14 @@ impl Axis {
     }
 
     /// The continuous sample position (in units of samples, clamped to `[0, N - 1]`) of the
-    /// physical coordinate `x` on the row of roughness `alpha`: what a bilinear lookup of this
-    /// axis interpolates at.
+    /// physical coordinate `x` on the row of roughness `alpha` (and, for a `glass` mu axis, at
+    /// the IOR axis' index `eta_up >= 1`): what a bilinear lookup of this axis interpolates at.
     #[must_use]
-    pub fn position(&self, x: f64, alpha: f64) -> f64 {
+    pub fn position(&self, x: f64, alpha: f64, eta_up: f64) -> f64 {
         let t = match *self {
-            Axis::Mu { mapping, .. } => mapping.coordinate(x, alpha),
+            Axis::Mu { mapping, .. } => mapping.coordinate_at(x, alpha, eta_up),
             Axis::Roughness { .. } => x,
-            Axis::Ior { mapping, max, .. } => mapping.coordinate(x, max.0),
+            Axis::Ior { mapping, max, .. } => mapping.coordinate(x, max.0, alpha),
         };
         let n = self.size() as f64;
         let p = match self.grid() {

@@ -115,18 +115,18 @@ fn fit_points(spec: &super::TableSpec, per_cell: usize) -> Vec<FitPoint> {
     let convention = spec.roughness_convention();
     let mut points = Vec::new();
     for &t_eta in &ts(spec.ior) {
-        let eta = match spec.ior {
-            Some(super::Axis::Ior { mapping, max, .. }) => mapping.eta(t_eta, max.0),
-            _ => 1.0,
-        };
         for &t_r in &ts(spec.roughness) {
             let roughness = t_r;
             let alpha = convention.to_alpha(roughness);
+            let eta = match spec.ior {
+                Some(super::Axis::Ior { mapping, max, .. }) => mapping.eta(t_eta, max.0, alpha),
+                _ => 1.0,
+            };
             let mus: Vec<Option<f64>> = match spec.mu {
                 // The texture's points, then the grazing probes `verify` audits every row at.
                 Some(super::Axis::Mu { mapping, .. }) => ts(spec.mu)
                     .iter()
-                    .map(|&t_mu| Some(mapping.mu(t_mu, alpha)))
+                    .map(|&t_mu| Some(mapping.mu_at(t_mu, alpha, eta)))
                     .chain(super::axis::grazing_probes().into_iter().map(Some))
                     .collect(),
                 _ => vec![None],

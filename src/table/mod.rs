@@ -2,6 +2,7 @@
 
 pub mod axis;
 pub mod check;
+pub mod glass_layout;
 pub mod lookup_fit;
 pub mod normalisation;
 
@@ -287,6 +288,12 @@ impl TableSpec {
                 mapping: IorMapping::Linear,
                 ..
             }) => tags.push("ior-linear"),
+            // Cycles' axis is the default of F_avg alone; kiln's glass layout the dielectric
+            // albedos'.
+            Some(Axis::Ior {
+                mapping: IorMapping::Cycles,
+                ..
+            }) if self.quantity != Quantity::FAvg => tags.push("ior-cycles"),
             Some(Axis::Ior {
                 mapping: IorMapping::Blender,
                 ..
@@ -316,23 +323,98 @@ impl TableSpec {
     /// `mu` is `None` for the averages, `alpha` is 0 for `F_avg`.
     #[must_use]
     pub fn texel_coordinates(&self, index: usize) -> (f64, Option<f64>) {
-        let [_, r, m] = self.texel_indices(index);
-        let (Some(roughness), Some(r)) = (self.roughness, r) else {
-            return (0.0, None);
-        };
-        match (self.mu, m) {
-            (Some(mu), Some(m)) => self.point(roughness.coordinate(r), mu.coordinate(m)),
-            _ => (roughness.alpha(r), None),
-        }
+        let (alpha, mu, _) = self.texel_point(index);
+        (alpha, mu)
     }
 
     /// The relative index of refraction at which texel `index` is computed: the IOR axis' `eta`,
     /// or `1 / eta` for light arriving from inside; `None` without an IOR axis.
     #[must_use]
     pub fn texel_eta(&self, index: usize) -> Option<f64> {
-        let [i, _, _] = self.texel_indices(index);
-        let eta = self.ior?.value_at(i?, 1.0);
-        Some(self.relative_eta(eta))
+        self.texel_point(index).2
+    }
+
+    /// The point `(alpha, mu, eta)` at which texel `index` (row-major, slowest axis first) is
+    /// computed: `mu` is `None` for the averages, `alpha` is 0 for `F_avg`, `eta` (the relative
+    /// index, `1 / eta` for light from inside) is `None` without an IOR axis. On a `glass` IOR
+    /// axis the IOR of a texel depends on its roughness, the `eta = 1` slice is computed at
+    /// `eta = 1 +` [`glass_layout::LIMIT_ETA_OFFSET`] (its one-sided limit), and a `glass` mu
+    /// axis' `mu` depends on both.
+    #[must_use]
+    pub fn texel_point(&self, index: usize) -> (f64, Option<f64>, Option<f64>) {
+        let [k, r, m] = self.texel_indices(index);
+        let row = match (self.roughness, r) {
+            (Some(roughness), Some(r)) => Some(roughness.coordinate(r)),
+            _ => None,
+        };
+        let row_alpha = row.map_or(0.0, |t_r| self.row_alpha(t_r));
+        let eta_up = match (self.ior, k) {
+            (Some(ior), Some(k)) => Some(self.ior_at(ior.coordinate(k), row_alpha)),
+            _ => None,
+        };
+        let eta = eta_up.map(|eta| self.relative_eta(eta));
+        let Some(t_r) = row else {
+            return (0.0, None, eta);
+        };
+        match (self.mu, m) {
+            (Some(mu), Some(m)) => {
+                let (alpha, mu) = self.point_at(t_r, mu.coordinate(m), eta_up.unwrap_or(1.0));
+                (alpha, mu, eta)
+            }
+            _ if self.row_limit_alpha().is_some() => (row_alpha, None, eta),
+            _ => (self.roughness_convention().to_alpha(t_r), None, eta),
+        }
+    }
+
+    /// The `alpha` at which the row at roughness coordinate `t_roughness` is computed: its
+    /// `alpha`, or on the row `alpha = 0` of a layout that follows layers shrinking with `alpha`
+    /// their limit's ([`TableSpec::row_limit_alpha`]).
+    #[must_use]
+    pub fn row_alpha(&self, t_roughness: f64) -> f64 {
+        let alpha = self.roughness_convention().to_alpha(t_roughness);
+        match self.row_limit_alpha() {
+            Some(limit) if alpha == 0.0 => limit,
+            _ => alpha,
+        }
+    }
+
+    /// The IOR axis' index `eta >= 1` at its texture coordinate `t_eta` on the row of
+    /// `row_alpha` ([`TableSpec::row_alpha`]): on a `glass` axis the slice `eta = 1` is its
+    /// one-sided limit, computed at [`glass_layout::limit_slice_eta`]. 1 without an IOR axis.
+    #[must_use]
+    pub fn ior_at(&self, t_eta: f64, row_alpha: f64) -> f64 {
+        match self.ior {
+            Some(Axis::Ior { mapping, max, .. }) => {
+                let eta = mapping.eta(t_eta, max.0, row_alpha);
+                if mapping == IorMapping::Glass && eta <= 1.0 {
+                    glass_layout::limit_slice_eta(row_alpha)
+                } else {
+                    eta
+                }
+            }
+            _ => 1.0,
+        }
+    }
+
+    /// The `alpha` at which a row at `alpha = 0` is computed when the layout's coordinates
+    /// follow layers that shrink with `alpha` (its limit `alpha -> 0+` at fixed texture
+    /// coordinates): [`glass_layout::ROW_LIMIT_ALPHA`] on a `glass` IOR axis,
+    /// [`axis::LAYER_LIMIT_ALPHA`] on an `adaptive` mu axis; `None` otherwise.
+    #[must_use]
+    pub fn row_limit_alpha(&self) -> Option<f64> {
+        if let Some(Axis::Ior {
+            mapping: IorMapping::Glass,
+            ..
+        }) = self.ior
+        {
+            return Some(glass_layout::ROW_LIMIT_ALPHA);
+        }
+        match self.mu {
+            Some(Axis::Mu { mapping, .. }) if mapping.depends_on_roughness() => {
+                Some(axis::LAYER_LIMIT_ALPHA)
+            }
+            _ => None,
+        }
     }
 
     /// The relative index a table of this quantity is computed at for the IOR axis value `eta`
@@ -350,24 +432,31 @@ impl TableSpec {
     /// latter ignored for `E_avg`). On the row `alpha = 0` of an `adaptive` mu axis this is the
     /// boundary layer's limit, taken at [`axis::LAYER_LIMIT_ALPHA`] (see [`axis`]), except at
     /// `t_mu = 1`, where the limit is the mirror at normal incidence (`alpha = 0`, `mu = 1`).
+    /// A `glass` mu axis is read at `eta = 1` ([`TableSpec::point_at`] names the IOR).
     #[must_use]
     pub fn point(&self, t_roughness: f64, t_mu: f64) -> (f64, Option<f64>) {
+        self.point_at(t_roughness, t_mu, 1.0)
+    }
+
+    /// [`TableSpec::point`] at the IOR axis' index `eta_up >= 1` (only a `glass` mu axis
+    /// depends on it).
+    #[must_use]
+    pub fn point_at(&self, t_roughness: f64, t_mu: f64, eta_up: f64) -> (f64, Option<f64>) {
         debug_assert!(self.roughness.is_some(), "F_avg has no roughness axis");
         let alpha = self.roughness_convention().to_alpha(t_roughness);
         match self.mu {
             Some(Axis::Mu { mapping, .. }) => {
-                if alpha == 0.0 && mapping.depends_on_roughness() {
+                if alpha == 0.0
+                    && let Some(limit) = self.row_limit_alpha()
+                {
                     // The layer's limit at fixed t; at t = 1 (mu = 1 for every alpha > 0) that
                     // limit is the mirror's: loss exactly 0, not the 2e-14 of alpha = 1e-7.
                     if t_mu >= 1.0 {
                         return (0.0, Some(1.0));
                     }
-                    return (
-                        axis::LAYER_LIMIT_ALPHA,
-                        Some(mapping.mu(t_mu, axis::LAYER_LIMIT_ALPHA)),
-                    );
+                    return (limit, Some(mapping.mu_at(t_mu, limit, eta_up)));
                 }
-                (alpha, Some(mapping.mu(t_mu, alpha)))
+                (alpha, Some(mapping.mu_at(t_mu, alpha, eta_up)))
             }
             _ => (alpha, None),
         }
@@ -464,7 +553,9 @@ impl Table {
         eta: f64,
     ) -> impl Fn(f64) -> f64 + 'a {
         let alpha = self.spec.roughness_convention().to_alpha(roughness);
-        let corner = move |axis: Axis, x: f64, stride: usize| Corner::new(axis, x, alpha, stride);
+        let eta_up = axis_index(eta);
+        let corner =
+            move |axis: Axis, x: f64, stride: usize| Corner::new(axis, x, alpha, eta_up, stride);
         // Per axis, slowest first: the two samples to blend, the second's weight, the stride
         // (the product of the faster axes' sizes). In place: a lookup allocates nothing (the
         // audits and `f_ms_norm` make millions).
@@ -506,6 +597,7 @@ impl Table {
     #[must_use]
     pub fn lookup_weights(&self, mu: f64, roughness: f64, eta: f64) -> LookupWeights {
         let alpha = self.spec.roughness_convention().to_alpha(roughness);
+        let eta_up = axis_index(eta);
         let (roughness_stride, ior_stride) = self.strides();
         let mut out = LookupWeights {
             terms: [(0, 1.0); 8],
@@ -517,7 +609,7 @@ impl Table {
             (self.spec.mu, mu, 1),
         ] {
             let Some(axis) = axis else { continue };
-            let c = Corner::new(axis, x, alpha, stride);
+            let c = Corner::new(axis, x, alpha, eta_up, stride);
             let n = out.count;
             for k in 0..n {
                 let (index, weight) = out.terms[k];
@@ -547,9 +639,9 @@ struct Corner {
 
 impl Corner {
     /// Where a lookup of `axis` at the physical coordinate `x` (on the row of roughness
-    /// `alpha`) falls, for an axis of index stride `stride`.
-    fn new(axis: Axis, x: f64, alpha: f64, stride: usize) -> Self {
-        let p = axis.position(x, alpha);
+    /// `alpha`, at the IOR axis' index `eta_up`) falls, for an axis of index stride `stride`.
+    fn new(axis: Axis, x: f64, alpha: f64, eta_up: f64, stride: usize) -> Self {
+        let p = axis.position(x, alpha, eta_up);
         let i = (p.floor() as usize).min(axis.size().saturating_sub(2));
         Corner {
             low: i,
@@ -558,6 +650,12 @@ impl Corner {
             stride,
         }
     }
+}
+
+/// The IOR axis' index `eta >= 1` of a lookup's `eta` (an inside table's relative index
+/// `eta < 1` is read at `1 / eta`).
+fn axis_index(eta: f64) -> f64 {
+    if eta < 1.0 { 1.0 / eta } else { eta }
 }
 
 /// The texels a lookup blends and their weights: the lookup is `sum weight * texel` (up to

@@ -11,7 +11,6 @@ pub mod verdict;
 pub use error_map::{ErrorMap, MAX_MAP_CELLS, error_maps};
 
 use crate::integrate::reference::ReferenceSettings;
-use crate::table::axis::Axis;
 use crate::table::{Table, TableSpec};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -500,29 +499,31 @@ pub fn lookup_coordinates(spec: &TableSpec, settings: &AuditSettings) -> Vec<Coo
         let steps = settings.density.max(1) * n;
         (0..=steps).map(|j| j as f64 / steps as f64).collect()
     };
-    let etas: Vec<Option<f64>> = match spec.ior {
-        Some(axis @ Axis::Ior { mapping, max, .. }) => ladder(axis.size())
-            .into_iter()
-            .map(|t| Some(spec.relative_eta(mapping.eta(t, max.0))))
-            .collect(),
-        _ => vec![None],
+    // The IOR ladder in the axis' own coordinate: on a `glass` axis the index at a coordinate
+    // depends on the roughness (the rung's alpha, or the layer limit's on the row alpha = 0).
+    let t_etas: Vec<Option<f64>> = match spec.ior {
+        Some(axis) => ladder(axis.size()).into_iter().map(Some).collect(),
+        None => vec![None],
     };
+    let eta_up_at = |t_eta: Option<f64>, row_alpha: f64| t_eta.map(|t| spec.ior_at(t, row_alpha));
     let mut points = Vec::new();
-    for eta in etas {
+    for t_eta in t_etas {
         let Some(roughness) = spec.roughness else {
             points.push(Coordinates {
                 alpha: 0.0,
                 mu: None,
-                eta,
+                eta: eta_up_at(t_eta, 0.0).map(|eta| spec.relative_eta(eta)),
             });
             continue;
         };
         for t_r in ladder(roughness.size()) {
+            let eta_up = eta_up_at(t_eta, spec.row_alpha(t_r));
+            let eta = eta_up.map(|eta| spec.relative_eta(eta));
             let at = |(alpha, mu): (f64, Option<f64>)| Coordinates { alpha, mu, eta };
             match spec.mu {
                 Some(axis) => {
                     for t_mu in ladder(axis.size()) {
-                        points.push(at(spec.point(t_r, t_mu)));
+                        points.push(at(spec.point_at(t_r, t_mu, eta_up.unwrap_or(1.0))));
                     }
                     let alpha = spec.roughness_convention().to_alpha(t_r);
                     points.extend(grazing_probes().into_iter().map(|mu| at((alpha, Some(mu)))));

@@ -63,9 +63,13 @@ pub struct BakeArgs {
     /// [default: 16]. Only with a table over the IOR.
     #[arg(long, value_parser = parse_size, allow_negative_numbers = true)]
     ior_size: Option<usize>,
-    /// Spacing of the IOR axis over [1, --ior-max]: cycles (linear in sqrt((eta - 1) /
-    /// (eta + 1)), denser near eta = 1 where the inside tables change fastest) or linear.
-    /// The axis lists eta >= 1; inside tables are computed at 1 / eta [default: cycles].
+    /// Layout of the tables over the IOR, on [1, --ior-max]. glass: kiln's glass layout for the
+    /// dielectric tables, whose IOR and mu coordinates follow the layers near eta = 1 (the IOR
+    /// coordinate tied to roughness, the mu coordinate to roughness and the IOR; the eta = 1
+    /// slice holds the limit eta -> 1+; see docs/conventions.md); f-avg keeps cycles. The
+    /// product grids: cycles (linear in sqrt((eta - 1) / (eta + 1)), Cycles' glass tables; their
+    /// names get -ior-cycles) or linear, with --mu-axis. The axis lists eta >= 1; inside tables
+    /// are computed at 1 / eta [default: glass].
     #[arg(long, value_enum)]
     ior_axis: Option<IorMapping>,
     /// The top of the IOR axis, above 1 (Unreal's glass table goes to 3; diamond is 2.42)
@@ -271,7 +275,7 @@ pub fn run(args: BakeArgs) -> kiln::Result<()> {
         mu_mapping: args.mu_axis,
         grid: args.grid,
         ior_size: args.ior_size.unwrap_or(BakeOptions::DEFAULT_IOR_SIZE),
-        ior_mapping: args.ior_axis.unwrap_or(IorMapping::Cycles),
+        ior_mapping: args.ior_axis.unwrap_or(IorMapping::Glass),
         ior_max: args.ior_max.unwrap_or(BakeOptions::DEFAULT_IOR_MAX),
         transmission: args.transmission,
         check_against_reference: !args.no_reference_check,

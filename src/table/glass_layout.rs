@@ -1,0 +1,245 @@
+//! kiln's own glass layout (issue 38): texture coordinates for the dielectric tables over
+//! `(eta, roughness, mu)` that follow the layers a product grid cannot, so that a renderer's
+//! trilinear lookup stays close to the energy albedo `R + T` near `eta = 1`.
+//!
+//! What the layout follows (measured with `examples/glass_layout.rs`, `docs/physics.md`
+//! "Glass near eta = 1"):
+//!
+//! - **The eta layer in `mu`.** For light from outside, `E(0) = 1` for every `eta > 1`, while
+//!   the limit `eta -> 1+` at fixed `mu > 0` is `(1 + Lambda(mu)) / (1 + 2 Lambda(mu))` (0.533 at
+//!   `alpha = 1`, `mu = 1/15`): `E` falls from 1 to that curve over a layer of width about
+//!   `(eta - 1) / alpha` in `mu` (`sqrt(eta - 1)` on a mirror). The `mu` coordinate gives that
+//!   layer a fixed share [`LAYER_SHARE`] of `t`, whatever `eta`:
+//!   `t = w A(mu; kappa, p_e) + (1 - w) A(mu; 4 alpha, 0.4)`, with
+//!   `A(mu; k, p) = (mu (1 + k) / (mu + k))^p` (kiln's adaptive axis is `A(mu; 4 alpha, 0.4)`,
+//!   [`crate::integrate::grazing`]) and `kappa = c_e (eta - 1) / (alpha + s sqrt(eta - 1))`.
+//! - **The regime change at `eta - 1 ~ alpha^2`**, where that layer merges with the masking
+//!   layer `mu ~ alpha`: the IOR coordinate is tied to `alpha^2`,
+//!   `z = b A(x; c_z alpha^2, q) + (1 - b) x^q` with `x = u(eta) / u(eta_max)`,
+//!   `u(eta) = (eta - 1) / (eta + 1)` (`x^(1/2)` is Cycles' `z`, the fourth root of `F0`, scaled).
+//!   At every roughness half the IOR texels lie below `eta - 1 ~ alpha^2`, half above.
+//! - **`eta = 1` itself** is a discontinuity of a renderer's convention (an exactly index-matched
+//!   interface is passed straight through), not of the albedo tabulated: the `z = 0` slice holds
+//!   the one-sided limit `eta -> 1+` at fixed texture coordinates, computed at
+//!   `eta - 1 =` [`LIMIT_ETA_OFFSET`] `alpha^2` (its reciprocal for light from inside); the row
+//!   `alpha = 0` holds the limit `alpha -> 0+`, computed at [`ROW_LIMIT_ALPHA`].
+//!
+//! Both coordinates are increasing in their variable and reach 0 and 1 at the axis ends; a
+//! lookup computes them in closed form from `(mu, alpha, eta)`, a bake inverts them by
+//! bisection. The constants were chosen by measured furnace error at 16^3 (the issue's
+//! candidate table; `examples/glass_layout.rs` reproduces each row).
+
+use crate::numerics::bisection::bisect;
+
+/// `w`: the share of the `mu` coordinate given to the eta layer.
+pub const LAYER_SHARE: f64 = 0.2;
+/// `c_e`: the eta layer's width `kappa = c_e (eta - 1) / (alpha + s sqrt(eta - 1))`.
+pub const LAYER_SCALE: f64 = 1.0;
+/// `s`: the weight of `sqrt(eta - 1)` in the eta layer's width (the mirror's Fresnel layer).
+pub const LAYER_SQRT_WEIGHT: f64 = 1.0;
+/// `p_e`: the power that spreads the eta layer's texels toward `mu = 0`.
+pub const LAYER_POWER: f64 = 0.5;
+/// `q`: the IOR coordinate's power of `x = u(eta) / u(eta_max)` (1/2: Cycles' `z`).
+pub const IOR_POWER: f64 = 0.5;
+/// `c_z`: where the IOR coordinate's roughness-tied part puts `eta - 1 ~ c_z alpha^2`.
+pub const IOR_SCALE: f64 = 0.3;
+/// `b`: the share of the IOR coordinate tied to roughness.
+pub const IOR_SHARE: f64 = 0.5;
+/// The `eta = 1` slice is computed at `eta - 1 =` this times `alpha^2`: the albedo near
+/// `eta = 1` is a function of `(eta - 1) / alpha^2` (and of `mu / kappa`), which it approaches
+/// linearly (at `alpha = 1e-3`, `mu = 1e-3`, `E - E_limit` is 7e-6 at a ratio of 5e-5 and
+/// 6.2e-4 at 5e-3), so the slice is within about 1.5e-5 of its limit. A smaller ratio puts the
+/// slice's eta layer at `mu ~ 1e-5 alpha`, where the reference no longer converges in its
+/// budget.
+pub const LIMIT_ETA_OFFSET: f64 = 1e-3;
+
+/// The `alpha` at which the row `alpha = 0` of a glass table is computed: its limit
+/// `alpha -> 0+` at fixed texture coordinates. Larger than the adaptive axis' 1e-7
+/// ([`super::axis::LAYER_LIMIT_ALPHA`]) because the IOR coordinate puts `eta - 1` near
+/// `alpha^2` and its eta layer at `mu ~ (eta - 1) / alpha`, which the reference resolves down to
+/// about `alpha = 1e-3` (the corrections to the limit are `O(alpha^2)` in `E`'s masking layer;
+/// the albedo at `(mu / alpha, (eta - 1) / alpha^2)` fixed agrees to 1e-9 between
+/// `alpha = 1e-3` and `1e-2`).
+pub const ROW_LIMIT_ALPHA: f64 = 1e-3;
+
+/// The index at which the `eta = 1` slice is computed at roughness `alpha`
+/// (`1 + LIMIT_ETA_OFFSET alpha^2`).
+#[must_use]
+pub fn limit_slice_eta(alpha: f64) -> f64 {
+    1.0 + LIMIT_ETA_OFFSET * alpha * alpha
+}
+
+/// Halvings of a coordinate's inversion: from `[0, 1]` to below 1e-30 absolute, so that a `mu`
+/// or `x` as small as 1e-20 keeps ten digits.
+const INVERSION_STEPS: u32 = 110;
+
+/// `A(y; k, p) = (y (1 + k) / (y + k))^p` on `[0, 1]`: 0 at `y = 0`, 1 at `y = 1`, and 1 for
+/// every `y > 0` when `k = 0`.
+#[must_use]
+pub fn saturation(y: f64, k: f64, p: f64) -> f64 {
+    if y <= 0.0 {
+        return 0.0;
+    }
+    if k <= 0.0 {
+        return 1.0;
+    }
+    (y * (1.0 + k) / (y + k)).min(1.0).powf(p)
+}
+
+/// `u(eta) = (eta - 1) / (eta + 1)`, `sqrt(F0)`; an `eta < 1` is read as `1 / eta`.
+#[must_use]
+pub fn reflectance_root(eta: f64) -> f64 {
+    let eta = if eta < 1.0 { 1.0 / eta } else { eta };
+    ((eta - 1.0) / (eta + 1.0)).max(0.0)
+}
+
+/// The IOR coordinate `z` of `eta` (either side: `eta < 1` is read at `1 / eta`) on an axis up to
+/// `eta_max`, at slope-space roughness `alpha` (module docs).
+#[must_use]
+pub fn ior_coordinate(eta: f64, eta_max: f64, alpha: f64) -> f64 {
+    let x = (reflectance_root(eta) / reflectance_root(eta_max)).min(1.0);
+    ior_coordinate_of_x(x, alpha)
+}
+
+fn ior_coordinate_of_x(x: f64, alpha: f64) -> f64 {
+    IOR_SHARE * saturation(x, IOR_SCALE * alpha * alpha, IOR_POWER)
+        + (1.0 - IOR_SHARE) * x.powf(IOR_POWER)
+}
+
+/// The index `eta >= 1` at IOR coordinate `z` at roughness `alpha` (the inverse of
+/// [`ior_coordinate`]): 1 at `z = 0`, `eta_max` at `z = 1`.
+#[must_use]
+pub fn ior_at(z: f64, eta_max: f64, alpha: f64) -> f64 {
+    if z <= 0.0 {
+        return 1.0;
+    }
+    if z >= 1.0 {
+        return eta_max;
+    }
+    let x = bisect(0.0, 1.0, INVERSION_STEPS, |x| {
+        ior_coordinate_of_x(x, alpha) < z
+    });
+    let u = x * reflectance_root(eta_max);
+    (1.0 + u) / (1.0 - u)
+}
+
+/// The eta layer's width `kappa = c_e (eta - 1) / (alpha + s sqrt(eta - 1))` for the axis index
+/// `eta_up >= 1`.
+#[must_use]
+pub fn layer_width(alpha: f64, eta_up: f64) -> f64 {
+    let excess = (eta_up - 1.0).max(0.0);
+    if excess == 0.0 {
+        return 0.0;
+    }
+    LAYER_SCALE * excess / (alpha + LAYER_SQRT_WEIGHT * excess.sqrt())
+}
+
+/// The `mu` coordinate `t` of `mu` at roughness `alpha` and axis index `eta_up >= 1` (module
+/// docs): 0 at `mu = 0`, 1 at `mu = 1`.
+#[must_use]
+pub fn mu_coordinate(mu: f64, alpha: f64, eta_up: f64) -> f64 {
+    LAYER_SHARE * saturation(mu, layer_width(alpha, eta_up), LAYER_POWER)
+        + (1.0 - LAYER_SHARE) * crate::integrate::grazing::t_of_mu(mu, alpha)
+}
+
+/// `mu` at coordinate `t` (the inverse of [`mu_coordinate`]); where the coordinate is flat in
+/// `mu` (a mirror's layers have no width) the smallest such `mu`.
+#[must_use]
+pub fn mu_at(t: f64, alpha: f64, eta_up: f64) -> f64 {
+    if t <= 0.0 {
+        return 0.0;
+    }
+    if t >= 1.0 {
+        return 1.0;
+    }
+    bisect(0.0, 1.0, INVERSION_STEPS, |mu| {
+        mu_coordinate(mu, alpha, eta_up) < t
+    })
+}
+
+/// The one-sided limit `eta -> 1+` of the single-scattering energy albedo of light from outside
+/// at fixed `mu > 0`: every refracted direction tends to `-o`, which the height-correlated
+/// masking-shadowing keeps with probability `G2 / G1 = (1 + Lambda) / (1 + 2 Lambda)`
+/// (`Lambda = Lambda(mu)`; issue 38, `docs/physics.md`).
+#[must_use]
+pub fn pass_through_limit(lambda: f64) -> f64 {
+    if lambda.is_infinite() {
+        return 0.5;
+    }
+    (1.0 + lambda) / (1.0 + 2.0 * lambda)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Both coordinates run from 0 to 1, increase, and their inversions give back the variable.
+    #[test]
+    fn the_coordinates_invert() {
+        for alpha in [1e-7, 1e-3, 0.05, 0.3, 1.0] {
+            for eta in [1.0 + 1e-9, 1.0005, 1.01, 1.2, 1.5, 2.2, 3.0] {
+                let z = ior_coordinate(eta, 3.0, alpha);
+                assert!((0.0..=1.0).contains(&z));
+                let back = ior_at(z, 3.0, alpha);
+                assert!(((back - 1.0) / (eta - 1.0) - 1.0).abs() < 1e-8, "{alpha} {eta}: {back}");
+                // From inside, 1 / eta sits at the same coordinate.
+                assert_eq!(ior_coordinate(1.0 / eta, 3.0, alpha), z);
+                let mut last = -1.0;
+                for k in 0..=64 {
+                    let mu = if k == 0 { 0.0 } else { 10f64.powf(-8.0 * (1.0 - k as f64 / 64.0)) };
+                    let t = mu_coordinate(mu, alpha, eta);
+                    assert!(t > last || (t == last && t == 1.0), "{alpha} {eta} {mu}: {t}");
+                    last = t;
+                    let back = mu_at(t, alpha, eta);
+                    assert!((back - mu).abs() <= 1e-9 * mu, "{alpha} {eta} {mu}: {back}");
+                }
+            }
+        }
+        assert_eq!(ior_coordinate(1.0, 3.0, 0.5), 0.0);
+        assert!((ior_coordinate(3.0, 3.0, 0.5) - 1.0).abs() < 1e-15);
+        assert_eq!(ior_at(0.0, 3.0, 0.5), 1.0);
+        assert_eq!(ior_at(1.0, 3.0, 0.5), 3.0);
+    }
+
+    /// The eta layer keeps its share of the coordinate: at `mu = kappa` the layer's part is
+    /// `w (2 kappa / (1 + kappa))^(1/2)`, worked for `eta = 1.01`, `alpha = 0.1`:
+    /// `kappa = 0.01 / (0.1 + 0.1) = 0.05`.
+    #[test]
+    fn the_eta_layer_sits_at_a_fixed_share_of_the_coordinate() {
+        let kappa = layer_width(0.1, 1.01);
+        assert!((kappa - 0.05).abs() < 1e-12, "{kappa}");
+        let t = mu_coordinate(kappa, 0.1, 1.01);
+        let masking = crate::integrate::grazing::t_of_mu(kappa, 0.1);
+        let expected = 0.2 * (2.0 * 0.05 / 1.05f64).sqrt() + 0.8 * masking;
+        assert!((t - expected).abs() < 1e-12, "{t} {expected}");
+        // On a mirror the layer is the Fresnel layer sqrt(eta - 1).
+        assert!((layer_width(0.0, 1.0004) - 0.02).abs() < 1e-12);
+        // At eta = 1 it has no width: t jumps to w above mu = 0.
+        assert!((mu_coordinate(1e-300, 0.5, 1.0) - 0.2).abs() < 1e-12);
+    }
+
+    /// The IOR coordinate puts `eta - 1 = c_z alpha^2` halfway along its tied share:
+    /// at `alpha = 0.1`, `x = 0.003 (1 + 0.003) / (x + 0.003)`... worked: the tied part is
+    /// `(2 k / (1 + k))^(1/2)` at `x = k = 0.003`.
+    #[test]
+    fn the_ior_coordinate_is_tied_to_alpha_squared() {
+        let k: f64 = 0.3 * 0.01;
+        let eta_max: f64 = 3.0;
+        let u = k * reflectance_root(eta_max);
+        let eta = (1.0 + u) / (1.0 - u);
+        let z = ior_coordinate(eta, eta_max, 0.1);
+        let expected = 0.5 * (2.0 * k / (1.0 + k)).sqrt() + 0.5 * k.sqrt();
+        assert!((z - expected).abs() < 1e-12, "{z} {expected}");
+    }
+
+    /// `(1 + Lambda) / (1 + 2 Lambda)`: 1 where nothing is masked, 1/2 on the horizon; at
+    /// `alpha = 1`, `mu = 1/15` (GGX `Lambda = (sqrt(1 + alpha^2 tan^2) - 1) / 2`,
+    /// `tan^2 = 224`): 0.533.
+    #[test]
+    fn the_pass_through_limit() {
+        assert_eq!(pass_through_limit(0.0), 1.0);
+        assert_eq!(pass_through_limit(f64::INFINITY), 0.5);
+        let lambda = ((1.0f64 + 224.0).sqrt() - 1.0) / 2.0;
+        assert!((pass_through_limit(lambda) - 0.5333).abs() < 1e-3);
+    }
+}
