@@ -175,10 +175,7 @@ impl BakeOptions {
         }
         if self.ior_mapping == IorMapping::Glass
             && self.mu_mapping != MuMapping::Adaptive
-            && let Some(q) = self
-                .quantities
-                .iter()
-                .find(|q| q.has_ior() && q.has_mu())
+            && let Some(q) = self.quantities.iter().find(|q| q.has_ior() && q.has_mu())
         {
             return Err(Error::InvalidInput(format!(
                 "--quantity {} with --mu-axis {}: kiln's glass layout (--ior-axis glass, the \

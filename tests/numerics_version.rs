@@ -7,7 +7,7 @@
 //! SIMD width) does not fail, while any change of substance does.
 
 use kiln::cache::{NUMERICS_VERSION, fnv1a};
-use kiln::{BakeOptions, Method, Ndf, Quantity, Table};
+use kiln::{BakeOptions, IorMapping, Method, Ndf, Quantity, Table};
 
 /// The digests of [`NUMERICS_VERSION`]: (version, table, FNV-1a of its values at 9 digits).
 const GOLDEN: &[(u32, &str, &str)] = &[
@@ -115,6 +115,17 @@ fn tables() -> Vec<Table> {
             Quantity::EAvgDielectricInside,
             Quantity::FAvg,
         ],
+        ior_mapping: IorMapping::Cycles,
+        ..base.clone()
+    }));
+    // kiln's glass layout (the default for the dielectric albedos).
+    all.extend(bake(BakeOptions {
+        quantities: vec![
+            Quantity::EDielectric,
+            Quantity::EDielectricInside,
+            Quantity::EAvgDielectric,
+            Quantity::EAvgDielectricInside,
+        ],
         ..base.clone()
     }));
     let qmc = BakeOptions {
@@ -135,6 +146,7 @@ fn tables() -> Vec<Table> {
     }));
     all.extend(bake(BakeOptions {
         quantities: vec![Quantity::EDielectric],
+        ior_mapping: IorMapping::Cycles,
         ..qmc
     }));
     all

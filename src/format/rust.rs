@@ -9,6 +9,9 @@ use crate::model::RoughnessConvention;
 use crate::table::Table;
 use crate::table::axis::{ADAPTIVE_POWER, ADAPTIVE_SCALE, Axis, Grid, IorMapping, MuMapping};
 use crate::table::glass_layout;
+
+/// The glass layout the `glass` mappings stand for.
+const GLASS: glass_layout::GlassLayout = glass_layout::GlassLayout::KILN;
 use std::fmt::Write as _;
 
 /// On every generated array: a measured value may happen to print like a mathematical constant
@@ -95,16 +98,25 @@ fn coordinate_code(axis: &Axis) -> String {
                 "if mu <= 0.0 {{\n        0.0\n    }} else {{\n        let k = {ADAPTIVE_SCALE:?} * alpha;\n        \
                  (mu * (1.0 + k) / (mu + k)).min(1.0).powf({ADAPTIVE_POWER:?})\n    }}"
             ),
-            MuMapping::Glass => format!(
-                "{{\n        {SATURATION}\n        let e = (eta - 1.0).max(0.0);\n        \
-                 let kappa = {:?} * e / (alpha + {:?} * e.sqrt()).max(1e-30);\n        \
-                 {:?} * a(mu, kappa, {:?}) + {:?} * a(mu, {ADAPTIVE_SCALE:?} * alpha, {ADAPTIVE_POWER:?})\n    }}",
-                glass_layout::LAYER_SCALE as f32,
-                glass_layout::LAYER_SQRT_WEIGHT as f32,
-                glass_layout::LAYER_SHARE as f32,
-                glass_layout::LAYER_POWER as f32,
-                (1.0 - glass_layout::LAYER_SHARE) as f32,
-            ),
+            MuMapping::Glass => {
+                let share = if GLASS.layer_share_decay > 0.0 {
+                    format!(
+                        "{:?} / (1.0 + e / ({:?} * alpha * alpha).max(1e-30))",
+                        GLASS.layer_share as f32, GLASS.layer_share_decay as f32
+                    )
+                } else {
+                    format!("{:?}", GLASS.layer_share as f32)
+                };
+                format!(
+                    "{{\n        {SATURATION}\n        let e = (eta - 1.0).max(0.0);\n        \
+                     let kappa = {:?} * e / (alpha + {:?} * e.sqrt()).max(1e-30);\n        \
+                     let w = {share};\n        \
+                     w * a(mu, kappa, {:?}) + (1.0 - w) * a(mu, {ADAPTIVE_SCALE:?} * alpha, {ADAPTIVE_POWER:?})\n    }}",
+                    GLASS.layer_scale as f32,
+                    GLASS.layer_sqrt_weight as f32,
+                    GLASS.layer_power as f32,
+                )
+            }
         },
         Axis::Roughness { .. } => "roughness".to_string(),
         Axis::Ior { mapping, max, .. } => match mapping {
@@ -122,11 +134,11 @@ fn coordinate_code(axis: &Axis) -> String {
                  let x = (((eta - 1.0) / (eta + 1.0)).max(0.0) / {:?}_f32).min(1.0);\n        \
                  {:?} * a(x, {:?} * alpha * alpha, {:?}) + {:?} * x.powf({:?})\n    }}",
                 glass_layout::reflectance_root(max.0) as f32,
-                glass_layout::IOR_SHARE as f32,
-                glass_layout::IOR_SCALE as f32,
-                glass_layout::IOR_POWER as f32,
-                (1.0 - glass_layout::IOR_SHARE) as f32,
-                glass_layout::IOR_POWER as f32,
+                GLASS.ior_share as f32,
+                GLASS.ior_scale as f32,
+                GLASS.ior_power as f32,
+                (1.0 - GLASS.ior_share) as f32,
+                GLASS.ior_power as f32,
             ),
         },
     }

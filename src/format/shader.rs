@@ -18,6 +18,9 @@ use crate::model::RoughnessConvention;
 use crate::table::Table;
 use crate::table::axis::{ADAPTIVE_POWER, ADAPTIVE_SCALE, Axis, Grid, IorMapping, MuMapping};
 use crate::table::glass_layout;
+
+/// The glass layout the `glass` mappings stand for.
+const GLASS: glass_layout::GlassLayout = glass_layout::GlassLayout::KILN;
 use std::fmt::Write as _;
 
 /// A shading language.
@@ -102,12 +105,10 @@ fn coordinate(language: Language, axis: &Axis) -> String {
                 language.select("mu <= 0.0", "0.0", &t)
             }
             MuMapping::Glass => {
-                let share = glass_layout::LAYER_SHARE;
+                // `layer_share` and `kappa` come from the preamble.
                 format!(
-                    "{} * {} + {} * {}",
-                    literal(share),
-                    saturation(language, "mu", "kappa", glass_layout::LAYER_POWER),
-                    literal(1.0 - share),
+                    "layer_share * {} + (1.0 - layer_share) * {}",
+                    saturation(language, "mu", "kappa", GLASS.layer_power),
                     saturation(
                         language,
                         "mu",
@@ -129,22 +130,20 @@ fn coordinate(language: Language, axis: &Axis) -> String {
             }
             IorMapping::Blender => "sqrt(max((eta_up - 1.0) / (eta_up + 1.0), 0.0))".to_string(),
             IorMapping::Glass => {
-                let x = format!(
-                    "min(max((eta_up - 1.0) / (eta_up + 1.0), 0.0) / {}, 1.0)",
-                    literal(glass_layout::reflectance_root(max.0))
-                );
-                let share = glass_layout::IOR_SHARE;
+                // `ior_x`, the preamble's x = u(eta) / u(eta_max).
+                let x = "ior_x";
+                let share = GLASS.ior_share;
                 format!(
                     "{} * {} + {} * pow({x}, {})",
                     literal(share),
                     saturation(
                         language,
-                        &x,
-                        &format!("{} * alpha * alpha", literal(glass_layout::IOR_SCALE)),
-                        glass_layout::IOR_POWER
+                        x,
+                        &format!("{} * alpha * alpha", literal(GLASS.ior_scale)),
+                        GLASS.ior_power
                     ),
                     literal(1.0 - share),
-                    literal(glass_layout::IOR_POWER)
+                    literal(GLASS.ior_power)
                 )
             }
         },
@@ -208,16 +207,42 @@ fn preamble(language: Language, table: &Table) -> String {
     if spec.ior.is_some() {
         out += &language.local("eta_up", &language.select("eta < 1.0", "1.0 / eta", "eta"));
     }
+    if let Some(Axis::Ior {
+        mapping: IorMapping::Glass,
+        max,
+        ..
+    }) = spec.ior
+    {
+        // x = u(eta) / u(eta_max), u = (eta - 1) / (eta + 1) (table::glass_layout).
+        out += &language.local(
+            "ior_x",
+            &format!(
+                "min(max((eta_up - 1.0) / (eta_up + 1.0), 0.0) / {}, 1.0)",
+                literal(glass_layout::reflectance_root(max.0))
+            ),
+        );
+    }
     if matches!(spec.mu, Some(Axis::Mu { mapping, .. }) if mapping.depends_on_ior()) {
         // The eta layer's width (table::glass_layout::layer_width).
         out += &language.local(
             "kappa",
             &format!(
                 "{} * max(eta_up - 1.0, 0.0) / max(alpha + {} * sqrt(max(eta_up - 1.0, 0.0)), 1e-30)",
-                literal(glass_layout::LAYER_SCALE),
-                literal(glass_layout::LAYER_SQRT_WEIGHT)
+                literal(GLASS.layer_scale),
+                literal(GLASS.layer_sqrt_weight)
             ),
         );
+        // The eta layer's share of the mu coordinate (GlassLayout::layer_share_at).
+        let share = if GLASS.layer_share_decay > 0.0 {
+            format!(
+                "{} / (1.0 + max(eta_up - 1.0, 0.0) / max({} * alpha * alpha, 1e-30))",
+                literal(GLASS.layer_share),
+                literal(GLASS.layer_share_decay)
+            )
+        } else {
+            literal(GLASS.layer_share)
+        };
+        out += &language.local("layer_share", &share);
     }
     out
 }

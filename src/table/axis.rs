@@ -184,7 +184,7 @@ impl MuMapping {
                  A(y; k, p) = (y (1 + k) / (y + k))^p (1 at k = 0, y > 0; 0 at y = 0), \
                  kappa = (eta - 1) / (alpha + sqrt(eta - 1)), eta >= 1 the IOR axis' index (1 / the \
                  relative index of light from inside); mu at t by bisection; the row at alpha = 0 \
-                 holds the limit alpha -> 0+ (computed at alpha = 1e-7)"
+                 holds the limit alpha -> 0+ (computed at alpha = 1e-3)"
             }
         }
     }
@@ -285,8 +285,8 @@ impl IorMapping {
                 "lookup coordinate t = A(x; 0.3 alpha^2, 0.5) / 2 + x^0.5 / 2 with x = u(eta) / \
                  u(eta_max), u(eta) = (eta - 1) / (eta + 1), A(y; k, p) = (y (1 + k) / (y + k))^p \
                  (1 at k = 0, y > 0; 0 at y = 0); eta at t by bisection; the slice t = 0 holds the \
-                 one-sided limit eta -> 1+ at fixed coordinates (computed at eta = 1 + 1e-7; a \
-                 renderer passes an exactly index-matched interface straight through)"
+                 one-sided limit eta -> 1+ at fixed coordinates (computed at eta - 1 = 1e-4 \
+                 alpha^2; a renderer passes an exactly index-matched interface straight through)"
             }
         }
     }

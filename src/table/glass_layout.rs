@@ -9,7 +9,7 @@
 //!   the limit `eta -> 1+` at fixed `mu > 0` is `(1 + Lambda(mu)) / (1 + 2 Lambda(mu))` (0.533 at
 //!   `alpha = 1`, `mu = 1/15`): `E` falls from 1 to that curve over a layer of width about
 //!   `(eta - 1) / alpha` in `mu` (`sqrt(eta - 1)` on a mirror). The `mu` coordinate gives that
-//!   layer a fixed share [`LAYER_SHARE`] of `t`, whatever `eta`:
+//!   layer a fixed share `w` of `t`, whatever `eta`:
 //!   `t = w A(mu; kappa, p_e) + (1 - w) A(mu; 4 alpha, 0.4)`, with
 //!   `A(mu; k, p) = (mu (1 + k) / (mu + k))^p` (kiln's adaptive axis is `A(mu; 4 alpha, 0.4)`,
 //!   [`crate::integrate::grazing`]) and `kappa = c_e (eta - 1) / (alpha + s sqrt(eta - 1))`.
@@ -31,27 +31,128 @@
 
 use crate::numerics::bisection::bisect;
 
-/// `w`: the share of the `mu` coordinate given to the eta layer.
-pub const LAYER_SHARE: f64 = 0.2;
-/// `c_e`: the eta layer's width `kappa = c_e (eta - 1) / (alpha + s sqrt(eta - 1))`.
-pub const LAYER_SCALE: f64 = 1.0;
-/// `s`: the weight of `sqrt(eta - 1)` in the eta layer's width (the mirror's Fresnel layer).
-pub const LAYER_SQRT_WEIGHT: f64 = 1.0;
-/// `p_e`: the power that spreads the eta layer's texels toward `mu = 0`.
-pub const LAYER_POWER: f64 = 0.5;
-/// `q`: the IOR coordinate's power of `x = u(eta) / u(eta_max)` (1/2: Cycles' `z`).
-pub const IOR_POWER: f64 = 0.5;
-/// `c_z`: where the IOR coordinate's roughness-tied part puts `eta - 1 ~ c_z alpha^2`.
-pub const IOR_SCALE: f64 = 0.3;
-/// `b`: the share of the IOR coordinate tied to roughness.
-pub const IOR_SHARE: f64 = 0.5;
+/// The constants of a glass layout (module docs); [`GlassLayout::KILN`] is kiln's, the one
+/// the `glass` mappings use. A value, so that candidates can be measured against it
+/// (`examples/glass_layout.rs`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GlassLayout {
+    /// `w`: the share of the `mu` coordinate given to the eta layer where `eta - 1 << alpha^2`.
+    pub layer_share: f64,
+    /// `d`: the eta layer's share falls as `w / (1 + (eta - 1) / (d alpha^2))`, so that where
+    /// the eta layer has merged with the masking layer (`eta - 1 >> alpha^2`) the coordinate is
+    /// kiln's adaptive one; 0 keeps the share `w` at every index.
+    pub layer_share_decay: f64,
+    /// `c_e`: the eta layer's width `kappa = c_e (eta - 1) / (alpha + s sqrt(eta - 1))`.
+    pub layer_scale: f64,
+    /// `s`: the weight of `sqrt(eta - 1)` in the eta layer's width (the mirror's Fresnel layer).
+    pub layer_sqrt_weight: f64,
+    /// `p_e`: the power that spreads the eta layer's texels toward `mu = 0`.
+    pub layer_power: f64,
+    /// `q`: the IOR coordinate's power of `x = u(eta) / u(eta_max)` (1/2: Cycles' `z`).
+    pub ior_power: f64,
+    /// `c_z`: where the IOR coordinate's roughness-tied part puts `eta - 1 ~ c_z alpha^2`.
+    pub ior_scale: f64,
+    /// `b`: the share of the IOR coordinate tied to roughness.
+    pub ior_share: f64,
+}
+
+impl GlassLayout {
+    /// kiln's glass layout.
+    pub const KILN: GlassLayout = GlassLayout {
+        layer_share: 0.2,
+        layer_share_decay: 0.0,
+        layer_scale: 1.0,
+        layer_sqrt_weight: 1.0,
+        layer_power: 0.5,
+        ior_power: 0.5,
+        ior_scale: 0.3,
+        ior_share: 0.5,
+    };
+
+    /// The IOR coordinate `z` of `eta` (either side: `eta < 1` is read at `1 / eta`) on an axis
+    /// up to `eta_max`, at slope-space roughness `alpha` (module docs).
+    #[must_use]
+    pub fn ior_coordinate(&self, eta: f64, eta_max: f64, alpha: f64) -> f64 {
+        let x = (reflectance_root(eta) / reflectance_root(eta_max)).min(1.0);
+        self.ior_coordinate_of_x(x, alpha)
+    }
+
+    fn ior_coordinate_of_x(&self, x: f64, alpha: f64) -> f64 {
+        self.ior_share * saturation(x, self.ior_scale * alpha * alpha, self.ior_power)
+            + (1.0 - self.ior_share) * x.powf(self.ior_power)
+    }
+
+    /// The index `eta >= 1` at IOR coordinate `z` at roughness `alpha` (the inverse of
+    /// [`GlassLayout::ior_coordinate`]): 1 at `z = 0`, `eta_max` at `z = 1`.
+    #[must_use]
+    pub fn ior_at(&self, z: f64, eta_max: f64, alpha: f64) -> f64 {
+        if z <= 0.0 {
+            return 1.0;
+        }
+        if z >= 1.0 {
+            return eta_max;
+        }
+        let x = bisect(0.0, 1.0, INVERSION_STEPS, |x| {
+            self.ior_coordinate_of_x(x, alpha) < z
+        });
+        let u = x * reflectance_root(eta_max);
+        (1.0 + u) / (1.0 - u)
+    }
+
+    /// The eta layer's width `kappa = c_e (eta - 1) / (alpha + s sqrt(eta - 1))` for the axis
+    /// index `eta_up >= 1`.
+    #[must_use]
+    pub fn layer_width(&self, alpha: f64, eta_up: f64) -> f64 {
+        let excess = (eta_up - 1.0).max(0.0);
+        if excess == 0.0 {
+            return 0.0;
+        }
+        self.layer_scale * excess / (alpha + self.layer_sqrt_weight * excess.sqrt())
+    }
+
+    /// The eta layer's share of the `mu` coordinate at `(alpha, eta_up)`:
+    /// `w / (1 + (eta - 1) / (d alpha^2))`, or `w` where `d = 0`.
+    #[must_use]
+    pub fn layer_share_at(&self, alpha: f64, eta_up: f64) -> f64 {
+        if self.layer_share_decay <= 0.0 {
+            return self.layer_share;
+        }
+        let excess = (eta_up - 1.0).max(0.0);
+        self.layer_share / (1.0 + excess / (self.layer_share_decay * alpha * alpha).max(1e-300))
+    }
+
+    /// The `mu` coordinate `t` of `mu` at roughness `alpha` and axis index `eta_up >= 1`
+    /// (module docs): 0 at `mu = 0`, 1 at `mu = 1`.
+    #[must_use]
+    pub fn mu_coordinate(&self, mu: f64, alpha: f64, eta_up: f64) -> f64 {
+        let w = self.layer_share_at(alpha, eta_up);
+        w * saturation(mu, self.layer_width(alpha, eta_up), self.layer_power)
+            + (1.0 - w) * crate::integrate::grazing::t_of_mu(mu, alpha)
+    }
+
+    /// `mu` at coordinate `t` (the inverse of [`GlassLayout::mu_coordinate`]); where the
+    /// coordinate is flat in `mu` (a mirror's layers have no width) the smallest such `mu`.
+    #[must_use]
+    pub fn mu_at(&self, t: f64, alpha: f64, eta_up: f64) -> f64 {
+        if t <= 0.0 {
+            return 0.0;
+        }
+        if t >= 1.0 {
+            return 1.0;
+        }
+        bisect(0.0, 1.0, INVERSION_STEPS, |mu| {
+            self.mu_coordinate(mu, alpha, eta_up) < t
+        })
+    }
+}
+
 /// The `eta = 1` slice is computed at `eta - 1 =` this times `alpha^2`: the albedo near
 /// `eta = 1` is a function of `(eta - 1) / alpha^2` (and of `mu / kappa`), which it approaches
 /// linearly (at `alpha = 1e-3`, `mu = 1e-3`, `E - E_limit` is 7e-6 at a ratio of 5e-5 and
 /// 6.2e-4 at 5e-3), so the slice is within about 1.5e-5 of its limit. A smaller ratio puts the
 /// slice's eta layer at `mu ~ 1e-5 alpha`, where the reference no longer converges in its
 /// budget.
-pub const LIMIT_ETA_OFFSET: f64 = 1e-3;
+pub const LIMIT_ETA_OFFSET: f64 = 1e-4;
 
 /// The `alpha` at which the row `alpha = 0` of a glass table is computed: its limit
 /// `alpha -> 0+` at fixed texture coordinates. Larger than the adaptive axis' 1e-7
@@ -93,68 +194,34 @@ pub fn reflectance_root(eta: f64) -> f64 {
     ((eta - 1.0) / (eta + 1.0)).max(0.0)
 }
 
-/// The IOR coordinate `z` of `eta` (either side: `eta < 1` is read at `1 / eta`) on an axis up to
-/// `eta_max`, at slope-space roughness `alpha` (module docs).
+/// [`GlassLayout::ior_coordinate`] of kiln's layout.
 #[must_use]
 pub fn ior_coordinate(eta: f64, eta_max: f64, alpha: f64) -> f64 {
-    let x = (reflectance_root(eta) / reflectance_root(eta_max)).min(1.0);
-    ior_coordinate_of_x(x, alpha)
+    GlassLayout::KILN.ior_coordinate(eta, eta_max, alpha)
 }
 
-fn ior_coordinate_of_x(x: f64, alpha: f64) -> f64 {
-    IOR_SHARE * saturation(x, IOR_SCALE * alpha * alpha, IOR_POWER)
-        + (1.0 - IOR_SHARE) * x.powf(IOR_POWER)
-}
-
-/// The index `eta >= 1` at IOR coordinate `z` at roughness `alpha` (the inverse of
-/// [`ior_coordinate`]): 1 at `z = 0`, `eta_max` at `z = 1`.
+/// [`GlassLayout::ior_at`] of kiln's layout.
 #[must_use]
 pub fn ior_at(z: f64, eta_max: f64, alpha: f64) -> f64 {
-    if z <= 0.0 {
-        return 1.0;
-    }
-    if z >= 1.0 {
-        return eta_max;
-    }
-    let x = bisect(0.0, 1.0, INVERSION_STEPS, |x| {
-        ior_coordinate_of_x(x, alpha) < z
-    });
-    let u = x * reflectance_root(eta_max);
-    (1.0 + u) / (1.0 - u)
+    GlassLayout::KILN.ior_at(z, eta_max, alpha)
 }
 
-/// The eta layer's width `kappa = c_e (eta - 1) / (alpha + s sqrt(eta - 1))` for the axis index
-/// `eta_up >= 1`.
+/// [`GlassLayout::layer_width`] of kiln's layout.
 #[must_use]
 pub fn layer_width(alpha: f64, eta_up: f64) -> f64 {
-    let excess = (eta_up - 1.0).max(0.0);
-    if excess == 0.0 {
-        return 0.0;
-    }
-    LAYER_SCALE * excess / (alpha + LAYER_SQRT_WEIGHT * excess.sqrt())
+    GlassLayout::KILN.layer_width(alpha, eta_up)
 }
 
-/// The `mu` coordinate `t` of `mu` at roughness `alpha` and axis index `eta_up >= 1` (module
-/// docs): 0 at `mu = 0`, 1 at `mu = 1`.
+/// [`GlassLayout::mu_coordinate`] of kiln's layout.
 #[must_use]
 pub fn mu_coordinate(mu: f64, alpha: f64, eta_up: f64) -> f64 {
-    LAYER_SHARE * saturation(mu, layer_width(alpha, eta_up), LAYER_POWER)
-        + (1.0 - LAYER_SHARE) * crate::integrate::grazing::t_of_mu(mu, alpha)
+    GlassLayout::KILN.mu_coordinate(mu, alpha, eta_up)
 }
 
-/// `mu` at coordinate `t` (the inverse of [`mu_coordinate`]); where the coordinate is flat in
-/// `mu` (a mirror's layers have no width) the smallest such `mu`.
+/// [`GlassLayout::mu_at`] of kiln's layout.
 #[must_use]
 pub fn mu_at(t: f64, alpha: f64, eta_up: f64) -> f64 {
-    if t <= 0.0 {
-        return 0.0;
-    }
-    if t >= 1.0 {
-        return 1.0;
-    }
-    bisect(0.0, 1.0, INVERSION_STEPS, |mu| {
-        mu_coordinate(mu, alpha, eta_up) < t
-    })
+    GlassLayout::KILN.mu_at(t, alpha, eta_up)
 }
 
 /// The one-sided limit `eta -> 1+` of the single-scattering energy albedo of light from outside
@@ -181,14 +248,24 @@ mod tests {
                 let z = ior_coordinate(eta, 3.0, alpha);
                 assert!((0.0..=1.0).contains(&z));
                 let back = ior_at(z, 3.0, alpha);
-                assert!(((back - 1.0) / (eta - 1.0) - 1.0).abs() < 1e-8, "{alpha} {eta}: {back}");
+                assert!(
+                    ((back - 1.0) / (eta - 1.0) - 1.0).abs() < 1e-8,
+                    "{alpha} {eta}: {back}"
+                );
                 // From inside, 1 / eta sits at the same coordinate.
                 assert_eq!(ior_coordinate(1.0 / eta, 3.0, alpha), z);
                 let mut last = -1.0;
                 for k in 0..=64 {
-                    let mu = if k == 0 { 0.0 } else { 10f64.powf(-8.0 * (1.0 - k as f64 / 64.0)) };
+                    let mu = if k == 0 {
+                        0.0
+                    } else {
+                        10f64.powf(-8.0 * (1.0 - k as f64 / 64.0))
+                    };
                     let t = mu_coordinate(mu, alpha, eta);
-                    assert!(t > last || (t == last && t == 1.0), "{alpha} {eta} {mu}: {t}");
+                    assert!(
+                        t > last || (t == last && t == 1.0),
+                        "{alpha} {eta} {mu}: {t}"
+                    );
                     last = t;
                     let back = mu_at(t, alpha, eta);
                     assert!((back - mu).abs() <= 1e-9 * mu, "{alpha} {eta} {mu}: {back}");
@@ -230,6 +307,42 @@ mod tests {
         let z = ior_coordinate(eta, eta_max, 0.1);
         let expected = 0.5 * (2.0 * k / (1.0 + k)).sqrt() + 0.5 * k.sqrt();
         assert!((z - expected).abs() < 1e-12, "{z} {expected}");
+    }
+
+    /// The formulas files carry state the constants this module computes with.
+    #[test]
+    fn the_formulas_state_the_constants() {
+        use crate::table::axis::{IorMapping, MuMapping};
+        let mu = MuMapping::Glass.formula();
+        let ior = IorMapping::Glass.formula();
+        for (text, constant) in [
+            (
+                mu,
+                format!(
+                    "t = {} A(mu; kappa, {})",
+                    GlassLayout::KILN.layer_share,
+                    GlassLayout::KILN.layer_power
+                ),
+            ),
+            (mu, format!("computed at alpha = {ROW_LIMIT_ALPHA:e}")),
+            (
+                ior,
+                format!(
+                    "A(x; {} alpha^2, {})",
+                    GlassLayout::KILN.ior_scale,
+                    GlassLayout::KILN.ior_power
+                ),
+            ),
+            (ior, format!("eta - 1 = {LIMIT_ETA_OFFSET:e} alpha^2")),
+        ] {
+            assert!(text.contains(&constant), "{text} lacks {constant}");
+        }
+        let k = GlassLayout::KILN;
+        assert_eq!(
+            (k.layer_scale, k.layer_sqrt_weight, k.ior_share),
+            (1.0, 1.0, 0.5)
+        );
+        assert_eq!(k.layer_share_decay, 0.0);
     }
 
     /// `(1 + Lambda) / (1 + 2 Lambda)`: 1 where nothing is masked, 1/2 on the horizon; at

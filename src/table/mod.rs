@@ -348,10 +348,30 @@ impl TableSpec {
             _ => None,
         };
         let row_alpha = row.map_or(0.0, |t_r| self.row_alpha(t_r));
-        let eta_up = match (self.ior, k) {
+        let mut eta_up = match (self.ior, k) {
             (Some(ior), Some(k)) => Some(self.ior_at(ior.coordinate(k), row_alpha)),
             _ => None,
         };
+        // The eta = 1 slice of kiln's glass layout above the eta layer (t > w): as eta -> 1+ at
+        // fixed t the layer's part of the coordinate saturates, so the limit is the albedo at
+        // eta = 1 itself, at the mu the coordinate gives there (inside the layer, t <= w, the
+        // layer's profile is the limit, taken at glass_layout::limit_slice_eta).
+        if let (
+            Some(Axis::Ior {
+                mapping: IorMapping::Glass,
+                ..
+            }),
+            Some(Axis::Mu { .. }),
+            Some(0),
+            Some(m),
+        ) = (self.ior, self.mu, k, m)
+            && self.ior.is_some_and(|ior| ior.coordinate(0) == 0.0)
+            && self.mu.is_some_and(|mu| {
+                mu.coordinate(m) > glass_layout::GlassLayout::KILN.layer_share_at(row_alpha, 1.0)
+            })
+        {
+            eta_up = Some(1.0);
+        }
         let eta = eta_up.map(|eta| self.relative_eta(eta));
         let Some(t_r) = row else {
             return (0.0, None, eta);
