@@ -64,7 +64,9 @@ fn main() {
         }
     }
     // LIMIT_OFFSET=X computes the eta layer's texels of the eta = 1 slice at eta - 1 = X alpha^2.
-    let limit_offset: Option<f64> = std::env::var("LIMIT_OFFSET").ok().map(|v| v.parse().unwrap());
+    let limit_offset: Option<f64> = std::env::var("LIMIT_OFFSET")
+        .ok()
+        .map(|v| v.parse().unwrap());
     let rel = |eta_up: f64| if inside { 1.0 / eta_up } else { eta_up };
     // Table, as kiln bakes one in a glass layout.
     let nodes: Vec<(usize, usize, usize)> = (0..n)

@@ -99,10 +99,11 @@ pub enum MuMapping {
     /// boundary layer `mu ~ alpha` at every roughness (see the module docs); kiln's default
     /// for the tables it bakes.
     Adaptive,
-    /// kiln's glass layout ([`super::glass_layout`]): `t = w A(mu; kappa, 1/2) + (1 - w)
-    /// A(mu; 4 alpha, 0.4)`, the adaptive coordinate with a share `w = 0.2` given to the layer of
-    /// width `kappa = (eta - 1) / (alpha + sqrt(eta - 1))` that opens near grazing as
-    /// `eta -> 1+`; depends on roughness and on the IOR, so only on a table over the IOR.
+    /// kiln's glass layout ([`super::glass_layout`]): `t = w A(mu; kappa, 0.35) + (1 - w)
+    /// A(mu; 4 alpha, 0.4)`, the adaptive coordinate with a share `w = 0.3 / (1 + (eta - 1) /
+    /// alpha^2)` given to the layer of width `kappa = (eta - 1) / (alpha + sqrt(eta - 1))` that
+    /// opens near grazing as `eta -> 1+`; depends on roughness and on the IOR, so only on a table
+    /// over the IOR.
     Glass,
 }
 
@@ -180,11 +181,13 @@ impl MuMapping {
                  the row at alpha = 0 holds the limit alpha -> 0+ (computed at alpha = 1e-7)"
             }
             MuMapping::Glass => {
-                "lookup coordinate t = 0.2 A(mu; kappa, 0.5) + 0.8 A(mu; 4 alpha, 0.4) with \
+                "lookup coordinate t = w A(mu; kappa, 0.35) + (1 - w) A(mu; 4 alpha, 0.4) with \
                  A(y; k, p) = (y (1 + k) / (y + k))^p (1 at k = 0, y > 0; 0 at y = 0), \
-                 kappa = (eta - 1) / (alpha + sqrt(eta - 1)), eta >= 1 the IOR axis' index (1 / the \
-                 relative index of light from inside); mu at t by bisection; the row at alpha = 0 \
-                 holds the limit alpha -> 0+ (computed at alpha = 1e-3)"
+                 kappa = (eta - 1) / (alpha + sqrt(eta - 1)), w = 0.3 / (1 + (eta - 1) / \
+                 (1 alpha^2)), eta >= 1 the IOR axis' index (1 / the relative index of light from \
+                 inside); mu at t by bisection; the row at alpha = 0 holds the limit alpha -> 0+ \
+                 (computed at alpha = 1e-3); on the slice eta = 1 the texels above the eta layer \
+                 (t > 0.3) are the albedo at eta = 1"
             }
         }
     }
@@ -203,10 +206,10 @@ pub enum IorMapping {
     /// nodes, so the axis runs from `eta = 1 + 2e-8` to `eta = 99.5` whatever `eta_max`, and
     /// the lookup reads `t = z` unclamped (`microfacet_ggx_glass_E`).
     Blender,
-    /// kiln's glass layout ([`super::glass_layout`]): `z = A(x; 0.3 alpha^2, 1/2) / 2 + x^(1/2) / 2`
-    /// with `x = u(eta) / u(eta_max)`, `u = (eta - 1) / (eta + 1)`, `A` as [`MuMapping::Glass`]:
-    /// half the IOR texels below `eta - 1 ~ alpha^2` at every roughness; the slice `z = 0` holds
-    /// the limit `eta -> 1+`. Depends on roughness.
+    /// kiln's glass layout ([`super::glass_layout`]): `z = 0.35 A(x; 0.3 alpha^2, 1/2) + 0.65
+    /// x^(1/2)` with `x = u(eta) / u(eta_max)`, `u = (eta - 1) / (eta + 1)`, `A` as
+    /// [`MuMapping::Glass`]: a share of the IOR texels below `eta - 1 ~ alpha^2` at every
+    /// roughness; the slice `z = 0` holds the limit `eta -> 1+`. Depends on roughness.
     Glass,
 }
 
@@ -282,7 +285,7 @@ impl IorMapping {
                  a lookup reads t = sqrt((eta - 1) / (eta + 1)))"
             }
             IorMapping::Glass => {
-                "lookup coordinate t = A(x; 0.3 alpha^2, 0.5) / 2 + x^0.5 / 2 with x = u(eta) / \
+                "lookup coordinate t = 0.35 A(x; 0.3 alpha^2, 0.5) + 0.65 x^0.5 with x = u(eta) / \
                  u(eta_max), u(eta) = (eta - 1) / (eta + 1), A(y; k, p) = (y (1 + k) / (y + k))^p \
                  (1 at k = 0, y > 0; 0 at y = 0); eta at t by bisection; the slice t = 0 holds the \
                  one-sided limit eta -> 1+ at fixed coordinates (computed at eta - 1 = 1e-4 \
@@ -577,17 +580,17 @@ mod tests {
                 max: IorBound(3.0),
                 grid: Grid::Nodes,
             };
-            assert_eq!(axis.value_at(0, 1.0), 1.0);
-            assert!((axis.value_at(15, 1.0) - 3.0).abs() < 1e-14);
+            assert_eq!(axis.value_at(0, 1.0, 1.0), 1.0);
+            assert!((axis.value_at(15, 1.0, 1.0) - 3.0).abs() < 1e-14);
             for i in 0..16 {
-                let eta = axis.value_at(i, 1.0);
-                assert!((axis.position(eta, 1.0) - i as f64).abs() < 1e-9);
+                let eta = axis.value_at(i, 1.0, 1.0);
+                assert!((axis.position(eta, 1.0, 1.0) - i as f64).abs() < 1e-9);
                 // From inside: 1 / eta sits at the same place.
-                assert!((axis.position(1.0 / eta, 1.0) - i as f64).abs() < 1e-9);
+                assert!((axis.position(1.0 / eta, 1.0, 1.0) - i as f64).abs() < 1e-9);
             }
         }
         // Cycles' z: F0 = z^4.
-        let eta = IorMapping::Cycles.eta(0.5, 1.5);
+        let eta = IorMapping::Cycles.eta(0.5, 1.5, 1.0);
         let z = 0.5 * (0.5f64 / 2.5).sqrt();
         assert!((((eta - 1.0) / (eta + 1.0)).powi(2) - z.powi(4)).abs() < 1e-15);
     }
@@ -598,11 +601,11 @@ mod tests {
     #[test]
     fn blenders_ior_axis_is_its_clamped_z() {
         let blender = IorMapping::Blender;
-        assert!((blender.eta(0.5, 3.0) - 5.0 / 3.0).abs() < 1e-15);
-        assert!((blender.eta(0.0, 3.0) - (1.0 + 2e-8)).abs() < 1e-15);
-        assert!((blender.eta(1.0, 3.0) / (1.9801 / 0.0199) - 1.0).abs() < 1e-13);
-        assert!((blender.coordinate(5.0 / 3.0, 3.0) - 0.5).abs() < 1e-15);
-        assert!((blender.coordinate(0.6, 3.0) - 0.5).abs() < 1e-15);
+        assert!((blender.eta(0.5, 3.0, 1.0) - 5.0 / 3.0).abs() < 1e-15);
+        assert!((blender.eta(0.0, 3.0, 1.0) - (1.0 + 2e-8)).abs() < 1e-15);
+        assert!((blender.eta(1.0, 3.0, 1.0) / (1.9801 / 0.0199) - 1.0).abs() < 1e-13);
+        assert!((blender.coordinate(5.0 / 3.0, 3.0, 1.0) - 0.5).abs() < 1e-15);
+        assert!((blender.coordinate(0.6, 3.0, 1.0) - 0.5).abs() < 1e-15);
         // Bounds compare and hash by their bits: two axes to different ends are two keys.
         let axis = |max: f64| Axis::Ior {
             size: 16,
@@ -630,7 +633,7 @@ mod tests {
                 };
                 for alpha in [1e-7, 1e-3, 0.3, 1.0, 2.0] {
                     for i in 0..16 {
-                        let p = axis.position(axis.value_at(i, alpha), alpha);
+                        let p = axis.position(axis.value_at(i, alpha, 1.0), alpha, 1.0);
                         assert!((p - i as f64).abs() < 1e-9, "{mapping:?} {alpha} {i}: {p}");
                     }
                 }

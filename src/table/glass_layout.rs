@@ -59,14 +59,14 @@ pub struct GlassLayout {
 impl GlassLayout {
     /// kiln's glass layout.
     pub const KILN: GlassLayout = GlassLayout {
-        layer_share: 0.2,
-        layer_share_decay: 0.0,
+        layer_share: 0.3,
+        layer_share_decay: 1.0,
         layer_scale: 1.0,
         layer_sqrt_weight: 1.0,
-        layer_power: 0.5,
+        layer_power: 0.35,
         ior_power: 0.5,
         ior_scale: 0.3,
-        ior_share: 0.5,
+        ior_share: 0.35,
     };
 
     /// The IOR coordinate `z` of `eta` (either side: `eta < 1` is read at `1 / eta`) on an axis
@@ -279,25 +279,26 @@ mod tests {
     }
 
     /// The eta layer keeps its share of the coordinate: at `mu = kappa` the layer's part is
-    /// `w (2 kappa / (1 + kappa))^(1/2)`, worked for `eta = 1.01`, `alpha = 0.1`:
-    /// `kappa = 0.01 / (0.1 + 0.1) = 0.05`.
+    /// `w ((1 + kappa) / 2)^0.35`, worked for `eta = 1.01`, `alpha = 0.1`:
+    /// `kappa = 0.01 / (0.1 + 0.1) = 0.05`, `w = 0.3 / (1 + 0.01 / 0.01) = 0.15`.
     #[test]
     fn the_eta_layer_sits_at_a_fixed_share_of_the_coordinate() {
         let kappa = layer_width(0.1, 1.01);
         assert!((kappa - 0.05).abs() < 1e-12, "{kappa}");
         let t = mu_coordinate(kappa, 0.1, 1.01);
         let masking = crate::integrate::grazing::t_of_mu(kappa, 0.1);
-        let expected = 0.2 * (2.0 * 0.05 / 1.05f64).sqrt() + 0.8 * masking;
+        let expected = 0.15 * (1.05f64 / 2.0).powf(0.35) + 0.85 * masking;
         assert!((t - expected).abs() < 1e-12, "{t} {expected}");
         // On a mirror the layer is the Fresnel layer sqrt(eta - 1).
         assert!((layer_width(0.0, 1.0004) - 0.02).abs() < 1e-12);
         // At eta = 1 it has no width: t jumps to w above mu = 0.
-        assert!((mu_coordinate(1e-300, 0.5, 1.0) - 0.2).abs() < 1e-12);
+        assert!((mu_coordinate(1e-300, 0.5, 1.0) - 0.3).abs() < 1e-12);
+        // Where the layer has merged with the masking layer its share fades.
+        assert!((GlassLayout::KILN.layer_share_at(0.1, 1.1) - 0.3 / 11.0).abs() < 1e-15);
     }
 
-    /// The IOR coordinate puts `eta - 1 = c_z alpha^2` halfway along its tied share:
-    /// at `alpha = 0.1`, `x = 0.003 (1 + 0.003) / (x + 0.003)`... worked: the tied part is
-    /// `(2 k / (1 + k))^(1/2)` at `x = k = 0.003`.
+    /// The IOR coordinate's tied share at `x = k = c_z alpha^2` (`alpha = 0.1`, `k = 0.003`),
+    /// worked: `0.35 ((1 + k) / 2)^(1/2) + 0.65 k^(1/2)`.
     #[test]
     fn the_ior_coordinate_is_tied_to_alpha_squared() {
         let k: f64 = 0.3 * 0.01;
@@ -305,7 +306,7 @@ mod tests {
         let u = k * reflectance_root(eta_max);
         let eta = (1.0 + u) / (1.0 - u);
         let z = ior_coordinate(eta, eta_max, 0.1);
-        let expected = 0.5 * (2.0 * k / (1.0 + k)).sqrt() + 0.5 * k.sqrt();
+        let expected = 0.35 * ((1.0 + k) / 2.0).sqrt() + 0.65 * k.sqrt();
         assert!((z - expected).abs() < 1e-12, "{z} {expected}");
     }
 
@@ -315,34 +316,34 @@ mod tests {
         use crate::table::axis::{IorMapping, MuMapping};
         let mu = MuMapping::Glass.formula();
         let ior = IorMapping::Glass.formula();
+        let k = GlassLayout::KILN;
         for (text, constant) in [
+            (mu, format!("t = w A(mu; kappa, {})", k.layer_power)),
             (
                 mu,
                 format!(
-                    "t = {} A(mu; kappa, {})",
-                    GlassLayout::KILN.layer_share,
-                    GlassLayout::KILN.layer_power
+                    "w = {} / (1 + (eta - 1) / ({} alpha^2))",
+                    k.layer_share, k.layer_share_decay
                 ),
             ),
+            (mu, format!("(t > {})", k.layer_share)),
             (mu, format!("computed at alpha = {ROW_LIMIT_ALPHA:e}")),
             (
                 ior,
                 format!(
-                    "A(x; {} alpha^2, {})",
-                    GlassLayout::KILN.ior_scale,
-                    GlassLayout::KILN.ior_power
+                    "t = {} A(x; {} alpha^2, {}) + {} x^{}",
+                    k.ior_share,
+                    k.ior_scale,
+                    k.ior_power,
+                    1.0 - k.ior_share,
+                    k.ior_power
                 ),
             ),
             (ior, format!("eta - 1 = {LIMIT_ETA_OFFSET:e} alpha^2")),
         ] {
             assert!(text.contains(&constant), "{text} lacks {constant}");
         }
-        let k = GlassLayout::KILN;
-        assert_eq!(
-            (k.layer_scale, k.layer_sqrt_weight, k.ior_share),
-            (1.0, 1.0, 0.5)
-        );
-        assert_eq!(k.layer_share_decay, 0.0);
+        assert_eq!((k.layer_scale, k.layer_sqrt_weight), (1.0, 1.0));
     }
 
     /// `(1 + Lambda) / (1 + 2 Lambda)`: 1 where nothing is masked, 1/2 on the horizon; at

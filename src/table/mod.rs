@@ -978,10 +978,22 @@ mod tests {
         if let Some(Axis::Ior { mapping, .. }) = &mut glass.ior {
             *mapping = IorMapping::Cycles;
         }
-        assert!(!glass.id().contains("ior"), "{}", glass.id());
-        let mut f_avg = glass;
+        // Cycles' product grid is the default of F_avg alone: a dielectric albedo on it is tagged.
+        assert!(glass.id().ends_with("-ior-cycles"), "{}", glass.id());
+        let mut f_avg = glass.clone();
         f_avg.quantity = Quantity::FAvg;
         assert!(f_avg.base_id() == "dielectric-F_avg", "{}", f_avg.base_id());
+        assert!(!f_avg.id().contains("ior"), "{}", f_avg.id());
+        // kiln's glass layout is the dielectric albedos' default: no tag.
+        if let Some(Axis::Ior { mapping, .. }) = &mut glass.ior {
+            *mapping = IorMapping::Glass;
+        }
+        glass.mu = Some(Axis::Mu {
+            size: 4,
+            mapping: MuMapping::Glass,
+            grid: Grid::Nodes,
+        });
+        assert_eq!(glass.id(), "ggx-height-correlated-E_dielectric");
         // A derived table takes the layout of its source.
         let mut norm = default.clone();
         norm.lookup_of = Some(Box::new(sqrt));
@@ -1069,7 +1081,7 @@ mod tests {
                 for row in first_row..5 {
                     let r = r_axis.coordinate(row);
                     for col in 0..4 {
-                        let mu = mu_axis.value_at(col, r * r);
+                        let mu = mu_axis.value_at(col, r * r, 1.0);
                         let got = t.lookup(mu, r);
                         assert!(
                             (got - t.value[row * 4 + col]).abs() < 1e-9,

@@ -761,7 +761,7 @@ mod tests {
     ) -> TableSpec {
         TableSpec {
             quantity,
-            ior: Some(Axis::Ior {
+            ior: Some(crate::table::axis::Axis::Ior {
                 size: iors,
                 mapping: crate::table::axis::IorMapping::Linear,
                 max: crate::table::axis::IorBound(3.0),
