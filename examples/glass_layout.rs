@@ -2,8 +2,9 @@
 //! candidate glass layouts ([`GlassLayout`], kiln's is `GlassLayout::KILN`), per eta band, for
 //! the N^3 `E_dielectric` table of light from outside (`out`) or inside (`in`), GGX
 //! height-correlated, on nodes grids, IOR axis up to 3. The table is built as `kiln bake` builds
-//! one in the glass layout (the row `alpha = 0` at `ROW_LIMIT_ALPHA`, the slice `eta = 1` at
-//! `limit_slice_eta`), from the reference at 1e-9, and audited at a fixed set of points for every
+//! one in the glass layout (`TableSpec::texel_point`: the row `alpha = 0` at `ROW_LIMIT_ALPHA`,
+//! the slice `eta = 1` at `eta = 1` above the eta layer and at `limit_slice_eta` inside it), from
+//! the reference at 1e-9, and audited at a fixed set of points for every
 //! candidate: `eta` at `1 + 1e-6` and 30 steps of Cycles' `z` (IOR nodes of a 16-texel axis and
 //! halfway between), `r` in 30 steps, and `mu` at 0, 1e-12, 1e-6 to 1 in 24 log steps and every
 //! 1/64 (the truth is cached in the temporary directory, `kiln-glass-truth-{out,in}.bin`, so a
@@ -18,7 +19,9 @@
 use kiln::integrate::dielectric::reference_dielectric_albedo;
 use kiln::integrate::reference::ReferenceSettings;
 use kiln::model::{Masking, Model, Ndf};
-use kiln::table::glass_layout::{GlassLayout, ROW_LIMIT_ALPHA, limit_slice_eta};
+use kiln::table::glass_layout::{
+    GlassLayout, LAYER_ROW_LIMIT_ALPHA, ROW_LIMIT_ALPHA, limit_slice_eta,
+};
 use rayon::prelude::*;
 use std::collections::HashMap;
 use std::io::Write;
@@ -82,9 +85,16 @@ fn main() {
             let eta = layout.ior_at(z, ETA_MAX, alpha);
             // The eta = 1 slice: the albedo at eta = 1 above the eta layer (t > w), the layer's
             // profile at a small offset inside it (as `TableSpec::texel_point`).
+            let layer = eta <= 1.0 && t <= layout.layer_share_at(alpha, 1.0);
+            // The layer's texels of the row alpha = 0 at LAYER_ROW_LIMIT_ALPHA.
+            let alpha = if layer && i == 0 {
+                LAYER_ROW_LIMIT_ALPHA
+            } else {
+                alpha
+            };
             let eta_up = if eta > 1.0 {
                 eta
-            } else if t > layout.layer_share_at(alpha, 1.0) {
+            } else if !layer {
                 1.0
             } else {
                 limit_offset.map_or_else(|| limit_slice_eta(alpha), |o| 1.0 + o * alpha * alpha)

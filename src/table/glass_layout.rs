@@ -163,6 +163,13 @@ pub const LIMIT_ETA_OFFSET: f64 = 1e-4;
 /// `alpha = 1e-3` and `1e-2`).
 pub const ROW_LIMIT_ALPHA: f64 = 1e-3;
 
+/// The `alpha` at which the eta layer's texels (`t <= w`) of the `eta = 1` slice are computed on
+/// the row `alpha = 0`: there the albedo is a function of `mu / alpha` and `(eta - 1) / alpha^2`
+/// alone (from inside, 0.0754526032 at `alpha` 1e-3 and 0.0754526236 at 1e-2, `mu = 2.5e-5
+/// alpha`, `eta = 1 / (1 + 1e-4 alpha^2)`), and at `alpha = 1e-3` the reference exhausts its
+/// budget on them.
+pub const LAYER_ROW_LIMIT_ALPHA: f64 = 1e-2;
+
 /// The index at which the `eta = 1` slice is computed at roughness `alpha`
 /// (`1 + LIMIT_ETA_OFFSET alpha^2`).
 #[must_use]

@@ -356,23 +356,35 @@ impl TableSpec {
         // fixed t the layer's part of the coordinate saturates, so the limit is the albedo at
         // eta = 1 itself, at the mu the coordinate gives there (inside the layer, t <= w, the
         // layer's profile is the limit, taken at glass_layout::limit_slice_eta).
+        // On the row alpha = 0 the layer's texels are computed at a larger alpha
+        // (glass_layout::LAYER_ROW_LIMIT_ALPHA), where the reference converges.
+        let mut layer_limit = None;
         if let (
             Some(Axis::Ior {
                 mapping: IorMapping::Glass,
                 ..
             }),
-            Some(Axis::Mu { .. }),
+            Some(mu_axis @ Axis::Mu { mapping, .. }),
             Some(0),
             Some(m),
-        ) = (self.ior, self.mu, k, m)
+            Some(t_r),
+        ) = (self.ior, self.mu, k, m, row)
             && self.ior.is_some_and(|ior| ior.coordinate(0) == 0.0)
-            && self.mu.is_some_and(|mu| {
-                mu.coordinate(m) > glass_layout::GlassLayout::KILN.layer_share_at(row_alpha, 1.0)
-            })
         {
-            eta_up = Some(1.0);
+            let t_mu = mu_axis.coordinate(m);
+            if t_mu > glass_layout::GlassLayout::KILN.layer_share_at(row_alpha, 1.0) {
+                eta_up = Some(1.0);
+            } else if self.roughness_convention().to_alpha(t_r) == 0.0 {
+                let alpha = glass_layout::LAYER_ROW_LIMIT_ALPHA;
+                let eta_limit = glass_layout::limit_slice_eta(alpha);
+                eta_up = Some(eta_limit);
+                layer_limit = Some((alpha, mapping.mu_at(t_mu, alpha, eta_limit)));
+            }
         }
         let eta = eta_up.map(|eta| self.relative_eta(eta));
+        if let Some((alpha, mu)) = layer_limit {
+            return (alpha, Some(mu), eta);
+        }
         let Some(t_r) = row else {
             return (0.0, None, eta);
         };
