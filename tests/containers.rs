@@ -22,6 +22,8 @@ fn tables() -> &'static [Table] {
             BakeOptions {
                 quantities: vec![Quantity::EDielectric, Quantity::FAvg],
                 size: 3,
+                // kiln's glass layout, whose mu coordinate is its own.
+                mu_mapping: MuMapping::Adaptive,
                 ..options
             }
             .bake(&|_| {})

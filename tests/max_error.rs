@@ -101,7 +101,19 @@ fn looser_bounds_cost_fewer_samples() {
     .resolved()
     .specs();
     let spec_digits: Vec<_> = specs.iter().map(|s| s.reference_digits).collect();
-    assert_eq!(spec_digits, [Some(5), Some(5), Some(5)]);
+    // kiln's glass layout computes at 1e-9 at least (kiln::bake::GLASS_LAYOUT_MIN_DIGITS): the
+    // reference at coarser tolerances understates its error at some of its nodes.
+    assert_eq!(spec_digits, [Some(5), Some(9), Some(9)]);
+    let product_grid = BakeOptions {
+        max_error: Some(1e-5),
+        quantities: vec![Quantity::EDielectric, Quantity::EAvgDielectricInside],
+        ior_mapping: kiln::IorMapping::Cycles,
+        ..BakeOptions::default()
+    }
+    .resolved()
+    .specs();
+    let spec_digits: Vec<_> = product_grid.iter().map(|s| s.reference_digits).collect();
+    assert_eq!(spec_digits, [Some(5), Some(5)]);
     // Out of range: a clear error.
     for bad in [0.0, 1e-12, 0.6, f64::NAN] {
         let options = BakeOptions {

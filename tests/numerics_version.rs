@@ -44,25 +44,45 @@ const GOLDEN: &[(u32, &str, &str)] = &[
     ),
     (
         11,
-        "ggx-height-correlated-E_dielectric Reference",
+        "ggx-height-correlated-E_dielectric-ior-cycles Reference",
         "8be1bdf15cfb3879",
     ),
     (
         11,
-        "ggx-height-correlated-E_dielectric_inside Reference",
+        "ggx-height-correlated-E_dielectric_inside-ior-cycles Reference",
         "d559317d916cf96e",
     ),
     (
         11,
-        "ggx-height-correlated-E_avg_dielectric Reference",
+        "ggx-height-correlated-E_avg_dielectric-ior-cycles Reference",
         "187a7bdcc6797d6a",
     ),
     (
         11,
-        "ggx-height-correlated-E_avg_dielectric_inside Reference",
+        "ggx-height-correlated-E_avg_dielectric_inside-ior-cycles Reference",
         "ab14230185748a72",
     ),
     (11, "dielectric-F_avg Reference", "6721c906b37a9454"),
+    (
+        11,
+        "ggx-height-correlated-E_dielectric Reference",
+        "c1392445f35fcdd9",
+    ),
+    (
+        11,
+        "ggx-height-correlated-E_dielectric_inside Reference",
+        "2f4ced5a0ad3e072",
+    ),
+    (
+        11,
+        "ggx-height-correlated-E_avg_dielectric Reference",
+        "3fadd359c4b5f2de",
+    ),
+    (
+        11,
+        "ggx-height-correlated-E_avg_dielectric_inside Reference",
+        "279b23a6937ace08",
+    ),
     (11, "ggx-height-correlated-E Qmc", "4f022cec14919ccd"),
     (11, "ggx-height-correlated-E_avg Qmc", "237b702ae4bc2f45"),
     (11, "beckmann-height-correlated-E Qmc", "86dc491fb47ddc48"),
@@ -73,7 +93,7 @@ const GOLDEN: &[(u32, &str, &str)] = &[
     ),
     (
         11,
-        "ggx-height-correlated-E_dielectric Qmc",
+        "ggx-height-correlated-E_dielectric-ior-cycles Qmc",
         "499cd44787ed1757",
     ),
 ];

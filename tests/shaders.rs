@@ -21,6 +21,16 @@ fn tables() -> Vec<Table> {
             quantities: vec![Quantity::E, Quantity::EDielectric, Quantity::FAvg],
             mu_mapping: MuMapping::Sqrt,
             grid: Grid::Centers,
+            ior_mapping: kiln::IorMapping::Cycles,
+            ..base.clone()
+        }
+        .bake(&|_| {})
+        .unwrap(),
+    );
+    // kiln's glass layout, whose lookups compute its coordinates.
+    tables.extend(
+        BakeOptions {
+            quantities: vec![Quantity::EDielectric, Quantity::EDielectricInside],
             ..base
         }
         .bake(&|_| {})

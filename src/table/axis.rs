@@ -99,11 +99,12 @@ pub enum MuMapping {
     /// boundary layer `mu ~ alpha` at every roughness (see the module docs); kiln's default
     /// for the tables it bakes.
     Adaptive,
-    /// kiln's glass layout ([`super::glass_layout`]): `t = w A(mu; kappa, 0.35) + (1 - w)
+    /// kiln's glass layout (`table::glass_layout`): `t = w A(mu; kappa, 0.35) + (1 - w)
     /// A(mu; 4 alpha, 0.4)`, the adaptive coordinate with a share `w = 0.3 / (1 + (eta - 1) /
     /// alpha^2)` given to the layer of width `kappa = (eta - 1) / (alpha + sqrt(eta - 1))` that
     /// opens near grazing as `eta -> 1+`; depends on roughness and on the IOR, so only on a table
-    /// over the IOR.
+    /// over the IOR, chosen by `--ior-axis glass`.
+    #[cfg_attr(feature = "cli", value(skip))]
     Glass,
 }
 
@@ -206,10 +207,10 @@ pub enum IorMapping {
     /// nodes, so the axis runs from `eta = 1 + 2e-8` to `eta = 99.5` whatever `eta_max`, and
     /// the lookup reads `t = z` unclamped (`microfacet_ggx_glass_E`).
     Blender,
-    /// kiln's glass layout ([`super::glass_layout`]): `z = 0.35 A(x; 0.3 alpha^2, 1/2) + 0.65
-    /// x^(1/2)` with `x = u(eta) / u(eta_max)`, `u = (eta - 1) / (eta + 1)`, `A` as
-    /// [`MuMapping::Glass`]: a share of the IOR texels below `eta - 1 ~ alpha^2` at every
-    /// roughness; the slice `z = 0` holds the limit `eta -> 1+`. Depends on roughness.
+    /// kiln's glass layout for the dielectric albedos (the default): IOR and
+    /// mu coordinates that follow the layers near `eta = 1`, the slice `eta = 1` holding the
+    /// limit `eta -> 1+`; `z = 0.35 A(x; 0.3 alpha^2, 1/2) + 0.65 x^(1/2)`, `x = u(eta) /
+    /// u(eta_max)`, `u = (eta - 1) / (eta + 1)`, `A(y; k, p) = (y (1 + k) / (y + k))^p`.
     Glass,
 }
 

@@ -430,14 +430,19 @@ impl TableSpec {
 
     /// The `alpha` at which a row at `alpha = 0` is computed when the layout's coordinates
     /// follow layers that shrink with `alpha` (its limit `alpha -> 0+` at fixed texture
-    /// coordinates): [`glass_layout::ROW_LIMIT_ALPHA`] on a `glass` IOR axis,
+    /// coordinates): [`glass_layout::ROW_LIMIT_ALPHA`] on a `glass` IOR axis with a mu axis,
     /// [`axis::LAYER_LIMIT_ALPHA`] on an `adaptive` mu axis; `None` otherwise.
     #[must_use]
     pub fn row_limit_alpha(&self) -> Option<f64> {
-        if let Some(Axis::Ior {
-            mapping: IorMapping::Glass,
-            ..
-        }) = self.ior
+        // An average has no layer in mu to follow: its row alpha = 0 is the smooth interface's
+        // exact 1, at every index.
+        if let (
+            Some(Axis::Ior {
+                mapping: IorMapping::Glass,
+                ..
+            }),
+            Some(_),
+        ) = (self.ior, self.mu)
         {
             return Some(glass_layout::ROW_LIMIT_ALPHA);
         }

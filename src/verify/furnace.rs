@@ -763,6 +763,7 @@ mod tests {
             density: 1,
             ..crate::verify::AuditSettings::default()
         };
+        // The truth at the reference's own 1e-11: the furnace's, at 1e-9, within 1e-8 of it.
         let reference = crate::integrate::reference::ReferenceSettings::default();
         let expected = |spec: &TableSpec| {
             crate::verify::lookup_coordinates(spec, &settings)
@@ -781,11 +782,11 @@ mod tests {
         let points = expected(&e.spec);
         let worst = points.iter().map(|p| p.1).fold(0.0, f64::max);
         assert!(
-            (report.max_deviation - worst).abs() < 1e-12,
+            (report.max_deviation - worst).abs() < 1e-8,
             "{report:?} {worst}"
         );
         assert!(report.max_deviation > 0.1);
-        assert!((report.deviation.abs() - worst).abs() < 1e-12);
+        assert!((report.deviation.abs() - worst).abs() < 1e-8);
         // Glass seen from inside (the slowest reference: one side only), banded by `1 / eta`.
         let spec = glass_spec(Quantity::EDielectricInside, 2, 2, 2);
         let glass = table(spec.clone(), vec![0.8; 8]);
@@ -806,7 +807,7 @@ mod tests {
                 .map(|p| p.1)
                 .fold(0.0, f64::max);
             assert!(
-                (band.max_deviation - worst).abs() < 1e-12,
+                (band.max_deviation - worst).abs() < 1e-8,
                 "{band:?} {worst}"
             );
             assert!(in_band(band.worst_eta));

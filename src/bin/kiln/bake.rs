@@ -66,7 +66,7 @@ pub struct BakeArgs {
     /// Layout of the tables over the IOR, on [1, --ior-max]. glass: kiln's glass layout for the
     /// dielectric tables, whose IOR and mu coordinates follow the layers near eta = 1 (the IOR
     /// coordinate tied to roughness, the mu coordinate to roughness and the IOR; the eta = 1
-    /// slice holds the limit eta -> 1+; see docs/conventions.md); f-avg keeps cycles. The
+    /// slice holds the limit eta -> 1+); f-avg keeps cycles. The
     /// product grids: cycles (linear in sqrt((eta - 1) / (eta + 1)), Cycles' glass tables; their
     /// names get -ior-cycles) or linear, with --mu-axis. The axis lists eta >= 1; inside tables
     /// are computed at 1 / eta [default: glass].
