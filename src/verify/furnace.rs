@@ -367,10 +367,8 @@ impl FormReport {
     }
 }
 
-/// The reference's tolerance for the truth of Turquin's deviation `E_true / E_lookup - 1`
-/// ([`TURQUIN_TRUTH_TOLERANCE`]): the deviations reported are 1e-5 and more, printed to three
-/// digits, so a truth to 1e-9 moves none of them, and at 1e-11 the glass tables' truth near
-/// `eta = 1` costs seconds a point.
+/// The reference settings for the truth of Turquin's deviation, at
+/// [`TURQUIN_TRUTH_TOLERANCE`].
 fn truth_settings() -> crate::integrate::reference::ReferenceSettings {
     crate::integrate::reference::ReferenceSettings {
         tolerance: TURQUIN_TRUTH_TOLERANCE,
@@ -378,7 +376,11 @@ fn truth_settings() -> crate::integrate::reference::ReferenceSettings {
     }
 }
 
-/// See [`truth_settings`].
+/// The reference's tolerance for the truth of Turquin's deviation `E_true / E_lookup - 1`: the
+/// deviations reported are 1e-5 and more, printed to three digits, so a truth to 1e-9 moves none
+/// of them (the 16 x 16 x 16 glass tables' bands are the same at 1e-11), and at 1e-11 the glass
+/// tables' truth near `eta = 1` costs seconds a point (their furnace took 139 s and 246 s at
+/// 1e-11, 95 s and 106 s at 1e-9, one run each on 2 cores, 2026-12-05).
 pub const TURQUIN_TRUTH_TOLERANCE: f64 = 1e-9;
 
 /// The furnace test of Turquin's compensation with an E table's lookup: single scattering
