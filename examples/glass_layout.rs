@@ -86,8 +86,8 @@ fn main() {
             // The eta = 1 slice: the albedo at eta = 1 above the eta layer (t > w), the layer's
             // profile at a small offset inside it (as `TableSpec::texel_point`).
             let layer = eta <= 1.0 && t <= layout.layer_share_at(alpha, 1.0);
-            // The layer's texels of the row alpha = 0 at LAYER_ROW_LIMIT_ALPHA.
-            let alpha = if layer && i == 0 {
+            // The layer's texels of the rows below LAYER_ROW_LIMIT_ALPHA at that alpha.
+            let alpha = if layer && alpha < LAYER_ROW_LIMIT_ALPHA {
                 LAYER_ROW_LIMIT_ALPHA
             } else {
                 alpha

@@ -938,12 +938,8 @@ pub fn bake_table(spec: TableSpec, command: String, progress: &(dyn Fn(u64) + Sy
 /// [`crate::integrate::average_quadrature::average_albedo_to`]).
 #[must_use]
 pub fn estimate_texel(spec: &TableSpec, index: usize) -> Estimate {
-    let (alpha, mu) = spec.texel_coordinates(index);
-    let at = Point {
-        alpha,
-        mu,
-        eta: spec.texel_eta(index),
-    };
+    let (alpha, mu, eta) = spec.texel_point(index);
+    let at = Point { alpha, mu, eta };
     let integral = spec.integral();
     match spec.method {
         Method::Qmc => integral.qmc(at, &spec.qmc),

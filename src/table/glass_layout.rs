@@ -9,7 +9,8 @@
 //!   the limit `eta -> 1+` at fixed `mu > 0` is `(1 + Lambda(mu)) / (1 + 2 Lambda(mu))` (0.533 at
 //!   `alpha = 1`, `mu = 1/15`): `E` falls from 1 to that curve over a layer of width about
 //!   `(eta - 1) / alpha` in `mu` (`sqrt(eta - 1)` on a mirror). The `mu` coordinate gives that
-//!   layer a fixed share `w` of `t`, whatever `eta`:
+//!   layer a share `w` of `t` while it stands apart from the masking layer,
+//!   `w = w_0 / (1 + (eta - 1) / (d alpha^2))`:
 //!   `t = w A(mu; kappa, p_e) + (1 - w) A(mu; 4 alpha, 0.4)`, with
 //!   `A(mu; k, p) = (mu (1 + k) / (mu + k))^p` (kiln's adaptive axis is `A(mu; 4 alpha, 0.4)`,
 //!   [`crate::integrate::grazing`]) and `kappa = c_e (eta - 1) / (alpha + s sqrt(eta - 1))`.
@@ -17,17 +18,22 @@
 //!   layer `mu ~ alpha`: the IOR coordinate is tied to `alpha^2`,
 //!   `z = b A(x; c_z alpha^2, q) + (1 - b) x^q` with `x = u(eta) / u(eta_max)`,
 //!   `u(eta) = (eta - 1) / (eta + 1)` (`x^(1/2)` is Cycles' `z`, the fourth root of `F0`, scaled).
-//!   At every roughness half the IOR texels lie below `eta - 1 ~ alpha^2`, half above.
+//!   At every roughness a share of the IOR texels lies below `eta - 1 ~ alpha^2`.
 //! - **`eta = 1` itself** is a discontinuity of a renderer's convention (an exactly index-matched
 //!   interface is passed straight through), not of the albedo tabulated: the `z = 0` slice holds
-//!   the one-sided limit `eta -> 1+` at fixed texture coordinates, computed at
-//!   `eta - 1 =` [`LIMIT_ETA_OFFSET`] `alpha^2` (its reciprocal for light from inside); the row
+//!   the one-sided limit `eta -> 1+` at fixed texture coordinates. Above the eta layer
+//!   (`t > w`) that limit is the albedo at `eta = 1` itself (the layer's part of `t` saturates);
+//!   inside it, the layer's profile, computed at `eta - 1 =` [`LIMIT_ETA_OFFSET`] `alpha^2` (its
+//!   reciprocal for light from inside) and at `alpha >=` [`LAYER_ROW_LIMIT_ALPHA`]. The row
 //!   `alpha = 0` holds the limit `alpha -> 0+`, computed at [`ROW_LIMIT_ALPHA`].
+//!   [`crate::table::TableSpec::texel_point`] says where each texel is computed.
 //!
 //! Both coordinates are increasing in their variable and reach 0 and 1 at the axis ends; a
 //! lookup computes them in closed form from `(mu, alpha, eta)`, a bake inverts them by
-//! bisection. The constants were chosen by measured furnace error at 16^3 (the issue's
-//! candidate table; `examples/glass_layout.rs` reproduces each row).
+//! bisection. The constants were chosen by measured furnace error at 16^3
+//! (`examples/glass_layout.rs` measures any candidate: `-- 16 out w=0.2 d=0 pe=0.5 b=0.5`, the
+//! first one, 9.4e-2 next to `eta = 1` and 4.4e-3 above 1.5 on its audit points; kiln's,
+//! `-- 16 out`, 6.9e-2 and 3.2e-3).
 
 use crate::numerics::bisection::bisect;
 
@@ -163,10 +169,10 @@ pub const LIMIT_ETA_OFFSET: f64 = 1e-4;
 /// `alpha = 1e-3` and `1e-2`).
 pub const ROW_LIMIT_ALPHA: f64 = 1e-3;
 
-/// The `alpha` at which the eta layer's texels (`t <= w`) of the `eta = 1` slice are computed on
-/// the row `alpha = 0`: there the albedo is a function of `mu / alpha` and `(eta - 1) / alpha^2`
-/// alone (from inside, 0.0754526032 at `alpha` 1e-3 and 0.0754526236 at 1e-2, `mu = 2.5e-5
-/// alpha`, `eta = 1 / (1 + 1e-4 alpha^2)`), and at `alpha = 1e-3` the reference exhausts its
+/// The smallest `alpha` at which the eta layer's texels (`t <= w`) of the `eta = 1` slice are
+/// computed (rows of smaller `alpha`, and `alpha = 0`, at this one, at the same `t`): there the
+/// albedo is a function of `mu / alpha` and `(eta - 1) / alpha^2` alone (from inside, 0.0754526032 at `alpha` 1e-3 and 0.0754526236 at 1e-2, `mu = 2.5e-5
+/// alpha`, `eta = 1 / (1 + 1e-4 alpha^2)`), and near `alpha = 1e-3` the reference exhausts its
 /// budget on them.
 pub const LAYER_ROW_LIMIT_ALPHA: f64 = 1e-2;
 
@@ -229,18 +235,6 @@ pub fn mu_coordinate(mu: f64, alpha: f64, eta_up: f64) -> f64 {
 #[must_use]
 pub fn mu_at(t: f64, alpha: f64, eta_up: f64) -> f64 {
     GlassLayout::KILN.mu_at(t, alpha, eta_up)
-}
-
-/// The one-sided limit `eta -> 1+` of the single-scattering energy albedo of light from outside
-/// at fixed `mu > 0`: every refracted direction tends to `-o`, which the height-correlated
-/// masking-shadowing keeps with probability `G2 / G1 = (1 + Lambda) / (1 + 2 Lambda)`
-/// (`Lambda = Lambda(mu)`; issue 38, `docs/physics.md`).
-#[must_use]
-pub fn pass_through_limit(lambda: f64) -> f64 {
-    if lambda.is_infinite() {
-        return 0.5;
-    }
-    (1.0 + lambda) / (1.0 + 2.0 * lambda)
 }
 
 #[cfg(test)]
@@ -351,16 +345,5 @@ mod tests {
             assert!(text.contains(&constant), "{text} lacks {constant}");
         }
         assert_eq!((k.layer_scale, k.layer_sqrt_weight), (1.0, 1.0));
-    }
-
-    /// `(1 + Lambda) / (1 + 2 Lambda)`: 1 where nothing is masked, 1/2 on the horizon; at
-    /// `alpha = 1`, `mu = 1/15` (GGX `Lambda = (sqrt(1 + alpha^2 tan^2) - 1) / 2`,
-    /// `tan^2 = 224`): 0.533.
-    #[test]
-    fn the_pass_through_limit() {
-        assert_eq!(pass_through_limit(0.0), 1.0);
-        assert_eq!(pass_through_limit(f64::INFINITY), 0.5);
-        let lambda = ((1.0f64 + 224.0).sqrt() - 1.0) / 2.0;
-        assert!((pass_through_limit(lambda) - 0.5333).abs() < 1e-3);
     }
 }

@@ -356,8 +356,9 @@ impl TableSpec {
         // fixed t the layer's part of the coordinate saturates, so the limit is the albedo at
         // eta = 1 itself, at the mu the coordinate gives there (inside the layer, t <= w, the
         // layer's profile is the limit, taken at glass_layout::limit_slice_eta).
-        // On the row alpha = 0 the layer's texels are computed at a larger alpha
-        // (glass_layout::LAYER_ROW_LIMIT_ALPHA), where the reference converges.
+        // On the rows below alpha = glass_layout::LAYER_ROW_LIMIT_ALPHA the layer's texels are
+        // computed at that alpha, where the reference converges: the layer's profile is a
+        // function of mu / alpha and (eta - 1) / alpha^2 there, both kept.
         let mut layer_limit = None;
         if let (
             Some(Axis::Ior {
@@ -374,7 +375,9 @@ impl TableSpec {
             let t_mu = mu_axis.coordinate(m);
             if t_mu > glass_layout::GlassLayout::KILN.layer_share_at(row_alpha, 1.0) {
                 eta_up = Some(1.0);
-            } else if self.roughness_convention().to_alpha(t_r) == 0.0 {
+            } else if self.roughness_convention().to_alpha(t_r)
+                < glass_layout::LAYER_ROW_LIMIT_ALPHA
+            {
                 let alpha = glass_layout::LAYER_ROW_LIMIT_ALPHA;
                 let eta_limit = glass_layout::limit_slice_eta(alpha);
                 eta_up = Some(eta_limit);

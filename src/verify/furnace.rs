@@ -380,7 +380,8 @@ fn truth_settings() -> crate::integrate::reference::ReferenceSettings {
 /// deviations reported are 1e-5 and more, printed to three digits, so a truth to 1e-9 moves none
 /// of them (the 16 x 16 x 16 glass tables' bands are the same at 1e-11), and at 1e-11 the glass
 /// tables' truth near `eta = 1` costs seconds a point (their furnace took 139 s and 246 s at
-/// 1e-11, 95 s and 106 s at 1e-9, one run each on 2 cores, 2026-12-05).
+/// 1e-11, 95 s and 106 s at 1e-9 with a build running beside them, one run each on 2 cores,
+/// 2026-12-05).
 pub const TURQUIN_TRUTH_TOLERANCE: f64 = 1e-9;
 
 /// The furnace test of Turquin's compensation with an E table's lookup: single scattering
