@@ -32,7 +32,7 @@
 //! lookup computes them in closed form from `(mu, alpha, eta)`, a bake inverts them by
 //! bisection. The constants were chosen by measured furnace error at 16^3
 //! (`examples/glass_layout.rs` measures any candidate: `-- 16 out w=0.2 d=0 pe=0.5 b=0.5`, the
-//! first one, 9.4e-2 next to `eta = 1` and 4.4e-3 above 1.5 on its audit points; kiln's,
+//! first one, 9.4e-2 next to `eta = 1` and 4.6e-3 above 1.5 on its audit points; kiln's,
 //! `-- 16 out`, 6.9e-2 and 3.2e-3).
 
 use crate::numerics::bisection::bisect;
