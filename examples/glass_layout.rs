@@ -19,9 +19,7 @@
 use kiln::integrate::dielectric::reference_dielectric_albedo;
 use kiln::integrate::reference::ReferenceSettings;
 use kiln::model::{Masking, Model, Ndf};
-use kiln::table::glass_layout::{
-    GlassLayout, LAYER_ROW_LIMIT_ALPHA, ROW_LIMIT_ALPHA, limit_slice_eta,
-};
+use kiln::table::glass_layout::{GlassLayout, ROW_LIMIT_ALPHA};
 use rayon::prelude::*;
 use std::collections::HashMap;
 use std::io::Write;
@@ -83,21 +81,18 @@ fn main() {
             let t = j as f64 / (n - 1) as f64;
             let alpha = if i == 0 { ROW_LIMIT_ALPHA } else { r * r };
             let eta = layout.ior_at(z, ETA_MAX, alpha);
-            // The eta = 1 slice: the albedo at eta = 1 above the eta layer (t > w), the layer's
-            // profile at a small offset inside it (as `TableSpec::texel_point`).
-            let layer = eta <= 1.0 && t <= layout.layer_share_at(alpha, 1.0);
-            // The layer's texels of the rows below LAYER_ROW_LIMIT_ALPHA at that alpha.
-            let alpha = if layer && alpha < LAYER_ROW_LIMIT_ALPHA {
-                LAYER_ROW_LIMIT_ALPHA
+            // The eta = 1 slice where `TableSpec::texel_point` puts it (LIMIT_OFFSET moves the
+            // eta layer's texels).
+            let (alpha, eta_up) = if eta > 1.0 {
+                (alpha, eta)
             } else {
-                alpha
-            };
-            let eta_up = if eta > 1.0 {
-                eta
-            } else if !layer {
-                1.0
-            } else {
-                limit_offset.map_or_else(|| limit_slice_eta(alpha), |o| 1.0 + o * alpha * alpha)
+                match layout.limit_slice_point(t, alpha) {
+                    (alpha, eta_up) if eta_up > 1.0 => (
+                        alpha,
+                        limit_offset.map_or(eta_up, |o| 1.0 + o * alpha * alpha),
+                    ),
+                    point => point,
+                }
             };
             if i == 0 && t >= 1.0 {
                 return truth(0.0, 1.0, rel(eta_up));

@@ -950,7 +950,7 @@ pub fn estimate_texel(spec: &TableSpec, index: usize) -> Estimate {
             // (GLASS_LAYOUT_MIN_DIGITS); where its layers' limits (mu ~ 1e-4 alpha at
             // alpha 1e-3, eta - 1 ~ 1e-9) exhaust the budget at those, the texel settles for a
             // hundred times the tolerance, converged (the bake's check measures the result).
-            if !r.converged && spec.row_limit_alpha().is_some() && spec.ior.is_some() {
+            if !r.converged && spec.is_glass_layout() {
                 let coarser = crate::integrate::reference::ReferenceSettings {
                     tolerance: settings.tolerance * 100.0,
                     ..settings
@@ -983,12 +983,12 @@ pub const MAX_IOR: f64 = crate::model::fresnel::MAX_INDEX;
 pub fn check_computed(table: &Table) -> Result<()> {
     let spec = &table.spec;
     let place = |k: usize| {
-        let (alpha, mu) = spec.texel_coordinates(k);
+        let (alpha, mu, eta) = spec.texel_point(k);
         let mut at = format!("texel {k} (alpha {alpha:e}");
         if let Some(mu) = mu {
             at += &format!(", mu {mu:e}");
         }
-        if let Some(eta) = spec.texel_eta(k) {
+        if let Some(eta) = eta {
             at += &format!(", eta {eta:e}");
         }
         at + ")"

@@ -127,25 +127,20 @@ fn tables() -> Vec<Table> {
         mu_mapping: kiln::MuMapping::Linear,
         ..base.clone()
     }));
+    let glass = [
+        Quantity::EDielectric,
+        Quantity::EDielectricInside,
+        Quantity::EAvgDielectric,
+        Quantity::EAvgDielectricInside,
+    ];
     all.extend(bake(BakeOptions {
-        quantities: vec![
-            Quantity::EDielectric,
-            Quantity::EDielectricInside,
-            Quantity::EAvgDielectric,
-            Quantity::EAvgDielectricInside,
-            Quantity::FAvg,
-        ],
+        quantities: [&glass[..], &[Quantity::FAvg]].concat(),
         ior_mapping: IorMapping::Cycles,
         ..base.clone()
     }));
     // kiln's glass layout (the default for the dielectric albedos).
     all.extend(bake(BakeOptions {
-        quantities: vec![
-            Quantity::EDielectric,
-            Quantity::EDielectricInside,
-            Quantity::EAvgDielectric,
-            Quantity::EAvgDielectricInside,
-        ],
+        quantities: glass.to_vec(),
         ..base.clone()
     }));
     let qmc = BakeOptions {

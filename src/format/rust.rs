@@ -9,10 +9,10 @@ use crate::model::RoughnessConvention;
 use crate::table::Table;
 use crate::table::axis::{ADAPTIVE_POWER, ADAPTIVE_SCALE, Axis, Grid, IorMapping, MuMapping};
 use crate::table::glass_layout;
+use std::fmt::Write as _;
 
 /// The glass layout the `glass` mappings stand for.
 const GLASS: glass_layout::GlassLayout = glass_layout::GlassLayout::KILN;
-use std::fmt::Write as _;
 
 /// On every generated array: a measured value may happen to print like a mathematical constant
 /// (`1 - E(1, alpha = 1) = ln 2`), which clippy would flag in the including crate.
@@ -222,7 +222,7 @@ fn write_lookup(out: &mut String, table: &Table, prefix: &str, ty: &str) {
                 out,
                 "pub fn {name}(table: &{ty}, mu: f32, roughness: f32) -> f32 {{"
             );
-            if matches!(mu_axis, Axis::Mu { mapping, .. } if mapping.depends_on_roughness()) {
+            if spec.coordinates_depend_on_roughness() {
                 let _ = writeln!(out, "    let alpha = {alpha};");
             }
             let _ = writeln!(out, "    let t_mu = {};", coordinate_code(&mu_axis));
@@ -291,12 +291,7 @@ fn write_ior_lookup(out: &mut String, table: &Table, prefix: &str, ty: &str) {
         RoughnessConvention::Perceptual => "roughness * roughness",
         RoughnessConvention::Alpha => "roughness",
     };
-    if spec
-        .mu
-        .into_iter()
-        .chain(spec.ior)
-        .any(|axis| axis.depends_on_row())
-    {
+    if spec.coordinates_depend_on_roughness() {
         let _ = writeln!(out, "    let alpha = {alpha};");
     }
     let _ = writeln!(out, "    let t_eta = {};", coordinate_code(&ior));

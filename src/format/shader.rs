@@ -18,10 +18,10 @@ use crate::model::RoughnessConvention;
 use crate::table::Table;
 use crate::table::axis::{ADAPTIVE_POWER, ADAPTIVE_SCALE, Axis, Grid, IorMapping, MuMapping};
 use crate::table::glass_layout;
+use std::fmt::Write as _;
 
 /// The glass layout the `glass` mappings stand for.
 const GLASS: glass_layout::GlassLayout = glass_layout::GlassLayout::KILN;
-use std::fmt::Write as _;
 
 /// A shading language.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -192,12 +192,7 @@ fn parameters(language: Language, table: &Table) -> Vec<(&'static str, String)> 
 fn preamble(language: Language, table: &Table) -> String {
     let spec = &table.spec;
     let mut out = String::new();
-    if spec
-        .mu
-        .into_iter()
-        .chain(spec.ior)
-        .any(|axis| axis.depends_on_row())
-    {
+    if spec.coordinates_depend_on_roughness() {
         let alpha = match spec.roughness_convention() {
             RoughnessConvention::Perceptual => "roughness * roughness",
             RoughnessConvention::Alpha => "roughness",
@@ -223,7 +218,7 @@ fn preamble(language: Language, table: &Table) -> String {
         );
     }
     if matches!(spec.mu, Some(Axis::Mu { mapping, .. }) if mapping.depends_on_ior()) {
-        // The eta layer's width (table::glass_layout::layer_width).
+        // The eta layer's width (GlassLayout::layer_width).
         out += &language.local(
             "kappa",
             &format!(

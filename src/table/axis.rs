@@ -147,7 +147,7 @@ impl MuMapping {
             MuMapping::Linear => t,
             MuMapping::Sqrt => t * t,
             MuMapping::Adaptive => crate::integrate::grazing::mu_of_t(t, alpha),
-            MuMapping::Glass => super::glass_layout::mu_at(t, alpha, eta_up),
+            MuMapping::Glass => super::glass_layout::GlassLayout::KILN.mu_at(t, alpha, eta_up),
         }
     }
 
@@ -166,7 +166,9 @@ impl MuMapping {
             MuMapping::Linear => mu,
             MuMapping::Sqrt => mu.sqrt(),
             MuMapping::Adaptive => crate::integrate::grazing::t_of_mu(mu, alpha),
-            MuMapping::Glass => super::glass_layout::mu_coordinate(mu, alpha, eta_up),
+            MuMapping::Glass => {
+                super::glass_layout::GlassLayout::KILN.mu_coordinate(mu, alpha, eta_up)
+            }
         }
     }
 
@@ -245,7 +247,7 @@ impl IorMapping {
     #[must_use]
     pub fn eta(self, t: f64, max: f64, alpha: f64) -> f64 {
         match self {
-            IorMapping::Glass => super::glass_layout::ior_at(t, max, alpha),
+            IorMapping::Glass => super::glass_layout::GlassLayout::KILN.ior_at(t, max, alpha),
             IorMapping::Linear => 1.0 + t * (max - 1.0),
             IorMapping::Cycles => {
                 let z = t * Self::z(max);
@@ -265,7 +267,9 @@ impl IorMapping {
     pub fn coordinate(self, eta: f64, max: f64, alpha: f64) -> f64 {
         let eta = if eta < 1.0 { 1.0 / eta } else { eta };
         match self {
-            IorMapping::Glass => super::glass_layout::ior_coordinate(eta, max, alpha),
+            IorMapping::Glass => {
+                super::glass_layout::GlassLayout::KILN.ior_coordinate(eta, max, alpha)
+            }
             IorMapping::Linear => (eta - 1.0) / (max - 1.0),
             IorMapping::Cycles => Self::z(eta) / Self::z(max),
             IorMapping::Blender => Self::z(eta),

@@ -136,6 +136,22 @@ impl GlassLayout {
             + (1.0 - w) * crate::integrate::grazing::t_of_mu(mu, alpha)
     }
 
+    /// Where a texel of the `eta = 1` slice at `mu` coordinate `t_mu` on the row computed at
+    /// `row_alpha` is computed, as `(alpha, eta_up)`: above the eta layer (`t_mu > w`) the layer's
+    /// part of the coordinate saturates as `eta -> 1+`, so the limit is the albedo at `eta = 1`
+    /// itself, on the row; inside the layer its profile, at [`limit_slice_eta`], on rows below
+    /// [`LAYER_ROW_LIMIT_ALPHA`] at that `alpha` (the same `mu / alpha` and
+    /// `(eta - 1) / alpha^2`).
+    #[must_use]
+    pub fn limit_slice_point(&self, t_mu: f64, row_alpha: f64) -> (f64, f64) {
+        if t_mu > self.layer_share_at(row_alpha, 1.0) {
+            (row_alpha, 1.0)
+        } else {
+            let alpha = row_alpha.max(LAYER_ROW_LIMIT_ALPHA);
+            (alpha, limit_slice_eta(alpha))
+        }
+    }
+
     /// `mu` at coordinate `t` (the inverse of [`GlassLayout::mu_coordinate`]); where the
     /// coordinate is flat in `mu` (a mirror's layers have no width) the smallest such `mu`.
     #[must_use]
@@ -207,54 +223,26 @@ pub fn reflectance_root(eta: f64) -> f64 {
     ((eta - 1.0) / (eta + 1.0)).max(0.0)
 }
 
-/// [`GlassLayout::ior_coordinate`] of kiln's layout.
-#[must_use]
-pub fn ior_coordinate(eta: f64, eta_max: f64, alpha: f64) -> f64 {
-    GlassLayout::KILN.ior_coordinate(eta, eta_max, alpha)
-}
-
-/// [`GlassLayout::ior_at`] of kiln's layout.
-#[must_use]
-pub fn ior_at(z: f64, eta_max: f64, alpha: f64) -> f64 {
-    GlassLayout::KILN.ior_at(z, eta_max, alpha)
-}
-
-/// [`GlassLayout::layer_width`] of kiln's layout.
-#[must_use]
-pub fn layer_width(alpha: f64, eta_up: f64) -> f64 {
-    GlassLayout::KILN.layer_width(alpha, eta_up)
-}
-
-/// [`GlassLayout::mu_coordinate`] of kiln's layout.
-#[must_use]
-pub fn mu_coordinate(mu: f64, alpha: f64, eta_up: f64) -> f64 {
-    GlassLayout::KILN.mu_coordinate(mu, alpha, eta_up)
-}
-
-/// [`GlassLayout::mu_at`] of kiln's layout.
-#[must_use]
-pub fn mu_at(t: f64, alpha: f64, eta_up: f64) -> f64 {
-    GlassLayout::KILN.mu_at(t, alpha, eta_up)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    const KILN: GlassLayout = GlassLayout::KILN;
 
     /// Both coordinates run from 0 to 1, increase, and their inversions give back the variable.
     #[test]
     fn the_coordinates_invert() {
         for alpha in [1e-7, 1e-3, 0.05, 0.3, 1.0] {
             for eta in [1.0 + 1e-9, 1.0005, 1.01, 1.2, 1.5, 2.2, 3.0] {
-                let z = ior_coordinate(eta, 3.0, alpha);
+                let z = KILN.ior_coordinate(eta, 3.0, alpha);
                 assert!((0.0..=1.0).contains(&z));
-                let back = ior_at(z, 3.0, alpha);
+                let back = KILN.ior_at(z, 3.0, alpha);
                 assert!(
                     ((back - 1.0) / (eta - 1.0) - 1.0).abs() < 1e-8,
                     "{alpha} {eta}: {back}"
                 );
                 // From inside, 1 / eta sits at the same coordinate.
-                assert_eq!(ior_coordinate(1.0 / eta, 3.0, alpha), z);
+                assert_eq!(KILN.ior_coordinate(1.0 / eta, 3.0, alpha), z);
                 let mut last = -1.0;
                 for k in 0..=64 {
                     let mu = if k == 0 {
@@ -262,21 +250,21 @@ mod tests {
                     } else {
                         10f64.powf(-8.0 * (1.0 - k as f64 / 64.0))
                     };
-                    let t = mu_coordinate(mu, alpha, eta);
+                    let t = KILN.mu_coordinate(mu, alpha, eta);
                     assert!(
                         t > last || (t == last && t == 1.0),
                         "{alpha} {eta} {mu}: {t}"
                     );
                     last = t;
-                    let back = mu_at(t, alpha, eta);
+                    let back = KILN.mu_at(t, alpha, eta);
                     assert!((back - mu).abs() <= 1e-9 * mu, "{alpha} {eta} {mu}: {back}");
                 }
             }
         }
-        assert_eq!(ior_coordinate(1.0, 3.0, 0.5), 0.0);
-        assert!((ior_coordinate(3.0, 3.0, 0.5) - 1.0).abs() < 1e-15);
-        assert_eq!(ior_at(0.0, 3.0, 0.5), 1.0);
-        assert_eq!(ior_at(1.0, 3.0, 0.5), 3.0);
+        assert_eq!(KILN.ior_coordinate(1.0, 3.0, 0.5), 0.0);
+        assert!((KILN.ior_coordinate(3.0, 3.0, 0.5) - 1.0).abs() < 1e-15);
+        assert_eq!(KILN.ior_at(0.0, 3.0, 0.5), 1.0);
+        assert_eq!(KILN.ior_at(1.0, 3.0, 0.5), 3.0);
     }
 
     /// The eta layer keeps its share of the coordinate: at `mu = kappa` the layer's part is
@@ -284,16 +272,16 @@ mod tests {
     /// `kappa = 0.01 / (0.1 + 0.1) = 0.05`, `w = 0.3 / (1 + 0.01 / 0.01) = 0.15`.
     #[test]
     fn the_eta_layer_sits_at_a_fixed_share_of_the_coordinate() {
-        let kappa = layer_width(0.1, 1.01);
+        let kappa = KILN.layer_width(0.1, 1.01);
         assert!((kappa - 0.05).abs() < 1e-12, "{kappa}");
-        let t = mu_coordinate(kappa, 0.1, 1.01);
+        let t = KILN.mu_coordinate(kappa, 0.1, 1.01);
         let masking = crate::integrate::grazing::t_of_mu(kappa, 0.1);
         let expected = 0.15 * (1.05f64 / 2.0).powf(0.35) + 0.85 * masking;
         assert!((t - expected).abs() < 1e-12, "{t} {expected}");
         // On a mirror the layer is the Fresnel layer sqrt(eta - 1).
-        assert!((layer_width(0.0, 1.0004) - 0.02).abs() < 1e-12);
+        assert!((KILN.layer_width(0.0, 1.0004) - 0.02).abs() < 1e-12);
         // At eta = 1 it has no width: t jumps to w above mu = 0.
-        assert!((mu_coordinate(1e-300, 0.5, 1.0) - 0.3).abs() < 1e-12);
+        assert!((KILN.mu_coordinate(1e-300, 0.5, 1.0) - 0.3).abs() < 1e-12);
         // Where the layer has merged with the masking layer its share fades.
         assert!((GlassLayout::KILN.layer_share_at(0.1, 1.1) - 0.3 / 11.0).abs() < 1e-15);
     }
@@ -306,7 +294,7 @@ mod tests {
         let eta_max: f64 = 3.0;
         let u = k * reflectance_root(eta_max);
         let eta = (1.0 + u) / (1.0 - u);
-        let z = ior_coordinate(eta, eta_max, 0.1);
+        let z = KILN.ior_coordinate(eta, eta_max, 0.1);
         let expected = 0.35 * ((1.0 + k) / 2.0).sqrt() + 0.65 * k.sqrt();
         assert!((z - expected).abs() < 1e-12, "{z} {expected}");
     }

@@ -336,10 +336,10 @@ impl TableSpec {
 
     /// The point `(alpha, mu, eta)` at which texel `index` (row-major, slowest axis first) is
     /// computed: `mu` is `None` for the averages, `alpha` is 0 for `F_avg`, `eta` (the relative
-    /// index, `1 / eta` for light from inside) is `None` without an IOR axis. On a `glass` IOR
-    /// axis the IOR of a texel depends on its roughness, the `eta = 1` slice is computed at
-    /// `eta = 1 +` [`glass_layout::LIMIT_ETA_OFFSET`] (its one-sided limit), and a `glass` mu
-    /// axis' `mu` depends on both.
+    /// index, `1 / eta` for light from inside) is `None` without an IOR axis. In kiln's glass
+    /// layout the IOR of a texel depends on its roughness, a `mu` on both, and the `eta = 1`
+    /// slice holds the one-sided limit `eta -> 1+`
+    /// ([`glass_layout::GlassLayout::limit_slice_point`]).
     #[must_use]
     pub fn texel_point(&self, index: usize) -> (f64, Option<f64>, Option<f64>) {
         let [k, r, m] = self.texel_indices(index);
@@ -348,46 +348,26 @@ impl TableSpec {
             _ => None,
         };
         let row_alpha = row.map_or(0.0, |t_r| self.row_alpha(t_r));
-        let mut eta_up = match (self.ior, k) {
-            (Some(ior), Some(k)) => Some(self.ior_at(ior.coordinate(k), row_alpha)),
+        let t_eta = match (self.ior, k) {
+            (Some(ior), Some(k)) => Some(ior.coordinate(k)),
             _ => None,
         };
-        // The eta = 1 slice of kiln's glass layout above the eta layer (t > w): as eta -> 1+ at
-        // fixed t the layer's part of the coordinate saturates, so the limit is the albedo at
-        // eta = 1 itself, at the mu the coordinate gives there (inside the layer, t <= w, the
-        // layer's profile is the limit, taken at glass_layout::limit_slice_eta).
-        // On the rows below alpha = glass_layout::LAYER_ROW_LIMIT_ALPHA the layer's texels are
-        // computed at that alpha, where the reference converges: the layer's profile is a
-        // function of mu / alpha and (eta - 1) / alpha^2 there, both kept.
-        let mut layer_limit = None;
-        if let (
-            Some(Axis::Ior {
-                mapping: IorMapping::Glass,
-                ..
-            }),
-            Some(mu_axis @ Axis::Mu { mapping, .. }),
-            Some(0),
-            Some(m),
-            Some(t_r),
-        ) = (self.ior, self.mu, k, m, row)
-            && self.ior.is_some_and(|ior| ior.coordinate(0) == 0.0)
+        let mut eta_up = t_eta.map(|t| self.ior_at(t, row_alpha));
+        if let (Some(mu_axis @ Axis::Mu { mapping, .. }), Some(m)) = (self.mu, m)
+            && t_eta == Some(0.0)
+            && self.is_glass_layout()
         {
             let t_mu = mu_axis.coordinate(m);
-            if t_mu > glass_layout::GlassLayout::KILN.layer_share_at(row_alpha, 1.0) {
-                eta_up = Some(1.0);
-            } else if self.roughness_convention().to_alpha(t_r)
-                < glass_layout::LAYER_ROW_LIMIT_ALPHA
-            {
-                let alpha = glass_layout::LAYER_ROW_LIMIT_ALPHA;
-                let eta_limit = glass_layout::limit_slice_eta(alpha);
-                eta_up = Some(eta_limit);
-                layer_limit = Some((alpha, mapping.mu_at(t_mu, alpha, eta_limit)));
+            let (alpha, eta_limit) =
+                glass_layout::GlassLayout::KILN.limit_slice_point(t_mu, row_alpha);
+            if eta_limit > 1.0 {
+                // Inside the eta layer: its profile, at the slice's own point.
+                let mu = mapping.mu_at(t_mu, alpha, eta_limit);
+                return (alpha, Some(mu), Some(self.relative_eta(eta_limit)));
             }
+            eta_up = Some(eta_limit);
         }
         let eta = eta_up.map(|eta| self.relative_eta(eta));
-        if let Some((alpha, mu)) = layer_limit {
-            return (alpha, Some(mu), eta);
-        }
         let Some(t_r) = row else {
             return (0.0, None, eta);
         };
@@ -399,6 +379,30 @@ impl TableSpec {
             _ if self.row_limit_alpha().is_some() => (row_alpha, None, eta),
             _ => (self.roughness_convention().to_alpha(t_r), None, eta),
         }
+    }
+
+    /// Whether the table is an albedo in kiln's glass layout: a `glass` IOR axis and a mu axis
+    /// (an average on a `glass` IOR axis has no layer in mu to follow).
+    #[must_use]
+    pub fn is_glass_layout(&self) -> bool {
+        matches!(
+            self.ior,
+            Some(Axis::Ior {
+                mapping: IorMapping::Glass,
+                ..
+            })
+        ) && self.mu.is_some()
+    }
+
+    /// Whether a lookup's texture coordinates depend on the roughness as well as on their own
+    /// variable (the `adaptive` mu axis, kiln's glass layout): a generated lookup then computes
+    /// `alpha` first.
+    #[must_use]
+    pub fn coordinates_depend_on_roughness(&self) -> bool {
+        self.mu
+            .into_iter()
+            .chain(self.ior)
+            .any(|axis| axis.depends_on_row())
     }
 
     /// The `alpha` at which the row at roughness coordinate `t_roughness` is computed: its
@@ -439,14 +443,7 @@ impl TableSpec {
     pub fn row_limit_alpha(&self) -> Option<f64> {
         // An average has no layer in mu to follow: its row alpha = 0 is the smooth interface's
         // exact 1, at every index.
-        if let (
-            Some(Axis::Ior {
-                mapping: IorMapping::Glass,
-                ..
-            }),
-            Some(_),
-        ) = (self.ior, self.mu)
-        {
+        if self.is_glass_layout() {
             return Some(glass_layout::ROW_LIMIT_ALPHA);
         }
         match self.mu {

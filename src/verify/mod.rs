@@ -254,11 +254,11 @@ pub fn audit(
     // the roughness and mu clamped as the author says they clamped them).
     let nodes: Vec<(Coordinates, f64)> = (0..spec.len())
         .map(|k| {
-            let (alpha, mu) = spec.texel_coordinates(k);
+            let (alpha, mu, eta) = spec.texel_point(k);
             let at = Coordinates {
                 alpha: convention.to_alpha(clamp(convention.from_alpha(alpha))),
                 mu: mu.map(clamp),
-                eta: spec.texel_eta(k),
+                eta,
             };
             (at, table.value[k])
         })
@@ -610,12 +610,8 @@ pub fn node_error_terms(
     indices
         .par_iter()
         .map(|&k| {
-            let (alpha, mu) = spec.texel_coordinates(k);
-            let at = Coordinates {
-                alpha,
-                mu,
-                eta: spec.texel_eta(k),
-            };
+            let (alpha, mu, eta) = spec.texel_point(k);
+            let at = Coordinates { alpha, mu, eta };
             let reference = spec.integral().reference(at, settings);
             let (value, one_minus_value) = stored(k);
             // `1 - E` where both carry it directly; the split-sum channels and `E_F` by value.
