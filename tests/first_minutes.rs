@@ -586,3 +586,46 @@ fn verify_quiet_is_a_build_gate() {
     assert_eq!(message.lines().count(), 1, "{message}");
     assert!(message.contains("exceeds --max-error 1e-12"), "{message}");
 }
+
+/// kiln's glass layout (issue 38): a product-grid mu axis asked of it names the product grid,
+/// and the furnace picture, drawn over roughness and mu, is refused for a table over the IOR
+/// before any work, writing nothing.
+#[test]
+fn the_glass_layout_refuses_what_it_cannot_do() {
+    refused(
+        &["bake", "--quantity", "e-dielectric", "--mu-axis", "linear"],
+        &["--mu-axis linear", "glass layout", "--ior-axis cycles"],
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().to_str().unwrap();
+    let baked = kiln(&[
+        "bake",
+        "--quantity",
+        "e-dielectric",
+        "--size",
+        "3",
+        "--ior-size",
+        "2",
+        "--max-error",
+        "1e-3",
+        "--format",
+        "json",
+        "--out",
+        out,
+        "-q",
+    ]);
+    assert!(baked.status.success(), "{}", stderr(&baked));
+    let table = dir.path().join("ggx-height-correlated-E_dielectric.json");
+    let picture = dir.path().join("furnace.png");
+    refused(
+        &[
+            "verify",
+            "--furnace",
+            table.to_str().unwrap(),
+            "--plot",
+            picture.to_str().unwrap(),
+        ],
+        &["--plot", "IOR axis", "per IOR band"],
+    );
+    assert!(!picture.exists());
+}

@@ -64,6 +64,22 @@ impl TableSpec {
                 super::MAX_TEXELS
             ));
         }
+        // kiln's glass layout: its mu coordinate needs the IOR, its IOR coordinate the roughness.
+        let glass_mu =
+            matches!(self.mu, Some(Axis::Mu { mapping, .. }) if mapping.depends_on_ior());
+        let glass_ior =
+            matches!(self.ior, Some(Axis::Ior { mapping, .. }) if mapping.depends_on_roughness());
+        if glass_mu && !glass_ior {
+            return Err(
+                "its mu axis is in kiln's glass layout, which needs a glass IOR axis".into(),
+            );
+        }
+        if glass_ior && self.roughness.is_none() {
+            return Err(format!(
+                "its eta axis is in kiln's glass layout, which needs a roughness axis ({} has none)",
+                q.symbol()
+            ));
+        }
         if !self.transmission.is_default() && (!q.has_ior() || q == Quantity::FAvg) {
             return Err(format!(
                 "a transmission convention belongs to the dielectric tables, not {}",
@@ -177,6 +193,57 @@ mod tests {
             Err(message) => assert!(message.contains(words), "{message}: wanted {words:?}"),
             Ok(()) => panic!("accepted, wanted {words:?}: {spec:?}"),
         }
+    }
+
+    /// kiln's glass layout is whole or refused: a glass mu axis without a glass IOR axis (an E
+    /// table claiming it), a glass IOR axis without roughness (F_avg claiming it).
+    #[test]
+    fn the_glass_layout_comes_whole() {
+        let glass_mu = Axis::Mu {
+            size: 3,
+            mapping: MuMapping::Glass,
+            grid: Grid::Nodes,
+        };
+        let glass_ior = Axis::Ior {
+            size: 2,
+            mapping: IorMapping::Glass,
+            max: IorBound(3.0),
+            grid: Grid::Nodes,
+        };
+        refused(
+            &TableSpec {
+                mu: Some(glass_mu),
+                ..e_spec()
+            },
+            "needs a glass IOR axis",
+        );
+        let dielectric = TableSpec {
+            quantity: Quantity::EDielectric,
+            ior: Some(ior(3.0)),
+            ..e_spec()
+        };
+        assert_eq!(dielectric.check(), Ok(()));
+        refused(
+            &TableSpec {
+                mu: Some(glass_mu),
+                ..dielectric.clone()
+            },
+            "needs a glass IOR axis",
+        );
+        let glass = TableSpec {
+            ior: Some(glass_ior),
+            mu: Some(glass_mu),
+            ..dielectric
+        };
+        assert_eq!(glass.check(), Ok(()));
+        let f_avg = TableSpec {
+            quantity: Quantity::FAvg,
+            ior: Some(glass_ior),
+            roughness: None,
+            mu: None,
+            ..e_spec()
+        };
+        refused(&f_avg, "needs a roughness axis (F_avg has none)");
     }
 
     /// Each axis in its place, of a size kiln reads; each rule both ways.
