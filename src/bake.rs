@@ -11,7 +11,7 @@ use crate::integrate::value::Point;
 use crate::integrate::{Estimate, QmcSettings};
 use crate::model::dielectric::TransmissionConvention;
 use crate::model::{Masking, Model, Ndf, RoughnessConvention};
-use crate::table::axis::{Axis, Grid, IorBound, IorMapping, MuMapping};
+use crate::table::axis::{Axis, Grid, IorBound, IorMapping, MuMapping, RoughnessSpacing};
 use crate::table::{Method, Quantity, Table, TableSpec, Texels};
 use crate::verify::{MAX_AVERAGE_ENTRIES_CHECKED, spread_indices};
 use rayon::prelude::*;
@@ -38,6 +38,10 @@ pub struct BakeOptions {
     pub scrambles: u32,
     pub seed: u64,
     pub roughness_convention: RoughnessConvention,
+    /// How the roughness samples are spaced along the convention's value (the tables over the
+    /// IOR keep the linear spacing).
+    #[serde(default)]
+    pub roughness_spacing: RoughnessSpacing,
     pub mu_mapping: MuMapping,
     pub grid: Grid,
     /// Samples on the index-of-refraction axis of the dielectric tables and `F_avg` (their
@@ -85,6 +89,7 @@ impl Default for BakeOptions {
             scrambles: QmcSettings::DEFAULT_SCRAMBLES,
             seed: 0,
             roughness_convention: RoughnessConvention::Perceptual,
+            roughness_spacing: RoughnessSpacing::Linear,
             mu_mapping: MuMapping::Adaptive,
             grid: Grid::Nodes,
             ior_size: Self::DEFAULT_IOR_SIZE,
@@ -186,14 +191,15 @@ impl BakeOptions {
                 self.mu_mapping.name()
             )));
         }
-        if self.mu_mapping == MuMapping::Adaptive
+        if self.mu_mapping.depends_on_roughness()
             && let Some(q) = self.quantities.iter().find(|q| q.varies_on_a_mirror())
         {
             return Err(Error::InvalidInput(format!(
-                "--quantity {} needs --mu-axis linear or sqrt: the adaptive mu axis follows E's \
+                "--quantity {} needs --mu-axis linear or sqrt: the {} mu axis follows E's \
                  grazing layer and maps every mu > 0 to t = 1 at roughness 0, where {} still \
                  varies with mu",
                 q.cli_name(),
+                self.mu_mapping.name(),
                 if *q == Quantity::EF {
                     "E_F = F(mu)"
                 } else {
@@ -440,6 +446,13 @@ impl BakeOptions {
             size: self.size,
             convention: self.roughness_convention,
             grid: self.grid,
+            spacing: self.roughness_spacing,
+        };
+        let ior_roughness = Axis::Roughness {
+            size: self.size,
+            convention: self.roughness_convention,
+            grid: self.grid,
+            spacing: RoughnessSpacing::Linear,
         };
         let mu = Axis::Mu {
             size: self.size,
@@ -496,7 +509,11 @@ impl BakeOptions {
                                 },
                             ),
                             fresnel: self.fresnel.filter(|_| quantity == Quantity::EF),
-                            roughness: quantity.has_roughness().then_some(roughness),
+                            roughness: quantity.has_roughness().then_some(if quantity.has_ior() {
+                                ior_roughness
+                            } else {
+                                roughness
+                            }),
                             mu: quantity.has_mu().then_some(
                                 if glass_layout && quantity.has_ior() {
                                     glass_mu
@@ -564,6 +581,19 @@ impl BakeOptions {
     #[must_use]
     pub fn command_for(&self, model: Model) -> String {
         let command = self.command_without_texels(model);
+        // The CLI's default spacing goes with the mu axis: balanced rows with the balanced axis.
+        let paired = match self.mu_mapping {
+            MuMapping::Balanced => RoughnessSpacing::Balanced,
+            _ => RoughnessSpacing::Linear,
+        };
+        let command = if self.roughness_spacing == paired {
+            command
+        } else {
+            format!(
+                "{command} --roughness-spacing {}",
+                self.roughness_spacing.name()
+            )
+        };
         match self.texels {
             Texels::Nodes => command,
             texels => format!("{command} --texels {}", texels.name()),

@@ -84,5 +84,5 @@ pub use error::{Error, Result};
 pub use format::{Format, Precision};
 pub use integrate::{Estimate, QmcSettings, albedo, average_albedo};
 pub use model::{Fresnel, Masking, Model, Ndf, RoughnessConvention};
-pub use table::axis::{Axis, Grid, IorMapping, MuMapping};
+pub use table::axis::{Axis, Grid, IorMapping, MuMapping, RoughnessSpacing};
 pub use table::{Method, Quantity, Table, TableSpec};

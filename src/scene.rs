@@ -537,6 +537,8 @@ impl Scene {
                 let split_sum = crate::BakeOptions {
                     quantities: vec![Quantity::EScale, Quantity::EBias],
                     mu_mapping: crate::MuMapping::Linear,
+                    // The balanced rows are laid out for the balanced mu axis.
+                    roughness_spacing: crate::RoughnessSpacing::Linear,
                     ..base.clone()
                 };
                 needs.push((split_sum, Some(Effect::ImageBasedLighting), model));

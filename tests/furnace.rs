@@ -19,7 +19,7 @@ fn furnace_integrates_the_lookup_and_reports_the_identity() {
     let avg = committed("ggx-height-correlated-E_avg");
     let report = furnace(&e, &avg, 2).unwrap();
     assert_eq!(report.normalisation, "E_avg");
-    let Some(kiln::table::axis::Axis::Mu { mapping, .. }) = e.spec.mu else {
+    let Some(kiln::table::axis::Axis::Mu { mapping, size, .. }) = e.spec.mu else {
         unreachable!()
     };
     for row in report.rows.iter().filter(|row| row.roughness >= 0.1) {
@@ -27,8 +27,11 @@ fn furnace_integrates_the_lookup_and_reports_the_identity() {
         let mut integral = 0.0;
         for k in 0..cells {
             let (t0, t1) = (k as f64 / cells as f64, (k + 1) as f64 / cells as f64);
-            let (mu0, mu1) = (mapping.mu(t0, row.alpha), mapping.mu(t1, row.alpha));
-            let mid = mapping.mu((t0 + t1) / 2.0, row.alpha);
+            let (mu0, mu1) = (
+                mapping.mu(t0, row.alpha, size),
+                mapping.mu(t1, row.alpha, size),
+            );
+            let mid = mapping.mu((t0 + t1) / 2.0, row.alpha, size);
             integral += e.lookup_one_minus(mid, row.roughness) * (mu1 * mu1 - mu0 * mu0);
         }
         let relative = (integral / row.one_minus_e_avg_of_e - 1.0).abs();

@@ -27,6 +27,16 @@ fn tables() -> Vec<Table> {
         .bake(&|_| {})
         .unwrap(),
     );
+    // kiln's balanced layout, whose lookups compute both coordinates.
+    tables.extend(
+        BakeOptions {
+            mu_mapping: MuMapping::Balanced,
+            roughness_spacing: kiln::RoughnessSpacing::Balanced,
+            ..base.clone()
+        }
+        .bake(&|_| {})
+        .unwrap(),
+    );
     // kiln's glass layout, whose lookups compute its coordinates.
     tables.extend(
         BakeOptions {
@@ -209,7 +219,15 @@ fn gpu_filtering_at_the_generated_coordinates_equals_the_table_lookup() {
         .filter(|t| t.spec.shape().len() == 2 && t.spec.mu.is_some())
     {
         let (mu_axis, r_axis) = (table.spec.mu.unwrap(), table.spec.roughness.unwrap());
-        let kiln::Axis::Mu { mapping, .. } = mu_axis else {
+        let kiln::Axis::Mu { mapping, size, .. } = mu_axis else {
+            unreachable!()
+        };
+        let kiln::Axis::Roughness {
+            convention,
+            spacing,
+            ..
+        } = r_axis
+        else {
             unreachable!()
         };
         let gpu = |t: f64, axis: kiln::Axis| match axis.grid() {
@@ -222,8 +240,9 @@ fn gpu_filtering_at_the_generated_coordinates_equals_the_table_lookup() {
         for a in 0..=20 {
             for b in 0..=20 {
                 let (mu, r) = (a as f64 / 20.0, b as f64 / 20.0);
-                let t_mu = mapping.coordinate(mu, r * r);
-                let sampled = gpu_sample(table, gpu(t_mu, mu_axis), gpu(r, r_axis));
+                let t_mu = mapping.coordinate(mu, r * r, size);
+                let t_r = spacing.coordinate(r, convention);
+                let sampled = gpu_sample(table, gpu(t_mu, mu_axis), gpu(t_r, r_axis));
                 let expected = table.lookup(mu, r);
                 assert!(
                     (sampled - expected).abs() < 1e-12,

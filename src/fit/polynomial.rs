@@ -51,7 +51,7 @@ pub struct PolynomialFit {
 /// `t` of kiln's adaptive axis at `(mu, alpha)`.
 #[must_use]
 pub fn adaptive_t(mu: f64, alpha: f64) -> f64 {
-    crate::table::axis::MuMapping::Adaptive.coordinate(mu, alpha)
+    crate::integrate::grazing::t_of_mu(mu, alpha)
 }
 
 /// Chebyshev polynomials `T_0..=T_n` at `x`.
@@ -147,7 +147,7 @@ pub fn truth_points(model: Model, progress: &(dyn Fn() + Sync)) -> Vec<((f64, f6
             } else {
                 r * r
             };
-            let mu = Some(crate::table::axis::MuMapping::Adaptive.mu(t, alpha));
+            let mu = Some(crate::integrate::grazing::mu_of_t(t, alpha));
             let v = integral
                 .reference(
                     Point {

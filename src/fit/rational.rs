@@ -142,7 +142,7 @@ pub fn coordinates_of(truth: &[((f64, f64), f64)]) -> Vec<((f64, f64), f64)> {
             } else {
                 r * r
             };
-            let mu = crate::table::axis::MuMapping::Adaptive.mu(t, alpha);
+            let mu = crate::integrate::grazing::mu_of_t(t, alpha);
             ((rational_t(mu, alpha), roughness_coordinate(r)), value)
         })
         .collect()

@@ -14,7 +14,9 @@
 //!     48    16  axis 1 descriptor  /  3 = alpha, 4 = eta), u32 mapping (mu: 0 = linear,
 //!                                     1 = sqrt: mu = t^2, 2 = adaptive:
 //!                                     t = (mu (1 + 4a) / (mu + 4a))^0.4, 3 = glass: kiln's
-//!                                     glass layout, `table::glass_layout`; eta: 0 = linear,
+//!                                     glass layout, `table::glass_layout`, 4 = balanced:
+//!                                     kiln's balanced layout, `table::balanced_layout`;
+//!                                     r or alpha: 0 = linear, 1 = balanced; eta: 0 = linear,
 //!                                     1 = cycles: linear in sqrt((eta - 1) / (eta + 1)),
 //!                                     2 = blender, 3 = glass),
 //!                                     u32 grid (0 = centers (i + 0.5)/N, 1 = nodes i/(N - 1)),
@@ -84,19 +86,25 @@ fn axis_descriptor(axis: Option<&Axis>) -> [u32; 4] {
                 MuMapping::Sqrt => 1,
                 MuMapping::Adaptive => 2,
                 MuMapping::Glass => 3,
+                MuMapping::Balanced => 4,
             };
             [1, m, grid(g), 0]
         }
         Some(&Axis::Roughness {
             convention,
             grid: g,
+            spacing,
             ..
         }) => {
             let q = match convention {
                 RoughnessConvention::Perceptual => 2,
                 RoughnessConvention::Alpha => 3,
             };
-            [q, 0, grid(g), 0]
+            let s = match spacing {
+                crate::table::axis::RoughnessSpacing::Linear => 0,
+                crate::table::axis::RoughnessSpacing::Balanced => 1,
+            };
+            [q, s, grid(g), 0]
         }
         Some(&Axis::Ior {
             mapping,

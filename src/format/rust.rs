@@ -7,7 +7,10 @@
 use super::metadata::{KILN_VERSION, Metadata};
 use crate::model::RoughnessConvention;
 use crate::table::Table;
-use crate::table::axis::{ADAPTIVE_POWER, ADAPTIVE_SCALE, Axis, Grid, IorMapping, MuMapping};
+use crate::table::axis::{
+    ADAPTIVE_POWER, ADAPTIVE_SCALE, Axis, Grid, IorMapping, MuMapping, RoughnessSpacing,
+};
+use crate::table::balanced_layout::BalancedLayout;
 use crate::table::glass_layout;
 use std::fmt::Write as _;
 
@@ -91,13 +94,30 @@ pub fn lookup_name(table: &Table) -> String {
 /// Rust for the texture coordinate `t` of one axis, from `mu` or the roughness (`alpha` bound).
 fn coordinate_code(axis: &Axis) -> String {
     match *axis {
-        Axis::Mu { mapping, .. } => match mapping {
+        Axis::Mu { mapping, size, .. } => match mapping {
             MuMapping::Linear => "mu".to_string(),
             MuMapping::Sqrt => "mu.max(0.0).sqrt()".to_string(),
             MuMapping::Adaptive => format!(
                 "if mu <= 0.0 {{\n        0.0\n    }} else {{\n        let k = {ADAPTIVE_SCALE:?} * alpha;\n        \
                  (mu * (1.0 + k) / (mu + k)).min(1.0).powf({ADAPTIVE_POWER:?})\n    }}"
             ),
+            MuMapping::Balanced => {
+                let l = BalancedLayout::KILN;
+                let eps0 = l.offset_at(0.0, size);
+                format!(
+                    "if mu <= 0.0 {{\n        0.0\n    }} else {{\n        \
+                     let k = {:?} * alpha * (1.0 + {:?} * alpha);\n        \
+                     let u = if k > 0.0 {{ (mu * (1.0 + k) / (mu + k)).min(1.0) }} else {{ 1.0 }};\n        \
+                     let eps = {:?} * (-{:?} * alpha).exp();\n        \
+                     let low = eps.powf({p:?});\n        \
+                     ((u + eps).powf({p:?}) - low) / ((1.0 + eps).powf({p:?}) - low)\n    }}",
+                    l.scale as f32,
+                    l.scale_growth as f32,
+                    eps0 as f32,
+                    l.offset_decay as f32,
+                    p = l.power as f32,
+                )
+            }
             MuMapping::Glass => {
                 let share = if GLASS.layer_share_decay > 0.0 {
                     format!(
@@ -118,7 +138,28 @@ fn coordinate_code(axis: &Axis) -> String {
                 )
             }
         },
-        Axis::Roughness { .. } => "roughness".to_string(),
+        Axis::Roughness {
+            spacing: RoughnessSpacing::Linear,
+            ..
+        } => "roughness".to_string(),
+        Axis::Roughness {
+            spacing: RoughnessSpacing::Balanced,
+            convention,
+            ..
+        } => {
+            let l = BalancedLayout::KILN;
+            let r = match convention {
+                RoughnessConvention::Perceptual => "roughness.clamp(0.0, 1.0)",
+                RoughnessConvention::Alpha => "roughness.clamp(0.0, 1.0).sqrt()",
+            };
+            format!(
+                "{{\n        let r = {r};\n        \
+                 {:?} * r.powf({:?}) + {:?} * r * r * (3.0 - 2.0 * r)\n    }}",
+                (1.0 - l.roughness_knee) as f32,
+                l.roughness_power as f32,
+                l.roughness_knee as f32,
+            )
+        }
         Axis::Ior { mapping, max, .. } => match mapping {
             IorMapping::Linear => format!("(eta - 1.0) / ({:?}_f32 - 1.0)", max.0 as f32),
             IorMapping::Cycles => {
@@ -181,6 +222,17 @@ fn write_lookup(out: &mut String, table: &Table, prefix: &str, ty: &str) {
         RoughnessConvention::Alpha => "roughness",
     };
     let n_r = spec.roughness_axis().size();
+    // The roughness' texture coordinate: the value itself on a linear spacing.
+    let (t_r_line, t_r_name) = match spec.roughness_axis() {
+        axis @ Axis::Roughness {
+            spacing: RoughnessSpacing::Balanced,
+            ..
+        } => (
+            Some(format!("    let t_r = {};", coordinate_code(&axis))),
+            "t_r",
+        ),
+        _ => (None, "roughness"),
+    };
     let _ = writeln!(out);
     let _ = writeln!(
         out,
@@ -198,18 +250,21 @@ fn write_lookup(out: &mut String, table: &Table, prefix: &str, ty: &str) {
         }
     );
     let _ = writeln!(out, "#[allow(clippy::all)]");
-    let t_r = position_code(spec.roughness_axis().grid(), "roughness", n_r);
+    let t_r = position_code(spec.roughness_axis().grid(), t_r_name, n_r);
     match spec.mu {
         None => {
             let _ = writeln!(out, "pub fn {name}(table: &{ty}, roughness: f32) -> f32 {{");
+            if let Some(line) = &t_r_line {
+                let _ = writeln!(out, "{line}");
+            }
             let _ = writeln!(out, "    let p = {t_r};");
             let _ = writeln!(out, "    let i = (p as usize).min({});", n_r - 2);
             let _ = writeln!(out, "    let f = p - i as f32;");
             if crate::table::normalisation::stores_per_roughness(spec) {
-                // (1 - Ē) / r is stored: give back 1 - Ē (crate::table::normalisation).
+                // (1 - Ē) / x is stored: give back 1 - Ē (crate::table::normalisation).
                 let _ = writeln!(
                     out,
-                    "    roughness.clamp(0.0, 1.0) * (table[i] * (1.0 - f) + table[i + 1] * f)"
+                    "    {t_r_name}.clamp(0.0, 1.0) * (table[i] * (1.0 - f) + table[i + 1] * f)"
                 );
             } else {
                 let _ = writeln!(out, "    table[i] * (1.0 - f) + table[i + 1] * f");
@@ -226,6 +281,9 @@ fn write_lookup(out: &mut String, table: &Table, prefix: &str, ty: &str) {
                 let _ = writeln!(out, "    let alpha = {alpha};");
             }
             let _ = writeln!(out, "    let t_mu = {};", coordinate_code(&mu_axis));
+            if let Some(line) = &t_r_line {
+                let _ = writeln!(out, "{line}");
+            }
             let _ = writeln!(out, "    let p_r = {t_r};");
             let _ = writeln!(
                 out,

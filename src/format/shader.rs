@@ -16,7 +16,10 @@
 use super::metadata::{KILN_VERSION, Metadata};
 use crate::model::RoughnessConvention;
 use crate::table::Table;
-use crate::table::axis::{ADAPTIVE_POWER, ADAPTIVE_SCALE, Axis, Grid, IorMapping, MuMapping};
+use crate::table::axis::{
+    ADAPTIVE_POWER, ADAPTIVE_SCALE, Axis, Grid, IorMapping, MuMapping, RoughnessSpacing,
+};
+use crate::table::balanced_layout::BalancedLayout;
 use crate::table::glass_layout;
 use std::fmt::Write as _;
 
@@ -104,6 +107,19 @@ fn coordinate(language: Language, axis: &Axis) -> String {
                 );
                 language.select("mu <= 0.0", "0.0", &t)
             }
+            MuMapping::Balanced => {
+                // `balanced_k` and `balanced_eps` come from the preamble.
+                let p = literal(BalancedLayout::KILN.power);
+                let u = language.select(
+                    "mu <= 0.0",
+                    "0.0",
+                    "min(mu * (1.0 + balanced_k) / max(mu + balanced_k, 1e-30), 1.0)",
+                );
+                format!(
+                    "(pow({u} + balanced_eps, {p}) - pow(balanced_eps, {p})) / (pow(1.0 + \
+                     balanced_eps, {p}) - pow(balanced_eps, {p}))"
+                )
+            }
             MuMapping::Glass => {
                 // `layer_share` and `kappa` come from the preamble.
                 format!(
@@ -118,7 +134,27 @@ fn coordinate(language: Language, axis: &Axis) -> String {
                 )
             }
         },
-        Axis::Roughness { .. } => "roughness".to_string(),
+        Axis::Roughness {
+            spacing: RoughnessSpacing::Linear,
+            ..
+        } => "roughness".to_string(),
+        Axis::Roughness {
+            spacing: RoughnessSpacing::Balanced,
+            convention,
+            ..
+        } => {
+            let l = BalancedLayout::KILN;
+            let r = match convention {
+                RoughnessConvention::Perceptual => "clamp(roughness, 0.0, 1.0)",
+                RoughnessConvention::Alpha => "sqrt(clamp(roughness, 0.0, 1.0))",
+            };
+            format!(
+                "{} * pow(max({r}, 1e-30), {}) + {} * {r} * {r} * (3.0 - 2.0 * {r})",
+                literal(1.0 - l.roughness_knee),
+                literal(l.roughness_power),
+                literal(l.roughness_knee)
+            )
+        }
         Axis::Ior { mapping, max, .. } => match mapping {
             IorMapping::Linear => format!("(eta_up - 1.0) / {}", literal(max.0 - 1.0)),
             IorMapping::Cycles => {
@@ -214,6 +250,31 @@ fn preamble(language: Language, table: &Table) -> String {
             &format!(
                 "min(max((eta_up - 1.0) / (eta_up + 1.0), 0.0) / {}, 1.0)",
                 literal(glass_layout::reflectance_root(max.0))
+            ),
+        );
+    }
+    if let Some(Axis::Mu {
+        mapping: MuMapping::Balanced,
+        size,
+        ..
+    }) = spec.mu
+    {
+        // The balanced layout's scale and grazing offset (BalancedLayout::scale_at, offset_at).
+        let l = BalancedLayout::KILN;
+        out += &language.local(
+            "balanced_k",
+            &format!(
+                "{} * alpha * (1.0 + {} * alpha)",
+                literal(l.scale),
+                literal(l.scale_growth)
+            ),
+        );
+        out += &language.local(
+            "balanced_eps",
+            &format!(
+                "{} * exp(-{} * alpha)",
+                literal(l.offset_at(0.0, size)),
+                literal(l.offset_decay)
             ),
         );
     }

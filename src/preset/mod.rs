@@ -320,6 +320,9 @@ impl Preset {
             grid: layout.grid,
             mu_mapping: layout.mu_mapping,
             roughness_convention: RoughnessConvention::Perceptual,
+            // The engines' files: linear rows, point samples (`--texels lookup-fit` asks).
+            roughness_spacing: crate::table::axis::RoughnessSpacing::Linear,
+            texels: crate::table::Texels::Nodes,
             ..BakeOptions::default()
         }
     }

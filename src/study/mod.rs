@@ -122,6 +122,8 @@ fn e_spec(model: Model, size: usize, mapping: MuMapping, method: Method) -> Tabl
         grid: Grid::Nodes,
         method,
         max_error: None,
+        roughness_spacing: crate::table::axis::RoughnessSpacing::Linear,
+        texels: crate::table::Texels::Nodes,
         ..BakeOptions::default()
     };
     let mut spec = options.specs().remove(0);

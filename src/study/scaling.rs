@@ -105,6 +105,9 @@ impl ScalingSettings {
             ior_size: size,
             mu_mapping: case.mu_mapping,
             max_error: Some(self.max_error),
+            // The study measures point samples on linear rows, whatever the mu axis.
+            roughness_spacing: crate::table::axis::RoughnessSpacing::Linear,
+            texels: crate::table::Texels::Nodes,
             ..BakeOptions::default()
         }
     }

@@ -86,6 +86,7 @@ pub fn cycles_style_table(size: usize, samples: u32) -> Vec<f64> {
         size,
         convention: RoughnessConvention::Perceptual,
         grid: Grid::Nodes,
+        spacing: crate::table::axis::RoughnessSpacing::Linear,
     };
     let mu_axis = Axis::Mu {
         size,

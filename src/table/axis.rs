@@ -106,6 +106,12 @@ pub enum MuMapping {
     /// over the IOR, chosen by `--ior-axis glass`.
     #[cfg_attr(feature = "cli", value(skip))]
     Glass,
+    /// kiln's balanced layout (`table::balanced_layout`): `t = ((u + eps)^0.4 - eps^0.4) / ((1 +
+    /// eps)^0.4 - eps^0.4)` of `u = mu (1 + k) / (mu + k)`, `k = 3 alpha (1 + 7 alpha)`,
+    /// `eps = (1.25 / 32) (32 / N)^1.5 exp(-3 alpha)`: the adaptive axis' grazing layer, with
+    /// more texels near `mu = 1` at moderate roughness and fewer at `mu < 1e-4`, for the lookup
+    /// of fitted texels (`--texels lookup-fit`).
+    Balanced,
 }
 
 impl MuMapping {
@@ -117,13 +123,17 @@ impl MuMapping {
             MuMapping::Sqrt => "sqrt",
             MuMapping::Adaptive => "adaptive",
             MuMapping::Glass => "glass",
+            MuMapping::Balanced => "balanced",
         }
     }
 
     /// Whether the texture coordinate depends on `alpha` as well as `mu`.
     #[must_use]
     pub fn depends_on_roughness(self) -> bool {
-        matches!(self, MuMapping::Adaptive | MuMapping::Glass)
+        matches!(
+            self,
+            MuMapping::Adaptive | MuMapping::Glass | MuMapping::Balanced
+        )
     }
 
     /// Whether the texture coordinate depends on the index of refraction (only on a table over
@@ -133,35 +143,41 @@ impl MuMapping {
         self == MuMapping::Glass
     }
 
-    /// `mu` at texture coordinate `t` on the row of slope-space roughness `alpha` (a `glass`
-    /// axis at `eta = 1`: see [`MuMapping::mu_at`]).
+    /// `mu` at texture coordinate `t` on the row of slope-space roughness `alpha`, on an axis
+    /// of `size` samples (only `balanced` depends on it; a `glass` axis at `eta = 1`: see
+    /// [`MuMapping::mu_at`]).
     #[must_use]
-    pub fn mu(self, t: f64, alpha: f64) -> f64 {
-        self.mu_at(t, alpha, 1.0)
+    pub fn mu(self, t: f64, alpha: f64, size: usize) -> f64 {
+        self.mu_at(t, alpha, 1.0, size)
     }
 
-    /// `mu` at texture coordinate `t` at roughness `alpha` and axis index `eta_up >= 1`.
+    /// `mu` at texture coordinate `t` at roughness `alpha` and axis index `eta_up >= 1`, on an
+    /// axis of `size` samples.
     #[must_use]
-    pub fn mu_at(self, t: f64, alpha: f64, eta_up: f64) -> f64 {
+    pub fn mu_at(self, t: f64, alpha: f64, eta_up: f64, size: usize) -> f64 {
         match self {
             MuMapping::Linear => t,
             MuMapping::Sqrt => t * t,
             MuMapping::Adaptive => crate::integrate::grazing::mu_of_t(t, alpha),
             MuMapping::Glass => super::glass_layout::GlassLayout::KILN.mu_at(t, alpha, eta_up),
+            MuMapping::Balanced => {
+                super::balanced_layout::BalancedLayout::KILN.mu_at(t, alpha, size)
+            }
         }
     }
 
-    /// The texture coordinate of `mu` at roughness `alpha` (the inverse of [`MuMapping::mu`]).
-    /// For `adaptive`, `mu = 0` gives 0 whatever `alpha`, and `alpha = 0` gives 1 for `mu > 0`.
+    /// The texture coordinate of `mu` at roughness `alpha` on an axis of `size` samples (the
+    /// inverse of [`MuMapping::mu`]). For `adaptive` and `balanced`, `mu = 0` gives 0 whatever
+    /// `alpha`, and `alpha = 0` gives 1 for `mu > 0`.
     #[must_use]
-    pub fn coordinate(self, mu: f64, alpha: f64) -> f64 {
-        self.coordinate_at(mu, alpha, 1.0)
+    pub fn coordinate(self, mu: f64, alpha: f64, size: usize) -> f64 {
+        self.coordinate_at(mu, alpha, 1.0, size)
     }
 
-    /// The texture coordinate of `mu` at roughness `alpha` and axis index `eta_up >= 1` (the
-    /// inverse of [`MuMapping::mu_at`]).
+    /// The texture coordinate of `mu` at roughness `alpha` and axis index `eta_up >= 1` on an
+    /// axis of `size` samples (the inverse of [`MuMapping::mu_at`]).
     #[must_use]
-    pub fn coordinate_at(self, mu: f64, alpha: f64, eta_up: f64) -> f64 {
+    pub fn coordinate_at(self, mu: f64, alpha: f64, eta_up: f64, size: usize) -> f64 {
         match self {
             MuMapping::Linear => mu,
             MuMapping::Sqrt => mu.sqrt(),
@@ -169,13 +185,16 @@ impl MuMapping {
             MuMapping::Glass => {
                 super::glass_layout::GlassLayout::KILN.mu_coordinate(mu, alpha, eta_up)
             }
+            MuMapping::Balanced => {
+                super::balanced_layout::BalancedLayout::KILN.mu_coordinate(mu, alpha, size)
+            }
         }
     }
 
     /// The formula, for metadata.
     #[must_use]
-    pub fn formula(self) -> &'static str {
-        match self {
+    pub fn formula(self) -> String {
+        let text = match self {
             MuMapping::Linear => "mu = t",
             MuMapping::Sqrt => "mu = t^2 (lookup coordinate t = sqrt(mu))",
             MuMapping::Adaptive => {
@@ -191,6 +210,80 @@ impl MuMapping {
                  inside); mu at t by bisection; the row at alpha = 0 holds the limit alpha -> 0+ \
                  (computed at alpha = 1e-3); on the slice eta = 1 the texels above the eta layer \
                  (t > 0.3) are the albedo at eta = 1"
+            }
+            MuMapping::Balanced => {
+                let l = super::balanced_layout::BalancedLayout::KILN;
+                return format!(
+                    "lookup coordinate t = ((u + eps)^{p} - eps^{p}) / ((1 + eps)^{p} - eps^{p}) \
+                     with u = mu (1 + k) / (mu + k), k = {c} alpha (1 + {e} alpha), eps = ({z} / \
+                     32) (32 / N)^{w} exp(-{y} alpha), N the axis size (t = 0 at mu = 0; t = 1 \
+                     at alpha = 0, mu > 0); mu = u k / (1 + k - u) with u = (t ((1 + eps)^{p} - \
+                     eps^{p}) + eps^{p})^(1/{p}) - eps; the row at alpha = 0 holds the limit \
+                     alpha -> 0+ (computed at alpha = 1e-7)",
+                    p = l.power,
+                    c = l.scale,
+                    e = l.scale_growth,
+                    z = l.offset,
+                    w = l.offset_size_power,
+                    y = l.offset_decay,
+                );
+            }
+        };
+        text.to_string()
+    }
+}
+
+/// How the samples of a roughness axis are spaced along its convention's value (`r` or
+/// `alpha`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+pub enum RoughnessSpacing {
+    /// The texture coordinate is the value itself: `r = t` (or `alpha = t`).
+    #[default]
+    Linear,
+    /// kiln's balanced layout (`table::balanced_layout`): `t = 0.6 r^1.37 + 0.4 r^2 (3 - 2 r)`
+    /// of perceptual `r = sqrt(alpha)`: more rows through the knee `r ~ 0.5` where `E` bends
+    /// fastest, fewer near the mirror.
+    Balanced,
+}
+
+impl RoughnessSpacing {
+    /// The name used on the command line and in files.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            RoughnessSpacing::Linear => "linear",
+            RoughnessSpacing::Balanced => "balanced",
+        }
+    }
+
+    /// Whether this is the linear spacing (which files written before the balanced layout
+    /// imply, and do not name).
+    #[must_use]
+    pub fn is_linear(&self) -> bool {
+        *self == RoughnessSpacing::Linear
+    }
+
+    /// The texture coordinate of the roughness `value` given in `convention`.
+    #[must_use]
+    pub fn coordinate(self, value: f64, convention: RoughnessConvention) -> f64 {
+        match self {
+            RoughnessSpacing::Linear => value,
+            RoughnessSpacing::Balanced => super::balanced_layout::BalancedLayout::KILN
+                .roughness_coordinate(convention.to_alpha(value.max(0.0)).sqrt()),
+        }
+    }
+
+    /// The roughness value in `convention` at texture coordinate `t` (the inverse of
+    /// [`RoughnessSpacing::coordinate`]).
+    #[must_use]
+    pub fn value_at(self, t: f64, convention: RoughnessConvention) -> f64 {
+        match self {
+            RoughnessSpacing::Linear => t,
+            RoughnessSpacing::Balanced => {
+                let r = super::balanced_layout::BalancedLayout::KILN.roughness_at(t);
+                convention.from_alpha(r * r)
             }
         }
     }
@@ -324,11 +417,14 @@ pub enum Axis {
         mapping: MuMapping,
         grid: Grid,
     },
-    /// Roughness, in the given convention (`r` with `alpha = r^2`, or `alpha`).
+    /// Roughness, in the given convention (`r` with `alpha = r^2`, or `alpha`), spaced along
+    /// it by `spacing`.
     Roughness {
         size: usize,
         convention: RoughnessConvention,
         grid: Grid,
+        #[serde(default, skip_serializing_if = "RoughnessSpacing::is_linear")]
+        spacing: RoughnessSpacing,
     },
     /// The index of refraction `eta` in `[1, max]` (listed from 1 up whichever side the light
     /// arrives from).
@@ -379,8 +475,14 @@ impl Axis {
     #[must_use]
     pub fn value_at(&self, i: usize, alpha: f64, eta_up: f64) -> f64 {
         match *self {
-            Axis::Mu { mapping, .. } => mapping.mu_at(self.coordinate(i), alpha, eta_up),
-            Axis::Roughness { .. } => self.coordinate(i),
+            Axis::Mu { mapping, size, .. } => {
+                mapping.mu_at(self.coordinate(i), alpha, eta_up, size)
+            }
+            Axis::Roughness {
+                convention,
+                spacing,
+                ..
+            } => spacing.value_at(self.coordinate(i), convention),
             Axis::Ior { mapping, max, .. } => mapping.eta(self.coordinate(i), max.0, alpha),
         }
     }
@@ -417,8 +519,37 @@ impl Axis {
     #[must_use]
     pub fn alpha(&self, i: usize) -> f64 {
         match *self {
-            Axis::Roughness { convention, .. } => convention.to_alpha(self.coordinate(i)),
+            Axis::Roughness { .. } => self.alpha_at_coordinate(self.coordinate(i)),
             Axis::Mu { .. } | Axis::Ior { .. } => panic!("alpha asked of a {} axis", self.name()),
+        }
+    }
+
+    /// `alpha` at texture coordinate `t` of a roughness axis. Panics on another axis.
+    #[must_use]
+    pub fn alpha_at_coordinate(&self, t: f64) -> f64 {
+        match *self {
+            Axis::Roughness {
+                convention,
+                spacing,
+                ..
+            } => convention.to_alpha(spacing.value_at(t, convention)),
+            Axis::Mu { .. } | Axis::Ior { .. } => panic!("alpha asked of a {} axis", self.name()),
+        }
+    }
+
+    /// The roughness value (in the axis' convention) at texture coordinate `t` of a roughness
+    /// axis. Panics on another axis.
+    #[must_use]
+    pub fn roughness_at_coordinate(&self, t: f64) -> f64 {
+        match *self {
+            Axis::Roughness {
+                convention,
+                spacing,
+                ..
+            } => spacing.value_at(t, convention),
+            Axis::Mu { .. } | Axis::Ior { .. } => {
+                panic!("roughness asked of a {} axis", self.name())
+            }
         }
     }
 
@@ -428,19 +559,29 @@ impl Axis {
         match *self {
             Axis::Mu { mapping, grid, .. } => format!("{}, {}", grid.formula(), mapping.formula()),
             Axis::Roughness {
-                convention: RoughnessConvention::Perceptual,
+                convention,
                 grid,
+                spacing,
                 ..
-            } => {
-                format!("{}, r = t_i, alpha = r^2", grid.formula())
-            }
-            Axis::Roughness {
-                convention: RoughnessConvention::Alpha,
-                grid,
-                ..
-            } => {
-                format!("{}, alpha = t_i", grid.formula())
-            }
+            } => match (convention, spacing) {
+                (RoughnessConvention::Perceptual, RoughnessSpacing::Linear) => {
+                    format!("{}, r = t_i, alpha = r^2", grid.formula())
+                }
+                (RoughnessConvention::Alpha, RoughnessSpacing::Linear) => {
+                    format!("{}, alpha = t_i", grid.formula())
+                }
+                (_, RoughnessSpacing::Balanced) => {
+                    let l = super::balanced_layout::BalancedLayout::KILN;
+                    format!(
+                        "{}, t_i = {} r^{} + {} r^2 (3 - 2 r) (r at t_i by bisection), alpha = \
+                         r^2",
+                        grid.formula(),
+                        1.0 - l.roughness_knee,
+                        l.roughness_power,
+                        l.roughness_knee
+                    )
+                }
+            },
             Axis::Ior {
                 mapping, grid, max, ..
             } => format!(
@@ -458,8 +599,12 @@ impl Axis {
     #[must_use]
     pub fn position(&self, x: f64, alpha: f64, eta_up: f64) -> f64 {
         let t = match *self {
-            Axis::Mu { mapping, .. } => mapping.coordinate_at(x, alpha, eta_up),
-            Axis::Roughness { .. } => x,
+            Axis::Mu { mapping, size, .. } => mapping.coordinate_at(x, alpha, eta_up, size),
+            Axis::Roughness {
+                convention,
+                spacing,
+                ..
+            } => spacing.coordinate(x, convention),
             Axis::Ior { mapping, max, .. } => mapping.coordinate(x, max.0, alpha),
         };
         let n = self.size() as f64;
@@ -509,6 +654,7 @@ mod tests {
             size: 2,
             convention: RoughnessConvention::Perceptual,
             grid: Grid::Centers,
+            spacing: crate::table::axis::RoughnessSpacing::Linear,
         };
         assert_eq!(r.listed_values(), [0.25, 0.75]);
         assert_eq!(r.alpha(1), 0.5625);
@@ -554,11 +700,13 @@ mod tests {
                 size: 2,
                 convention: RoughnessConvention::Perceptual,
                 grid: Grid::Centers,
+                spacing: crate::table::axis::RoughnessSpacing::Linear,
             },
             Axis::Roughness {
                 size: 2,
                 convention: RoughnessConvention::Alpha,
                 grid: Grid::Nodes,
+                spacing: crate::table::axis::RoughnessSpacing::Linear,
             },
             Axis::Ior {
                 size: 2,

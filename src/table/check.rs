@@ -80,6 +80,20 @@ impl TableSpec {
                 q.symbol()
             ));
         }
+        let balanced_rows = matches!(
+            self.roughness,
+            Some(Axis::Roughness {
+                spacing: super::axis::RoughnessSpacing::Balanced,
+                ..
+            })
+        );
+        if balanced_rows && self.ior.is_some() {
+            return Err(format!(
+                "its roughness axis has the balanced spacing, which kiln lays out for the tables \
+                 over roughness and mu only ({} has an eta axis)",
+                q.symbol()
+            ));
+        }
         if !self.transmission.is_default() && (!q.has_ior() || q == Quantity::FAvg) {
             return Err(format!(
                 "a transmission convention belongs to the dielectric tables, not {}",
@@ -167,6 +181,7 @@ mod tests {
         size: 4,
         convention: RoughnessConvention::Perceptual,
         grid: Grid::Nodes,
+        spacing: crate::table::axis::RoughnessSpacing::Linear,
     };
     const MU: Axis = Axis::Mu {
         size: 3,
@@ -298,6 +313,7 @@ mod tests {
             size: 1,
             convention: RoughnessConvention::Perceptual,
             grid: Grid::Nodes,
+            spacing: crate::table::axis::RoughnessSpacing::Linear,
         };
         let widest = TableSpec {
             roughness: Some(one_row),

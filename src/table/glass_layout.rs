@@ -303,7 +303,8 @@ mod tests {
     #[test]
     fn the_formulas_state_the_constants() {
         use crate::table::axis::{IorMapping, MuMapping};
-        let mu = MuMapping::Glass.formula();
+        let mu_text = MuMapping::Glass.formula();
+        let mu = mu_text.as_str();
         let ior = IorMapping::Glass.formula();
         let k = GlassLayout::KILN;
         for (text, constant) in [

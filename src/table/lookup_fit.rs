@@ -116,7 +116,9 @@ fn fit_points(spec: &super::TableSpec, per_cell: usize) -> Vec<FitPoint> {
     let mut points = Vec::new();
     for &t_eta in &ts(spec.ior) {
         for &t_r in &ts(spec.roughness) {
-            let roughness = t_r;
+            let roughness = spec
+                .roughness
+                .map_or(t_r, |axis| axis.roughness_at_coordinate(t_r));
             let alpha = convention.to_alpha(roughness);
             let eta = match spec.ior {
                 Some(super::Axis::Ior { mapping, max, .. }) => mapping.eta(t_eta, max.0, alpha),
@@ -124,9 +126,9 @@ fn fit_points(spec: &super::TableSpec, per_cell: usize) -> Vec<FitPoint> {
             };
             let mus: Vec<Option<f64>> = match spec.mu {
                 // The texture's points, then the grazing probes `verify` audits every row at.
-                Some(super::Axis::Mu { mapping, .. }) => ts(spec.mu)
+                Some(super::Axis::Mu { mapping, size, .. }) => ts(spec.mu)
                     .iter()
-                    .map(|&t_mu| Some(mapping.mu_at(t_mu, alpha, eta)))
+                    .map(|&t_mu| Some(mapping.mu_at(t_mu, alpha, eta, size)))
                     .chain(super::axis::grazing_probes().into_iter().map(Some))
                     .collect(),
                 _ => vec![None],

@@ -1,6 +1,7 @@
 //! Tables: what was computed (the spec), the values with their errors, and how to look them up.
 
 pub mod axis;
+pub mod balanced_layout;
 pub mod check;
 pub mod glass_layout;
 pub mod lookup_fit;
@@ -266,16 +267,23 @@ impl TableSpec {
         {
             tags.push("alpha");
         }
-        match self.mu {
-            Some(Axis::Mu {
-                mapping: MuMapping::Linear,
-                ..
-            }) => tags.push("mu-linear"),
-            Some(Axis::Mu {
-                mapping: MuMapping::Sqrt,
-                ..
-            }) => tags.push("mu-sqrt"),
+        let mu_mapping = match self.mu {
+            Some(Axis::Mu { mapping, .. }) => Some(mapping),
+            _ => None,
+        };
+        match mu_mapping {
+            Some(MuMapping::Linear) => tags.push("mu-linear"),
+            Some(MuMapping::Sqrt) => tags.push("mu-sqrt"),
+            Some(MuMapping::Balanced) => tags.push("mu-balanced"),
             _ => {}
+        }
+        // The balanced rows go with the balanced mu axis, which names them.
+        if let Some(Axis::Roughness { spacing, .. }) = self.roughness {
+            match (spacing, mu_mapping == Some(MuMapping::Balanced)) {
+                (axis::RoughnessSpacing::Linear, true) => tags.push("rows-linear"),
+                (axis::RoughnessSpacing::Balanced, false) => tags.push("rows-balanced"),
+                _ => {}
+            }
         }
         if self.axes().iter().any(|axis| axis.grid() == Grid::Centers) {
             tags.push("centers");
@@ -362,7 +370,7 @@ impl TableSpec {
                 glass_layout::GlassLayout::KILN.limit_slice_point(t_mu, row_alpha);
             if eta_limit > 1.0 {
                 // Inside the eta layer: its profile, at the slice's own point.
-                let mu = mapping.mu_at(t_mu, alpha, eta_limit);
+                let mu = mapping.mu_at(t_mu, alpha, eta_limit, mu_axis.size());
                 return (alpha, Some(mu), Some(self.relative_eta(eta_limit)));
             }
             eta_up = Some(eta_limit);
@@ -377,7 +385,7 @@ impl TableSpec {
                 (alpha, mu, eta)
             }
             _ if self.row_limit_alpha().is_some() => (row_alpha, None, eta),
-            _ => (self.roughness_convention().to_alpha(t_r), None, eta),
+            _ => (self.roughness_axis().alpha_at_coordinate(t_r), None, eta),
         }
     }
 
@@ -410,7 +418,7 @@ impl TableSpec {
     /// their limit's ([`TableSpec::row_limit_alpha`]).
     #[must_use]
     pub fn row_alpha(&self, t_roughness: f64) -> f64 {
-        let alpha = self.roughness_convention().to_alpha(t_roughness);
+        let alpha = self.roughness_axis().alpha_at_coordinate(t_roughness);
         match self.row_limit_alpha() {
             Some(limit) if alpha == 0.0 => limit,
             _ => alpha,
@@ -480,9 +488,9 @@ impl TableSpec {
     #[must_use]
     pub fn point_at(&self, t_roughness: f64, t_mu: f64, eta_up: f64) -> (f64, Option<f64>) {
         debug_assert!(self.roughness.is_some(), "F_avg has no roughness axis");
-        let alpha = self.roughness_convention().to_alpha(t_roughness);
+        let alpha = self.roughness_axis().alpha_at_coordinate(t_roughness);
         match self.mu {
-            Some(Axis::Mu { mapping, .. }) => {
+            Some(Axis::Mu { mapping, size, .. }) => {
                 if alpha == 0.0
                     && let Some(limit) = self.row_limit_alpha()
                 {
@@ -491,9 +499,9 @@ impl TableSpec {
                     if t_mu >= 1.0 {
                         return (0.0, Some(1.0));
                     }
-                    return (limit, Some(mapping.mu_at(t_mu, limit, eta_up)));
+                    return (limit, Some(mapping.mu_at(t_mu, limit, eta_up, size)));
                 }
-                (alpha, Some(mapping.mu_at(t_mu, alpha, eta_up)))
+                (alpha, Some(mapping.mu_at(t_mu, alpha, eta_up, size)))
             }
             _ => (alpha, None),
         }
@@ -772,6 +780,7 @@ pub(crate) fn test_e_spec(
             size: rows,
             convention: RoughnessConvention::Perceptual,
             grid,
+            spacing: crate::table::axis::RoughnessSpacing::Linear,
         }),
         mu: Some(Axis::Mu {
             size: columns,
@@ -978,6 +987,7 @@ mod tests {
             size: 5,
             convention: RoughnessConvention::Alpha,
             grid: Grid::Centers,
+            spacing: crate::table::axis::RoughnessSpacing::Linear,
         });
         assert_eq!(
             other.id(),
@@ -1047,6 +1057,7 @@ mod tests {
             size: 5,
             convention: RoughnessConvention::Alpha,
             grid: Grid::Nodes,
+            spacing: crate::table::axis::RoughnessSpacing::Linear,
         });
         assert_eq!(spec.roughness_convention(), RoughnessConvention::Alpha);
     }
@@ -1109,7 +1120,7 @@ mod tests {
                 // Halfway between two rows and two columns (in texture coordinates).
                 let r = (r_axis.coordinate(1) + r_axis.coordinate(2)) / 2.0;
                 let t_mu = (mu_axis.coordinate(2) + mu_axis.coordinate(3)) / 2.0;
-                let mu = mapping.mu(t_mu, r * r);
+                let mu = mapping.mu(t_mu, r * r, mu_axis.size());
                 assert!(
                     (t.lookup(mu, r) - 17.5).abs() < 1e-9,
                     "{grid:?} {mapping:?}"

@@ -58,7 +58,7 @@ pub fn one_minus_lookup_average(e: &Table, roughness: f64) -> (f64, f64) {
     };
     let alpha = e.spec.roughness_convention().to_alpha(roughness);
     let mut breaks: Vec<f64> = (0..size)
-        .map(|i| mapping.mu(grid.coordinate(i, size), alpha))
+        .map(|i| mapping.mu(grid.coordinate(i, size), alpha, size))
         .chain([0.0, 1.0])
         .collect();
     breaks.sort_by(f64::total_cmp);
@@ -80,7 +80,7 @@ pub fn divides_by_roughness(e: &TableSpec) -> bool {
     matches!(
         e.mu,
         Some(Axis::Mu {
-            mapping: super::axis::MuMapping::Adaptive,
+            mapping: super::axis::MuMapping::Adaptive | super::axis::MuMapping::Balanced,
             ..
         })
     ) && e.roughness_axis().grid() == Grid::Nodes
@@ -111,6 +111,7 @@ pub fn spec_for(e: &TableSpec) -> TableSpec {
             size,
             convention: e.roughness_convention(),
             grid: Grid::Nodes,
+            spacing: super::axis::RoughnessSpacing::Linear,
         }),
         lookup_of: Some(Box::new(e.clone())),
         // Derived exactly from the lookup (of fitted texels or not), not fitted itself.
@@ -140,8 +141,13 @@ pub fn derive(e: &Table, command: String) -> Table {
             } else {
                 x
             };
-            let (loss, error) = one_minus_lookup_average(e, at);
-            let scale = if per_x { at } else { 1.0 };
+            let roughness = spec.roughness_axis().roughness_at_coordinate(at);
+            let (loss, error) = one_minus_lookup_average(e, roughness);
+            let scale = if per_x {
+                divisor(&spec, roughness)
+            } else {
+                1.0
+            };
             (loss / scale, error / scale)
         })
         .collect();
@@ -158,6 +164,22 @@ pub fn derive(e: &Table, command: String) -> Table {
     }
 }
 
+/// What a normalisation table that stores `(1 - Ē) / x` divides by at `roughness` (in the
+/// table's convention): `x`, the E table's row coordinate at `roughness` (the roughness itself
+/// on linear rows). Below the E table's first row the lookup blends row 0 and row 1 with the
+/// weight `x / x_1`, so that `1 - Ē` grows like `x` there, whatever the rows' spacing.
+#[must_use]
+pub fn divisor(norm: &TableSpec, roughness: f64) -> f64 {
+    match norm.lookup_of.as_deref().map(TableSpec::roughness_axis) {
+        Some(Axis::Roughness {
+            spacing,
+            convention,
+            ..
+        }) => spacing.coordinate(roughness, convention),
+        _ => roughness,
+    }
+}
+
 /// `1 - Ē` at `roughness` (in the table's convention) from a normalisation table: its linear
 /// interpolation, times `roughness` if it stores `(1 - Ē) / x` ([`stores_per_roughness`]). The
 /// denominator of `f_ms` is `pi` times this
@@ -166,7 +188,7 @@ pub fn derive(e: &Table, command: String) -> Table {
 pub fn normalisation_lookup(norm: &Table, roughness: f64) -> f64 {
     let g = norm.lookup(0.0, roughness);
     if stores_per_roughness(&norm.spec) {
-        roughness.clamp(0.0, 1.0) * g
+        divisor(&norm.spec, roughness.clamp(0.0, 1.0)) * g
     } else {
         g
     }

@@ -33,10 +33,18 @@ pub const MAX_MAP_CELLS: usize = 64;
 /// Where a compared point sits in the table's texture coordinates: `(x, y)` = (`mu`'s
 /// coordinate, roughness' coordinate) for a 2-D table, (roughness', 0) for a 1-D one.
 fn map_position(spec: &TableSpec, p: &Point) -> (f64, f64) {
-    let t_r = p.roughness.clamp(0.0, 1.0);
+    let t_r = match spec.roughness {
+        Some(Axis::Roughness {
+            convention,
+            spacing,
+            ..
+        }) => spacing.coordinate(p.roughness, convention),
+        _ => p.roughness,
+    }
+    .clamp(0.0, 1.0);
     match (spec.mu, p.mu) {
-        (Some(Axis::Mu { mapping, .. }), Some(mu)) => {
-            (mapping.coordinate(mu, p.alpha).clamp(0.0, 1.0), t_r)
+        (Some(Axis::Mu { mapping, size, .. }), Some(mu)) => {
+            (mapping.coordinate(mu, p.alpha, size).clamp(0.0, 1.0), t_r)
         }
         _ => (t_r, 0.0),
     }

@@ -182,7 +182,7 @@ pub fn furnace(e: &Table, normalisation: &Table, density: usize) -> Result<Furna
             let loss = |mu: f64| e.lookup_one_minus(mu, roughness);
             let (of_e, one_minus_e_avg, ratio) = lobe_ratio(e, normalisation, roughness);
             let mut mus: Vec<f64> = (0..=mu_steps)
-                .map(|k| mapping.mu(k as f64 / mu_steps as f64, alpha))
+                .map(|k| mapping.mu(k as f64 / mu_steps as f64, alpha, n_mu))
                 .collect();
             mus.extend(super::grazing_probes());
             let (worst_mu, deviation) = mus
@@ -262,7 +262,10 @@ pub fn audit_normalisation(e: &Table, norm: &Table) -> Result<NormalisationAudit
         )));
     }
     let n = norm.spec.len();
-    let grid = norm.spec.roughness_axis().grid();
+    let axis = norm.spec.roughness_axis();
+    let grid = axis.grid();
+    // Nodes and the points halfway between them, in texture coordinates, as roughness values.
+    let at = |t: f64| axis.roughness_at_coordinate(t);
     let relative = |x: f64| -> f64 {
         let (truth, _) = one_minus_lookup_average(e, x);
         let table = normalisation_lookup(norm, x);
@@ -272,9 +275,9 @@ pub fn audit_normalisation(e: &Table, norm: &Table) -> Result<NormalisationAudit
             (table / truth - 1.0).abs()
         }
     };
-    let nodes: Vec<f64> = (1..n).map(|i| grid.coordinate(i, n)).collect();
+    let nodes: Vec<f64> = (1..n).map(|i| at(grid.coordinate(i, n))).collect();
     let between: Vec<f64> = (0..n - 1)
-        .map(|i| (grid.coordinate(i, n) + grid.coordinate(i + 1, n)) / 2.0)
+        .map(|i| at((grid.coordinate(i, n) + grid.coordinate(i + 1, n)) / 2.0))
         .collect();
     let node_max_relative_error = crate::stats::max_or_nan(nodes.iter().map(|&x| relative(x)));
     let (worst_roughness, lookup_max_relative_error) = between
@@ -483,7 +486,12 @@ pub fn furnace_maps(
     columns: usize,
 ) -> Result<Vec<FurnaceMap>> {
     use rayon::prelude::*;
-    let Some(Axis::Mu { mapping, .. }) = e.spec.mu else {
+    let Some(Axis::Mu {
+        mapping,
+        size: mu_size,
+        ..
+    }) = e.spec.mu
+    else {
         return Err(Error::InvalidInput("a furnace map needs an E table".into()));
     };
     if forms.contains(&Form::KullaConty) && normalisation.is_none() {
@@ -507,7 +515,7 @@ pub fn furnace_maps(
                 };
                 (0..columns)
                     .map(|k| {
-                        let mu = mapping.mu(coordinate(columns, k), alpha);
+                        let mu = mapping.mu(coordinate(columns, k), alpha, mu_size);
                         match form {
                             Form::KullaConty => {
                                 lobe_deviation(e.lookup_one_minus(mu, roughness), ratio)

@@ -514,6 +514,7 @@ fn spec_and_values(
         size,
         convention: layout.roughness,
         grid: layout.grid,
+        spacing: crate::table::axis::RoughnessSpacing::Linear,
     };
     let mu_axis = |size| Axis::Mu {
         size,

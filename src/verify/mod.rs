@@ -525,7 +525,7 @@ pub fn lookup_coordinates(spec: &TableSpec, settings: &AuditSettings) -> Vec<Coo
                     for t_mu in ladder(axis.size()) {
                         points.push(at(spec.point_at(t_r, t_mu, eta_up.unwrap_or(1.0))));
                     }
-                    let alpha = spec.roughness_convention().to_alpha(t_r);
+                    let alpha = roughness.alpha_at_coordinate(t_r);
                     points.extend(grazing_probes().into_iter().map(|mu| at((alpha, Some(mu)))));
                 }
                 None => points.push(at(spec.point(t_r, 0.0))),

@@ -502,12 +502,12 @@ fn run_furnace(args: &VerifyArgs, table: &Table) -> kiln::Result<bool> {
             .iter()
             .map(|map| {
                 let report = form_reports.iter().find(|f| f.form == map.form)?;
-                let kiln::Axis::Mu { mapping, .. } = table.spec.mu? else {
+                let kiln::Axis::Mu { mapping, size, .. } = table.spec.mu? else {
                     return None;
                 };
                 let alpha = convention.to_alpha(report.worst_roughness);
                 Some(crate::plot::FurnaceMark {
-                    t: mapping.coordinate(report.worst_mu, alpha),
+                    t: mapping.coordinate(report.worst_mu, alpha, size),
                     mu: report.worst_mu,
                     roughness: report.worst_roughness,
                     deviation: report.deviation,
