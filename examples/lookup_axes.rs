@@ -10,7 +10,7 @@
 //!
 //! Candidates, as `key=value` (defaults: kiln's axes): `n=32` samples per axis (nodes grid);
 //! the `mu` coordinate `t = (1 - b') A(mu; c alpha, p) + b' mu`, `b' = 4 b alpha (1 - alpha)`, `A(y; k, p) = (y (1 + k) / (y +
-//! k))^p` (`c=4 p=0.4 b=0`); the roughness coordinate `t_r = (1 - h) r + h r^g - s sin(2 pi r) / (2 pi)` (`h=0 g=1 s=0`), then blended with a smoothstep, `(1 - m) t_r + m r^2 (3 - 2 r)` (`m=0`);
+//! k))^p` (`c=4 p=0.4 b=0`); the roughness coordinate `t_r = (1 - h) r + h r^g - s sin(2 pi r) / (2 pi)` (`h=0 g=1 s=0`; with `d > 0`, `r^g` is `((r^2 + d^2)^(g/2) - d^g) / ((1 + d^2)^(g/2) - d^g)`, like `alpha` below `r ~ d`), then blended with a smoothstep, `(1 - m) t_r + m r^2 (3 - 2 r)` (`m=0`);
 //! `e=0` a slope in `k = c alpha (1 + e alpha)`, `q=0` a slope of the power `p + q alpha`;
 //! `z=0` an offset that makes `t` linear in `mu` at grazing, `t = ((u + z') ^ p - z'^p) / ((1 +
 //! z')^p - z'^p)` with `u = A(mu; k, 1)` and `z' = (z / 32) (32 / n)^w exp(-y alpha)` (`y=1`, `w=1`);
@@ -100,6 +100,7 @@ fn main() {
         ("h", 0.0),
         ("s", 0.0),
         ("m", 0.0),
+        ("d", 0.0),
         ("g", 1.0),
         ("e", 0.0),
         ("q", 0.0),
@@ -117,7 +118,7 @@ fn main() {
     let truth = truth();
     let n = p["n"] as usize;
     let (c, pw, b, h, g, s) = (p["c"], p["p"], p["b"], p["h"], p["g"], p["s"]);
-    let m = p["m"];
+    let (m, d) = (p["m"], p["d"]);
     let (e, q, z, y, w) = (p["e"], p["q"], p["z"], p["y"], p["w"]);
     let weights = |r: f64, mu: f64| -> Vec<(usize, f64)> {
         let alpha = r * r;
@@ -130,7 +131,12 @@ fn main() {
                 z / 32.0 * (32.0 / n as f64).powf(w) * (-y * alpha).exp(),
             )
             + blend * mu;
-        let t_r = (1.0 - h) * r + h * r.powf(g)
+        let power = if d > 0.0 {
+            ((r * r + d * d).powf(g / 2.0) - d.powf(g)) / ((1.0 + d * d).powf(g / 2.0) - d.powf(g))
+        } else {
+            r.powf(g)
+        };
+        let t_r = (1.0 - h) * r + h * power
             - s * (std::f64::consts::TAU * r).sin() / std::f64::consts::TAU;
         let t_r = (1.0 - m) * t_r + m * r * r * (3.0 - 2.0 * r);
         let pos = |t: f64| {

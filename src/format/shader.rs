@@ -148,10 +148,15 @@ fn coordinate(language: Language, axis: &Axis) -> String {
                 RoughnessConvention::Perceptual => "clamp(roughness, 0.0, 1.0)",
                 RoughnessConvention::Alpha => "sqrt(clamp(roughness, 0.0, 1.0))",
             };
+            let (d2, half) = (l.roughness_offset.powi(2), l.roughness_power / 2.0);
+            let low = l.roughness_offset.powf(l.roughness_power);
             format!(
-                "{} * pow(max({r}, 1e-30), {}) + {} * {r} * {r} * (3.0 - 2.0 * {r})",
+                "{} * (pow({r} * {r} + {}, {}) - {}) / {} + {} * {r} * {r} * (3.0 - 2.0 * {r})",
                 literal(1.0 - l.roughness_knee),
-                literal(l.roughness_power),
+                literal(d2),
+                literal(half),
+                literal(low),
+                literal((1.0 + d2).powf(half) - low),
                 literal(l.roughness_knee)
             )
         }

@@ -242,9 +242,10 @@ pub enum RoughnessSpacing {
     /// The texture coordinate is the value itself: `r = t` (or `alpha = t`).
     #[default]
     Linear,
-    /// kiln's balanced layout (`table::balanced_layout`): `t = 0.6 r^1.37 + 0.4 r^2 (3 - 2 r)`
-    /// of perceptual `r = sqrt(alpha)`: more rows through the knee `r ~ 0.5` where `E` bends
-    /// fastest, fewer near the mirror.
+    /// kiln's balanced layout (`table::balanced_layout`): `t = 0.6 P(r) + 0.4 r^2 (3 - 2 r)`
+    /// of perceptual `r = sqrt(alpha)`, `P(r)` the normalised `r^1.37`, proportional to `alpha`
+    /// below `r ~ 0.02`: more rows through the knee `r ~ 0.5` where `E` bends fastest, fewer
+    /// near the mirror.
     Balanced,
 }
 
@@ -573,12 +574,17 @@ impl Axis {
                 (_, RoughnessSpacing::Balanced) => {
                     let l = super::balanced_layout::BalancedLayout::KILN;
                     format!(
-                        "{}, t_i = {} r^{} + {} r^2 (3 - 2 r) (r at t_i by bisection), alpha = \
-                         r^2",
+                        "{}, t_i = {} P(r) + {} r^2 (3 - 2 r), P(r) = ((r^2 + d^2)^({} / 2) - \
+                         d^{}) / ((1 + d^2)^({} / 2) - d^{}), d = {} (r at t_i by bisection), \
+                         alpha = r^2",
                         grid.formula(),
                         1.0 - l.roughness_knee,
+                        l.roughness_knee,
                         l.roughness_power,
-                        l.roughness_knee
+                        l.roughness_power,
+                        l.roughness_power,
+                        l.roughness_power,
+                        l.roughness_offset
                     )
                 }
             },

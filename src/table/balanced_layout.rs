@@ -18,8 +18,10 @@
 //!   `mu < 1e-4`). To `O(alpha)` the coordinate is still a function of `mu / alpha` at small
 //!   `alpha`, so the grazing layer keeps its texels at every roughness, and the row
 //!   `alpha = 0` holds the layer's limit as on the adaptive axis.
-//! - **roughness:** `t_r = (1 - m) r^q + m r^2 (3 - 2 r)` (`r = sqrt(alpha)`, perceptual): more
-//!   rows through the knee, fewer near the mirror, where `E` depends on `mu / alpha` alone.
+//! - **roughness:** `t_r = (1 - m) P(r) + m r^2 (3 - 2 r)` (`r = sqrt(alpha)`, perceptual), `P`
+//!   the power `r^q` turned into a multiple of `alpha` below `r ~ d`
+//!   ([`BalancedLayout::roughness_coordinate`]): more rows through the knee, fewer near the
+//!   mirror, where `E` depends on `mu / alpha` alone.
 //!
 //! Both coordinates increase with their variable and reach 0 and 1 at the axis ends; a lookup
 //! computes them in closed form, a bake inverts them (the `mu` coordinate in closed form, the
@@ -49,6 +51,9 @@ pub struct BalancedLayout {
     pub roughness_power: f64,
     /// `m`: the share of the smoothstep `r^2 (3 - 2 r)` in the roughness coordinate.
     pub roughness_knee: f64,
+    /// `d`: below `r ~ d` the power of `r` turns into a multiple of `alpha = r^2` (see
+    /// [`BalancedLayout::roughness_coordinate`]).
+    pub roughness_offset: f64,
 }
 
 impl BalancedLayout {
@@ -62,6 +67,7 @@ impl BalancedLayout {
         offset_decay: 3.0,
         roughness_power: 1.37,
         roughness_knee: 0.4,
+        roughness_offset: 0.02,
     };
 
     /// The grazing layer's scale `k` at slope-space roughness `alpha`.
@@ -114,12 +120,22 @@ impl BalancedLayout {
         (u * k / (1.0 + k - u)).clamp(0.0, 1.0)
     }
 
-    /// The texture coordinate of perceptual roughness `r` in [0, 1].
+    /// The texture coordinate of perceptual roughness `r` in [0, 1]: `(1 - m) P(r) + m r^2 (3 -
+    /// 2 r)` with `P(r) = ((r^2 + d^2)^(q/2) - d^q) / ((1 + d^2)^(q/2) - d^q)`, which is `r^q`
+    /// (normalised) above `r ~ d` and proportional to `alpha = r^2` below: there a fitted
+    /// table's `1 - Ē` grows like `alpha`, and so does the coordinate that `f_ms_norm` divides
+    /// it by ([`crate::table::normalisation`]).
     #[must_use]
     pub fn roughness_coordinate(&self, r: f64) -> f64 {
         let r = r.clamp(0.0, 1.0);
-        let m = self.roughness_knee;
-        (1.0 - m) * r.powf(self.roughness_power) + m * r * r * (3.0 - 2.0 * r)
+        let (m, q, d) = (
+            self.roughness_knee,
+            self.roughness_power,
+            self.roughness_offset,
+        );
+        let low = d.powf(q);
+        let power = ((r * r + d * d).powf(q / 2.0) - low) / ((1.0 + d * d).powf(q / 2.0) - low);
+        (1.0 - m) * power + m * r * r * (3.0 - 2.0 * r)
     }
 
     /// Perceptual roughness `r` at texture coordinate `t` (the inverse of
@@ -183,7 +199,10 @@ mod tests {
         let eps = 1.25 / 32.0 * (-3.0 * alpha).exp();
         let t = ((u + eps).powf(0.4) - eps.powf(0.4)) / ((1.0 + eps).powf(0.4) - eps.powf(0.4));
         assert!((L.mu_coordinate(mu, alpha, 32) - t).abs() < 1e-15);
-        let t_r = 0.6 * 0.5f64.powf(1.37) + 0.4 * 0.25 * 2.0;
+        let d2 = 0.02f64 * 0.02;
+        let power = ((0.25 + d2).powf(0.685) - 0.02f64.powf(1.37))
+            / ((1.0 + d2).powf(0.685) - 0.02f64.powf(1.37));
+        let t_r = 0.6 * power + 0.4 * 0.25 * 2.0;
         assert!((L.roughness_coordinate(0.5) - t_r).abs() < 1e-15);
     }
 }

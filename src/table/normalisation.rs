@@ -10,14 +10,15 @@
 //! normalisation that closes the furnace for the lookup the renderer really uses is
 //! `1 - Ē(r) = 2 ∫ (1 - E_lookup(mu, r)) mu dmu`.
 //!
-//! Its table: over the E table's roughness coordinate `x` (`r` or `alpha`), on nodes that
+//! Its table: over the E table's roughness coordinate `x` (`r` or `alpha` on linear rows; the
+//! rows' texture coordinate on balanced rows, whose spacing it shares), on nodes that
 //! subdivide every cell of the E table's roughness axis [`SUBDIVISIONS`] times (497 entries for a
 //! 32-row table; so the kinks of the bilinear lookup, at the E table's rows, fall on nodes and
 //! the linear interpolation between them is smooth), one of two forms
 //! ([`divides_by_roughness`]):
 //!
-//! - `g(x) = (1 - Ē(x)) / x` for an E table on the adaptive `mu` axis with its rows on nodes
-//!   (kiln's default). There the lookup's columns move with `alpha`, and between the first two
+//! - `g(x) = (1 - Ē(x)) / x` for an E table on the adaptive or balanced `mu` axis with its rows
+//!   on nodes (kiln's default). There the lookup's columns move with `alpha`, and between the first two
 //!   rows `1 - Ē` starts linearly in `x` (3.4e-5 x for the default GGX table) and then grows
 //!   like `alpha`; divided by `x` it is close to linear over the first cell, where `1 - Ē`
 //!   itself varies over orders of magnitude. `g(0)` is the limit, the slope of `1 - Ē` at 0;
@@ -111,7 +112,11 @@ pub fn spec_for(e: &TableSpec) -> TableSpec {
             size,
             convention: e.roughness_convention(),
             grid: Grid::Nodes,
-            spacing: super::axis::RoughnessSpacing::Linear,
+            // The E table's rows are nodes of this axis (every SUBDIVISIONS-th).
+            spacing: match rows {
+                Axis::Roughness { spacing, .. } => spacing,
+                _ => unreachable!("a roughness axis"),
+            },
         }),
         lookup_of: Some(Box::new(e.clone())),
         // Derived exactly from the lookup (of fitted texels or not), not fitted itself.

@@ -166,19 +166,24 @@ pub struct BakeArgs {
     #[arg(long, value_enum, default_value = "r")]
     roughness_axis: RoughnessConvention,
     /// Spacing of the roughness samples along --roughness-axis: linear (the texture coordinate
-    /// is r, or alpha) or balanced (t = 0.6 r^1.37 + 0.4 r^2 (3 - 2 r): more rows where E bends
-    /// fastest, r ~ 0.5, fewer near the mirror; laid out with --mu-axis balanced for
-    /// --texels lookup-fit). The tables over the IOR keep the linear spacing [default:
-    /// balanced with --mu-axis balanced, otherwise linear].
-    #[arg(long, value_enum)]
+    /// is r, or alpha) or balanced (t = 0.6 P(r) + 0.4 r^2 (3 - 2 r), P(r) about r^1.37: more
+    /// rows where E bends fastest, r ~ 0.5, fewer near the mirror; laid out with --mu-axis
+    /// balanced for --texels lookup-fit). The tables over the IOR keep the linear spacing
+    /// [default: balanced with --mu-axis balanced, otherwise linear].
+    #[arg(long, value_enum, hide_possible_values = true)]
     roughness_spacing: Option<RoughnessSpacing>,
     /// Spacing of the mu axis: adaptive (follows the grazing layer mu ~ alpha; lookup
     /// coordinate t = (mu (1 + 4 alpha) / (mu + 4 alpha))^0.4), balanced (kiln's layout for
     /// --texels lookup-fit: the grazing layer, and more texels near mu = 1 at moderate
     /// roughness, so that the fitted lookup's largest error is about even over the domain;
-    /// 2.3e-4 at 32 x 32 with balanced rows, against 3.3e-4 on the adaptive axis; see
+    /// 2.1e-4 at 32 x 32 with balanced rows, against 3.3e-4 on the adaptive axis; see
     /// docs/accuracy.md), linear (mu = t) or sqrt (mu = t^2). See "Conventions" below.
-    #[arg(long, value_enum, default_value = "adaptive")]
+    #[arg(
+        long,
+        value_enum,
+        default_value = "adaptive",
+        hide_possible_values = true
+    )]
     mu_axis: MuMapping,
     /// Where samples sit: nodes i/(N - 1) on the axis ends (lookups must remap, see below) or
     /// texel centres (i + 0.5)/N.
