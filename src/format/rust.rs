@@ -152,16 +152,15 @@ fn coordinate_code(axis: &Axis) -> String {
                 RoughnessConvention::Perceptual => "roughness.clamp(0.0, 1.0)",
                 RoughnessConvention::Alpha => "roughness.clamp(0.0, 1.0).sqrt()",
             };
-            let (d2, half) = (l.roughness_offset.powi(2), l.roughness_power / 2.0);
-            let low = l.roughness_offset.powf(l.roughness_power);
+            let p = l.roughness_power_terms();
             format!(
                 "{{\n        let r = {r};\n        \
                  let power = ((r * r + {:?}).powf({:?}) - {:?}) / {:?};\n        \
                  {:?} * power + {:?} * r * r * (3.0 - 2.0 * r)\n    }}",
-                d2 as f32,
-                half as f32,
-                low as f32,
-                ((1.0 + d2).powf(half) - low) as f32,
+                p.offset_squared as f32,
+                p.half_power as f32,
+                p.low as f32,
+                p.scale as f32,
                 (1.0 - l.roughness_knee) as f32,
                 l.roughness_knee as f32,
             )

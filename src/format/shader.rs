@@ -148,15 +148,14 @@ fn coordinate(language: Language, axis: &Axis) -> String {
                 RoughnessConvention::Perceptual => "clamp(roughness, 0.0, 1.0)",
                 RoughnessConvention::Alpha => "sqrt(clamp(roughness, 0.0, 1.0))",
             };
-            let (d2, half) = (l.roughness_offset.powi(2), l.roughness_power / 2.0);
-            let low = l.roughness_offset.powf(l.roughness_power);
+            let p = l.roughness_power_terms();
             format!(
                 "{} * (pow({r} * {r} + {}, {}) - {}) / {} + {} * {r} * {r} * (3.0 - 2.0 * {r})",
                 literal(1.0 - l.roughness_knee),
-                literal(d2),
-                literal(half),
-                literal(low),
-                literal((1.0 + d2).powf(half) - low),
+                literal(p.offset_squared),
+                literal(p.half_power),
+                literal(p.low),
+                literal(p.scale),
                 literal(l.roughness_knee)
             )
         }

@@ -128,14 +128,25 @@ impl BalancedLayout {
     #[must_use]
     pub fn roughness_coordinate(&self, r: f64) -> f64 {
         let r = r.clamp(0.0, 1.0);
-        let (m, q, d) = (
-            self.roughness_knee,
-            self.roughness_power,
-            self.roughness_offset,
-        );
-        let low = d.powf(q);
-        let power = ((r * r + d * d).powf(q / 2.0) - low) / ((1.0 + d * d).powf(q / 2.0) - low);
+        let p = self.roughness_power_terms();
+        let power = ((r * r + p.offset_squared).powf(p.half_power) - p.low) / p.scale;
+        let m = self.roughness_knee;
         (1.0 - m) * power + m * r * r * (3.0 - 2.0 * r)
+    }
+
+    /// The constants of `P(r) = ((r^2 + d^2)^(q/2) - d^q) / ((1 + d^2)^(q/2) - d^q)`, as the
+    /// generated lookups write them.
+    #[must_use]
+    pub fn roughness_power_terms(&self) -> PowerTerms {
+        let (q, d) = (self.roughness_power, self.roughness_offset);
+        // (d^2)^(q/2) as P computes it, so that P(0) is exactly 0.
+        let low = (d * d).powf(q / 2.0);
+        PowerTerms {
+            offset_squared: d * d,
+            half_power: q / 2.0,
+            low,
+            scale: (1.0 + d * d).powf(q / 2.0) - low,
+        }
     }
 
     /// Perceptual roughness `r` at texture coordinate `t` (the inverse of
@@ -150,6 +161,16 @@ impl BalancedLayout {
         }
         bisect(0.0, 1.0, 64, |r| self.roughness_coordinate(r) < t)
     }
+}
+
+/// `P(r) = ((r^2 + offset_squared)^half_power - low) / scale`
+/// ([`BalancedLayout::roughness_power_terms`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PowerTerms {
+    pub offset_squared: f64,
+    pub half_power: f64,
+    pub low: f64,
+    pub scale: f64,
 }
 
 #[cfg(test)]
