@@ -1,5 +1,6 @@
 //! What the shader tests run and what they expect: the default tables and a second layout
-//! (texel centres, the sqrt mu axis, 8 x 8) baked with the generated shaders, the points the
+//! (texel centres, kiln's balanced layout with fitted texels: both of its coordinates computed
+//! in the shader; 8 x 8) baked with the generated shaders, the points the
 //! shaders are called at, and the library's value at each with the tolerance f32 allows.
 //! `tests/shader_execution.rs` runs the points as C++, `tests/gpu_shaders.rs` on Vulkan.
 
@@ -16,7 +17,7 @@ mod command;
 /// The generated files every test loads, by stem.
 pub const TABLE_FILES: [&str; 4] = [
     "ggx-height-correlated-E",
-    "ggx-height-correlated-E-mu-sqrt-centers",
+    "ggx-height-correlated-E-mu-balanced-centers-lookup-fit",
     "ggx-height-correlated-E_avg",
     "ggx-height-correlated-f_ms_norm",
 ];
@@ -87,7 +88,9 @@ impl Cases {
             &formats,
             &[
                 "--mu-axis",
-                "sqrt",
+                "balanced",
+                "--texels",
+                "lookup-fit",
                 "--grid",
                 "centers",
                 "--size",
@@ -98,10 +101,13 @@ impl Cases {
             &other,
         );
         for language in languages {
-            let name = format!("ggx-height-correlated-E-mu-sqrt-centers.{language}");
+            let name = format!("ggx-height-correlated-E-mu-balanced-centers-lookup-fit.{language}");
             std::fs::copy(other.join(&name), d.join(&name)).unwrap();
         }
-        let centres = read(&other, "ggx-height-correlated-E-mu-sqrt-centers");
+        let centres = read(
+            &other,
+            "ggx-height-correlated-E-mu-balanced-centers-lookup-fit",
+        );
         assert_eq!(centres.spec.quantity, Quantity::E);
         let e = read(&d, "ggx-height-correlated-E");
         let points = |t: &Table| -> Vec<f64> {
