@@ -156,6 +156,16 @@ impl BakeOptions {
                 q.symbol()
             )));
         }
+        if self.roughness_spacing == RoughnessSpacing::Balanced
+            && let Some(q) = self.quantities().into_iter().find(|q| q.has_ior())
+        {
+            return Err(Error::InvalidInput(format!(
+                "--roughness-spacing balanced (the default with --mu-axis balanced) lays out the \
+                 tables over roughness and mu; {} is over the IOR too, whose rows stay linear: \
+                 bake it in a separate command, or give --roughness-spacing linear",
+                q.symbol()
+            )));
+        }
         if !self.transmission.is_default()
             && !self
                 .quantities()

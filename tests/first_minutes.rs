@@ -629,3 +629,45 @@ fn the_glass_layout_refuses_what_it_cannot_do() {
     );
     assert!(!picture.exists());
 }
+
+/// kiln's balanced layout lays out the tables over roughness and mu: balanced rows with a
+/// table over the IOR are refused by name (asked for, or the default of `--mu-axis balanced`),
+/// and so is the balanced mu axis with a quantity that varies with `mu` on a mirror.
+#[test]
+fn the_balanced_layout_refuses_what_it_cannot_do() {
+    refused(
+        &[
+            "bake",
+            "--quantity",
+            "e,e-dielectric",
+            "--ior-axis",
+            "cycles",
+            "--roughness-spacing",
+            "balanced",
+        ],
+        &[
+            "--roughness-spacing balanced",
+            "E_dielectric",
+            "separate command",
+        ],
+    );
+    refused(
+        &[
+            "bake",
+            "--quantity",
+            "e-dielectric",
+            "--ior-axis",
+            "cycles",
+            "--mu-axis",
+            "balanced",
+        ],
+        &[
+            "default with --mu-axis balanced",
+            "--roughness-spacing linear",
+        ],
+    );
+    refused(
+        &["bake", "--quantity", "e-scale", "--mu-axis", "balanced"],
+        &["--mu-axis linear or sqrt", "balanced mu axis"],
+    );
+}
