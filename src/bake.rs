@@ -38,8 +38,8 @@ pub struct BakeOptions {
     pub scrambles: u32,
     pub seed: u64,
     pub roughness_convention: RoughnessConvention,
-    /// How the roughness samples are spaced along the convention's value (the tables over the
-    /// IOR keep the linear spacing).
+    /// How the roughness samples are spaced along the convention's value (linear only with a
+    /// table over the IOR: [`BakeOptions::validate`]).
     #[serde(default)]
     pub roughness_spacing: RoughnessSpacing,
     pub mu_mapping: MuMapping,
@@ -458,12 +458,6 @@ impl BakeOptions {
             grid: self.grid,
             spacing: self.roughness_spacing,
         };
-        let ior_roughness = Axis::Roughness {
-            size: self.size,
-            convention: self.roughness_convention,
-            grid: self.grid,
-            spacing: RoughnessSpacing::Linear,
-        };
         let mu = Axis::Mu {
             size: self.size,
             mapping: self.mu_mapping,
@@ -519,11 +513,7 @@ impl BakeOptions {
                                 },
                             ),
                             fresnel: self.fresnel.filter(|_| quantity == Quantity::EF),
-                            roughness: quantity.has_roughness().then_some(if quantity.has_ior() {
-                                ior_roughness
-                            } else {
-                                roughness
-                            }),
+                            roughness: quantity.has_roughness().then_some(roughness),
                             mu: quantity.has_mu().then_some(
                                 if glass_layout && quantity.has_ior() {
                                     glass_mu
@@ -591,12 +581,8 @@ impl BakeOptions {
     #[must_use]
     pub fn command_for(&self, model: Model) -> String {
         let command = self.command_without_texels(model);
-        // The CLI's default spacing goes with the mu axis: balanced rows with the balanced axis.
-        let paired = match self.mu_mapping {
-            MuMapping::Balanced => RoughnessSpacing::Balanced,
-            _ => RoughnessSpacing::Linear,
-        };
-        let command = if self.roughness_spacing == paired {
+        // The CLI's default spacing goes with the mu axis.
+        let command = if self.roughness_spacing == RoughnessSpacing::paired_with(self.mu_mapping) {
             command
         } else {
             format!(

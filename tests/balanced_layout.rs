@@ -156,22 +156,7 @@ fn the_fitted_32x32_lookup_meets_2_5e_4_through_the_generated_code() {
         );
     }
     source += "}\n";
-    let cpp = dir.path().join("lookup.cpp");
-    std::fs::write(&cpp, &source).unwrap();
-    let program = dir.path().join("lookup_cpp");
-    let compiler = cxx::compiler().expect("a C++ compiler (c++, g++ or clang++)");
-    let compiled = std::process::Command::new(compiler)
-        .args(["-std=c++17", "-O1", "-fsingle-precision-constant", "-o"])
-        .arg(&program)
-        .arg(&cpp)
-        .output()
-        .expect("a C++ compiler (c++) runs");
-    assert!(
-        compiled.status.success(),
-        "the generated HLSL does not compile as C++:\n{}",
-        String::from_utf8_lossy(&compiled.stderr)
-    );
-    let from_hlsl = run(&program);
+    let from_hlsl = cxx::compile_and_run(dir.path(), "lookup_cpp", &source);
 
     // Rust, compiled by rustc.
     let rust = std::fs::read_to_string(dir.path().join(format!("{id}.rs"))).unwrap();

@@ -12,6 +12,9 @@ use kiln::{BakeOptions, IorMapping, Quantity, Table};
 use std::fmt::Write as _;
 use std::sync::OnceLock;
 
+#[path = "common/cxx.rs"]
+mod cxx;
+
 /// One small bake of both dielectric albedos in kiln's glass layout, shared by the tests.
 fn tables() -> &'static [Table] {
     static TABLES: OnceLock<Vec<Table>> = OnceLock::new();
@@ -201,27 +204,7 @@ fn generated_hlsl_lookup_runs_and_matches_the_library() {
     }
     main += "}\n";
     source += &main;
-    let file = dir.path().join("lookup.cpp");
-    std::fs::write(&file, &source).unwrap();
-    let program = dir.path().join("lookup");
-    let compiler = std::env::var("CXX").unwrap_or_else(|_| "c++".into());
-    let compiled = std::process::Command::new(compiler)
-        .args(["-std=c++17", "-O0", "-fsingle-precision-constant", "-o"])
-        .arg(&program)
-        .arg(&file)
-        .output()
-        .expect("a C++ compiler (c++) runs");
-    assert!(
-        compiled.status.success(),
-        "the generated HLSL does not compile as C++:\n{}",
-        String::from_utf8_lossy(&compiled.stderr)
-    );
-    let output = std::process::Command::new(&program).output().unwrap();
-    let printed: Vec<f64> = String::from_utf8(output.stdout)
-        .unwrap()
-        .lines()
-        .map(|l| l.parse().unwrap())
-        .collect();
+    let printed = cxx::compile_and_run(dir.path(), "lookup", &source);
     let mut k = 0;
     let mut worst = 0.0f64;
     for table in tables() {

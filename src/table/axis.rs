@@ -194,13 +194,14 @@ impl MuMapping {
     /// The formula, for metadata.
     #[must_use]
     pub fn formula(self) -> String {
-        let text = match self {
-            MuMapping::Linear => "mu = t",
-            MuMapping::Sqrt => "mu = t^2 (lookup coordinate t = sqrt(mu))",
+        match self {
+            MuMapping::Linear => "mu = t".to_string(),
+            MuMapping::Sqrt => "mu = t^2 (lookup coordinate t = sqrt(mu))".to_string(),
             MuMapping::Adaptive => {
                 "lookup coordinate t = (mu (1 + 4 alpha) / (mu + 4 alpha))^0.4 (t = 0 at mu = 0; \
                  t = 1 at alpha = 0, mu > 0); mu = s k / (1 + k - s) with s = t^2.5, k = 4 alpha; \
                  the row at alpha = 0 holds the limit alpha -> 0+ (computed at alpha = 1e-7)"
+                    .to_string()
             }
             MuMapping::Glass => {
                 "lookup coordinate t = w A(mu; kappa, 0.35) + (1 - w) A(mu; 4 alpha, 0.4) with \
@@ -210,10 +211,11 @@ impl MuMapping {
                  inside); mu at t by bisection; the row at alpha = 0 holds the limit alpha -> 0+ \
                  (computed at alpha = 1e-3); on the slice eta = 1 the texels above the eta layer \
                  (t > 0.3) are the albedo at eta = 1"
+                    .to_string()
             }
             MuMapping::Balanced => {
                 let l = super::balanced_layout::BalancedLayout::KILN;
-                return format!(
+                format!(
                     "lookup coordinate t = ((u + eps)^{p} - eps^{p}) / ((1 + eps)^{p} - eps^{p}) \
                      with u = mu (1 + k) / (mu + k), k = {c} alpha (1 + {e} alpha), eps = ({z} / \
                      32) (32 / N)^{w} exp(-{y} alpha), N the axis size (t = 0 at mu = 0; t = 1 \
@@ -226,10 +228,9 @@ impl MuMapping {
                     z = l.offset,
                     w = l.offset_size_power,
                     y = l.offset_decay,
-                );
+                )
             }
-        };
-        text.to_string()
+        }
     }
 }
 
@@ -256,6 +257,16 @@ impl RoughnessSpacing {
         match self {
             RoughnessSpacing::Linear => "linear",
             RoughnessSpacing::Balanced => "balanced",
+        }
+    }
+
+    /// The spacing laid out with the `mu` axis `mapping`: balanced rows with the balanced axis,
+    /// linear otherwise (the command line's default).
+    #[must_use]
+    pub fn paired_with(mapping: MuMapping) -> Self {
+        match mapping {
+            MuMapping::Balanced => RoughnessSpacing::Balanced,
+            _ => RoughnessSpacing::Linear,
         }
     }
 

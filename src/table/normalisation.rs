@@ -148,11 +148,9 @@ pub fn derive(e: &Table, command: String) -> Table {
             };
             let roughness = spec.roughness_axis().roughness_at_coordinate(at);
             let (loss, error) = one_minus_lookup_average(e, roughness);
-            let scale = if per_x {
-                divisor(&spec, roughness)
-            } else {
-                1.0
-            };
+            // The node's coordinate is the E table's row coordinate there (shared spacing):
+            // what `divisor` gives at `roughness`.
+            let scale = if per_x { at } else { 1.0 };
             (loss / scale, error / scale)
         })
         .collect();
@@ -170,17 +168,18 @@ pub fn derive(e: &Table, command: String) -> Table {
 }
 
 /// What a normalisation table that stores `(1 - Ē) / x` divides by at `roughness` (in the
-/// table's convention): `x`, the E table's row coordinate at `roughness` (the roughness itself
-/// on linear rows). Below the E table's first row the lookup blends row 0 and row 1 with the
-/// weight `x / x_1`, so that `1 - Ē` grows like `x` there, whatever the rows' spacing.
+/// table's convention): `x`, the rows' coordinate at `roughness` (the roughness itself on
+/// linear rows), which it shares with its E table. Below the E table's first row the lookup
+/// blends row 0 and row 1 with the weight `x / x_1`, so that `1 - Ē` grows like `x` there,
+/// whatever the rows' spacing.
 #[must_use]
-pub fn divisor(norm: &TableSpec, roughness: f64) -> f64 {
-    match norm.lookup_of.as_deref().map(TableSpec::roughness_axis) {
-        Some(Axis::Roughness {
+fn divisor(norm: &TableSpec, roughness: f64) -> f64 {
+    match norm.roughness_axis() {
+        Axis::Roughness {
             spacing,
             convention,
             ..
-        }) => spacing.coordinate(roughness, convention),
+        } => spacing.coordinate(roughness, convention),
         _ => roughness,
     }
 }

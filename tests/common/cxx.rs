@@ -9,3 +9,33 @@ pub fn compiler() -> Option<&'static str> {
             .is_ok()
     })
 }
+
+/// Compiles `source` as C++17 with every literal in single precision (`name.cpp` in `dir`),
+/// runs it, and returns the numbers it prints, one per line. Panics, with the compiler's
+/// message, if it does not compile.
+#[allow(dead_code)] // not every test that includes this file runs a program
+pub fn compile_and_run(dir: &std::path::Path, name: &str, source: &str) -> Vec<f64> {
+    let file = dir.join(format!("{name}.cpp"));
+    std::fs::write(&file, source).unwrap();
+    let program = dir.join(name);
+    let compiler = compiler().expect("a C++ compiler (c++, g++ or clang++)");
+    let compiled = std::process::Command::new(compiler)
+        .args(["-std=c++17", "-O0", "-fsingle-precision-constant", "-o"])
+        .arg(&program)
+        .arg(&file)
+        .output()
+        .expect("the C++ compiler runs");
+    assert!(
+        compiled.status.success(),
+        "{} does not compile as C++:\n{}",
+        file.display(),
+        String::from_utf8_lossy(&compiled.stderr)
+    );
+    let output = std::process::Command::new(&program).output().unwrap();
+    assert!(output.status.success(), "{} failed", program.display());
+    String::from_utf8(output.stdout)
+        .unwrap()
+        .lines()
+        .map(|l| l.parse().unwrap())
+        .collect()
+}

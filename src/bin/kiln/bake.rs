@@ -287,10 +287,9 @@ pub fn run(args: BakeArgs) -> kiln::Result<()> {
         scrambles,
         seed: args.seed.unwrap_or(0),
         roughness_convention: args.roughness_axis,
-        roughness_spacing: args.roughness_spacing.unwrap_or(match args.mu_axis {
-            MuMapping::Balanced => RoughnessSpacing::Balanced,
-            _ => RoughnessSpacing::Linear,
-        }),
+        roughness_spacing: args
+            .roughness_spacing
+            .unwrap_or(RoughnessSpacing::paired_with(args.mu_axis)),
         mu_mapping: args.mu_axis,
         grid: args.grid,
         ior_size: args.ior_size.unwrap_or(BakeOptions::DEFAULT_IOR_SIZE),
@@ -491,12 +490,11 @@ fn bake_preset(preset: kiln::preset::Preset, args: &BakeArgs) -> kiln::Result<()
     let mut bakes = preset.bakes(args.max_error);
     // The engine's own tables (the first bake) get the texels asked for; glass tables, over
     // the IOR, stay point samples.
-    let texels = args.texels;
-    bakes[0].texels = texels;
-    if texels != kiln::table::Texels::Nodes && bakes.len() > 1 && !args.quiet {
+    bakes[0].texels = args.texels;
+    if args.texels != kiln::table::Texels::Nodes && bakes.len() > 1 && !args.quiet {
         eprintln!(
             "kiln: --texels {}: the {} glass tables (over the IOR) stay point samples",
-            texels.name(),
+            args.texels.name(),
             preset.name()
         );
     }
