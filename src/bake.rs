@@ -493,6 +493,7 @@ impl BakeOptions {
                                 digits => digits,
                             },
                             lookup_of: None,
+                            refined_start: None,
                             texels: if quantity.has_ior() {
                                 Texels::Nodes
                             } else {

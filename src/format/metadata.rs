@@ -121,7 +121,31 @@ impl Metadata {
     #[must_use]
     pub fn new(table: &Table, precision: &str) -> Self {
         let spec = &table.spec;
-        let axes: Vec<AxisMetadata> = spec.axes().iter().map(AxisMetadata::new).collect();
+        let mut axes: Vec<AxisMetadata> = spec.axes().iter().map(AxisMetadata::new).collect();
+        if let (Some(refined), [axis]) = (spec.refined_start, &mut axes[..]) {
+            // An f_ms_norm's nodes with a refined start (crate::table::normalisation).
+            let line = crate::table::normalisation::NodeLine::of(spec);
+            let roughness = spec.roughness_axis();
+            let nodes = format!(
+                "t_i the solution of min({} t, {} t + {}) = i (its first {} cells of the E \
+                 table's rows hold {} nodes each, the others {}: t_i = i / {} up to i = {}, then \
+                 (i - {}) / {})",
+                line.steep,
+                line.shallow,
+                line.offset,
+                refined.cells,
+                refined.subdivisions,
+                crate::table::normalisation::SUBDIVISIONS,
+                line.steep,
+                refined.cells * refined.subdivisions,
+                line.offset,
+                line.shallow
+            );
+            axis.formula = axis.formula.replacen(Grid::Nodes.formula(), &nodes, 1);
+            axis.values = (0..axis.size)
+                .map(|i| roughness.roughness_at_coordinate(line.coordinate(i as f64)))
+                .collect();
+        }
         let layout = match &axes[..] {
             [e, r, m] => format!(
                 "row-major, slowest axis first: value[({e}_index * {nr} + {r}_index) * {nm} + \

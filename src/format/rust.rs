@@ -255,7 +255,17 @@ fn write_lookup(out: &mut String, table: &Table, prefix: &str, ty: &str) {
         }
     );
     let _ = writeln!(out, "#[allow(clippy::all)]");
-    let t_r = position_code(spec.roughness_axis().grid(), t_r_name, n_r);
+    let t_r = match spec.refined_start {
+        // An f_ms_norm with a refined start: its node line (crate::table::normalisation).
+        Some(_) => {
+            let line = crate::table::normalisation::NodeLine::of(spec);
+            format!(
+                "({:?}_f32 * {t_r_name}).min({:?}_f32 * {t_r_name} + {:?}).clamp(0.0, {:?})",
+                line.steep, line.shallow, line.offset, line.last
+            )
+        }
+        None => position_code(spec.roughness_axis().grid(), t_r_name, n_r),
+    };
     match spec.mu {
         None => {
             let _ = writeln!(out, "pub fn {name}(table: &{ty}, roughness: f32) -> f32 {{");

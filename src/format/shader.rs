@@ -521,9 +521,19 @@ fn write_array_lookup(
     *out += &preamble(language, table);
     *out += &language.local("t", &coordinate(language, &axis));
     let last = literal((n - 1) as f64);
-    let position = match axis.grid() {
-        Grid::Nodes => format!("clamp(t * {last}, 0.0, {last})"),
-        Grid::Centers => format!("clamp(t * {} - 0.5, 0.0, {last})", literal(n as f64)),
+    let position = match (axis.grid(), table.spec.refined_start) {
+        // An f_ms_norm with a refined start: its node line (crate::table::normalisation).
+        (_, Some(_)) => {
+            let line = crate::table::normalisation::NodeLine::of(&table.spec);
+            format!(
+                "clamp(min({} * t, {} * t + {}), 0.0, {last})",
+                literal(line.steep),
+                literal(line.shallow),
+                literal(line.offset)
+            )
+        }
+        (Grid::Nodes, None) => format!("clamp(t * {last}, 0.0, {last})"),
+        (Grid::Centers, None) => format!("clamp(t * {} - 0.5, 0.0, {last})", literal(n as f64)),
     };
     *out += &language.local("p", &position);
     let int = match language {

@@ -111,10 +111,33 @@ impl TableSpec {
                         e.quantity.symbol()
                     ));
                 }
-                e.check().map_err(|m| format!("its E table: {m}"))
+                e.check().map_err(|m| format!("its E table: {m}"))?;
+                // kiln's layout of the normalisation of that E table, or the one of files
+                // older than the refined start (the same without it).
+                let kiln = super::normalisation::spec_for(e).refined_start;
+                if self.refined_start.is_some() && self.refined_start != kiln {
+                    return Err(format!(
+                        "f_ms_norm's refined_start {:?} is not kiln's for its E table ({kiln:?})",
+                        self.refined_start
+                    ));
+                }
+                let size = super::normalisation::size_of(e, self.refined_start);
+                let got = self.roughness.map_or(0, |axis| axis.size());
+                if got != size {
+                    return Err(format!(
+                        "f_ms_norm of a {}-row E table has {size} entries with this layout, not \
+                         {got}",
+                        e.roughness_axis().size()
+                    ));
+                }
+                Ok(())
             }
             (None, Quantity::FMsNorm) => Err("f_ms_norm needs lookup_of, its E table".into()),
             (Some(_), _) => Err(format!("{} is not derived from another table", q.symbol())),
+            (None, _) if self.refined_start.is_some() => Err(format!(
+                "{} has no refined start (f_ms_norm only)",
+                q.symbol()
+            )),
             (None, _) => Ok(()),
         }
     }
@@ -406,11 +429,61 @@ mod tests {
             ..e_spec()
         };
         refused(&norm, "f_ms_norm needs lookup_of");
-        let of = |source: TableSpec| TableSpec {
-            lookup_of: Some(Box::new(source)),
-            ..norm.clone()
+        // The normalisation of `source` as kiln lays it out.
+        let of = |source: TableSpec| {
+            let kiln = crate::table::normalisation::spec_for(&source);
+            TableSpec {
+                roughness: kiln.roughness,
+                refined_start: kiln.refined_start,
+                lookup_of: Some(Box::new(source)),
+                ..norm.clone()
+            }
         };
         assert_eq!(of(e_spec()).check(), Ok(()));
+        // Its size follows its E table and refined start; older files have none.
+        let resized = |size: usize, refined_start| {
+            let mut spec = of(e_spec());
+            if let Some(Axis::Roughness { size: s, .. }) = &mut spec.roughness {
+                *s = size;
+            }
+            TableSpec {
+                refined_start,
+                ..spec
+            }
+        };
+        let kiln = of(e_spec());
+        let rows = e_spec().roughness_axis().size();
+        assert_eq!(
+            resized(
+                (rows - 1) * crate::table::normalisation::SUBDIVISIONS + 1,
+                None
+            )
+            .check(),
+            Ok(())
+        );
+        refused(
+            &resized(kiln.roughness_axis().size() + 1, kiln.refined_start),
+            "entries with this layout, not",
+        );
+        refused(
+            &resized((rows - 1) * 16 + 1, kiln.refined_start),
+            "entries with this layout, not",
+        );
+        let foreign = crate::table::normalisation::RefinedStart {
+            cells: 1,
+            subdivisions: 0,
+        };
+        refused(
+            &resized(kiln.roughness_axis().size(), Some(foreign)),
+            "is not kiln's for its E table",
+        );
+        refused(
+            &TableSpec {
+                refined_start: kiln.refined_start,
+                ..e_spec()
+            },
+            "E has no refined start (f_ms_norm only)",
+        );
         refused(
             &of(TableSpec {
                 quantity: Quantity::EAvg,

@@ -143,6 +143,11 @@ pub struct TableSpec {
     /// Point samples (the default, absent from files) or texels fitted for the lookup.
     #[serde(default, skip_serializing_if = "Texels::is_nodes")]
     pub texels: Texels,
+    /// `f_ms_norm` storing `(1 - Ē) / x` only: its first cells with more nodes
+    /// ([`normalisation::REFINED_START`]); absent elsewhere, and in older files (every cell
+    /// then holds [`normalisation::SUBDIVISIONS`] nodes).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub refined_start: Option<normalisation::RefinedStart>,
 }
 
 impl TableSpec {
@@ -600,7 +605,7 @@ impl Table {
         let alpha = self.spec.roughness_convention().to_alpha(roughness);
         let eta_up = axis_index(eta);
         let corner =
-            move |axis: Axis, x: f64, stride: usize| Corner::new(axis, x, alpha, eta_up, stride);
+            move |axis: Axis, x: f64, stride: usize| self.corner(axis, x, alpha, eta_up, stride);
         // Per axis, slowest first: the two samples to blend, the second's weight, the stride
         // (the product of the faster axes' sizes). In place: a lookup allocates nothing (the
         // audits and `f_ms_norm` make millions).
@@ -624,6 +629,28 @@ impl Table {
                 count += 1;
             }
             blend(channel, &corners[..count], 0)
+        }
+    }
+
+    /// Where a lookup of `axis` at `x` falls ([`Corner::new`]), but on the roughness axis of an
+    /// `f_ms_norm` with a refined start, at its node line
+    /// ([`normalisation::NodeLine::position`]).
+    fn corner(&self, axis: Axis, x: f64, alpha: f64, eta_up: f64, stride: usize) -> Corner {
+        match (self.spec.refined_start, axis) {
+            (
+                Some(_),
+                Axis::Roughness {
+                    convention,
+                    spacing,
+                    size,
+                    ..
+                },
+            ) => Corner::at(
+                normalisation::NodeLine::of(&self.spec).position(spacing.coordinate(x, convention)),
+                size,
+                stride,
+            ),
+            _ => Corner::new(axis, x, alpha, eta_up, stride),
         }
     }
 
@@ -654,7 +681,7 @@ impl Table {
             (self.spec.mu, mu, 1),
         ] {
             let Some(axis) = axis else { continue };
-            let c = Corner::new(axis, x, alpha, eta_up, stride);
+            let c = self.corner(axis, x, alpha, eta_up, stride);
             let n = out.count;
             for k in 0..n {
                 let (index, weight) = out.terms[k];
@@ -686,11 +713,16 @@ impl Corner {
     /// Where a lookup of `axis` at the physical coordinate `x` (on the row of roughness
     /// `alpha`, at the IOR axis' index `eta_up`) falls, for an axis of index stride `stride`.
     fn new(axis: Axis, x: f64, alpha: f64, eta_up: f64, stride: usize) -> Self {
-        let p = axis.position(x, alpha, eta_up);
-        let i = (p.floor() as usize).min(axis.size().saturating_sub(2));
+        Corner::at(axis.position(x, alpha, eta_up), axis.size(), stride)
+    }
+
+    /// The corner at the continuous sample position `p` (in `[0, size - 1]`) of an axis of
+    /// `size` samples.
+    fn at(p: f64, size: usize, stride: usize) -> Self {
+        let i = (p.floor() as usize).min(size.saturating_sub(2));
         Corner {
             low: i,
-            high: (i + 1).min(axis.size() - 1),
+            high: (i + 1).min(size - 1),
             weight: p - i as f64,
             stride,
         }
@@ -792,6 +824,7 @@ pub(crate) fn test_e_spec(
         qmc: QmcSettings::default(),
         reference_digits: None,
         lookup_of: None,
+        refined_start: None,
         texels: Texels::Nodes,
         transmission: TransmissionConvention::SingleScattering,
     }

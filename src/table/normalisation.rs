@@ -31,6 +31,17 @@
 //!   0, 6 % for Enterprise PBR's half-float table), and below the first row centre, where the
 //!   clamped lookup is constant, `(1 - Ē) / x` would diverge.
 //!
+//! In the first form the first [`REFINED_START`]`.cells` cells of the E table's rows hold
+//! [`REFINED_START`]`.subdivisions` nodes each instead of [`SUBDIVISIONS`]: there `g` bends
+//! most (in the first cell `1 - Ē` is `x` times the average of row 1's texels read at
+//! columns that move with `alpha`, which changes 16-fold over the cell; in the next ones the
+//! division by `x` bends a lookup that starts from a non-zero loss), and with 16 nodes per cell
+//! the interpolation's relative error there was 1.1e-3 (kiln's default E table) and 2.2e-3 (the
+//! balanced layout with fitted texels); with 96 it is 3.8e-5 and 6.5e-5, the other cells' at
+//! most 2.8e-5 and 5.7e-5 (`kiln verify` on the f_ms_norm file). The node position of the
+//! roughness coordinate `t` is [`NodeLine::position`], one `min` of two lines: rows stay on
+//! nodes.
+//!
 //! The lookup is [`normalisation_lookup`]: the linear interpolation of `g`, times `x` in the
 //! first form.
 
@@ -39,8 +50,91 @@ use super::{Quantity, Table, TableSpec};
 use crate::numerics::gauss_kronrod::integrate_pieces;
 use rayon::prelude::*;
 
-/// Nodes of the normalisation table per cell of the E table's roughness axis.
+/// Nodes of the normalisation table per cell of the E table's roughness axis (beyond the
+/// refined start of the first form, [`REFINED_START`]).
 pub const SUBDIVISIONS: usize = 16;
+
+/// The first cells of the E table's roughness axis, from `x = 0`, holding more nodes of the
+/// normalisation table than [`SUBDIVISIONS`] (see the module docs). Recorded in the spec
+/// ([`TableSpec::refined_start`]); a file without it has [`SUBDIVISIONS`] nodes in every cell.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+pub struct RefinedStart {
+    /// How many cells, from the first row, are refined (at most the table's cells).
+    pub cells: usize,
+    /// Nodes per refined cell.
+    pub subdivisions: usize,
+}
+
+/// kiln's refined start: the first 4 cells with 96 nodes each (the measurements in the module
+/// docs; 3 cells left the balanced layout's fourth at 8.6e-5, 64 nodes its first at 1.4e-4).
+pub const REFINED_START: RefinedStart = RefinedStart {
+    cells: 4,
+    subdivisions: 96,
+};
+
+/// Where the roughness coordinate `t` in [0, 1] falls among a normalisation table's nodes:
+/// `p = min(steep t, shallow t + offset)`, clamped to `[0, last]`; node `i` holds `t` with
+/// `p(t) = i`. Without a refined start both lines are `(n - 1) t`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NodeLine {
+    /// Nodes per unit of `t` in the refined cells (`cells * subdivisions`).
+    pub steep: f64,
+    /// Nodes per unit of `t` beyond them (`cells * SUBDIVISIONS`).
+    pub shallow: f64,
+    /// `refined cells * (subdivisions - SUBDIVISIONS)`: where the second line starts.
+    pub offset: f64,
+    /// The last node's index, `n - 1`.
+    pub last: f64,
+}
+
+impl NodeLine {
+    /// The line of the normalisation table `norm` (a table of [`spec_for`]).
+    #[must_use]
+    pub fn of(norm: &TableSpec) -> NodeLine {
+        let last = (norm.len().max(2) - 1) as f64;
+        let cells = norm
+            .lookup_of
+            .as_deref()
+            .map_or(1, |e| e.roughness_axis().size().max(2) - 1) as f64;
+        match norm.refined_start {
+            Some(RefinedStart {
+                cells: refined,
+                subdivisions,
+            }) => NodeLine {
+                steep: cells * subdivisions as f64,
+                shallow: cells * SUBDIVISIONS as f64,
+                offset: (refined as f64) * (subdivisions as f64 - SUBDIVISIONS as f64),
+                last,
+            },
+            None => NodeLine {
+                steep: last,
+                shallow: last,
+                offset: 0.0,
+                last,
+            },
+        }
+    }
+
+    /// The continuous node position of the roughness coordinate `t` (clamped to the table).
+    #[must_use]
+    pub fn position(&self, t: f64) -> f64 {
+        (self.steep * t)
+            .min(self.shallow * t + self.offset)
+            .clamp(0.0, self.last)
+    }
+
+    /// The roughness coordinate of node `i` (the inverse of [`NodeLine::position`]).
+    #[must_use]
+    pub fn coordinate(&self, i: f64) -> f64 {
+        let refined_end =
+            self.offset * self.steep / (self.steep - self.shallow).max(f64::MIN_POSITIVE);
+        if self.offset == 0.0 || i <= refined_end {
+            i / self.steep
+        } else {
+            (i - self.offset) / self.shallow
+        }
+    }
+}
 
 /// `1 - Ē(roughness) = 2 ∫ (1 - E_lookup(mu, roughness)) mu dmu` of an E table's bilinear
 /// lookup ([`Table::lookup_one_minus`], taken along `mu` by [`Table::lookup_along_mu`]),
@@ -98,11 +192,12 @@ pub fn stores_per_roughness(norm: &TableSpec) -> bool {
 #[must_use]
 pub fn spec_for(e: &TableSpec) -> TableSpec {
     let rows = e.roughness_axis();
-    let size = match rows.grid() {
-        Grid::Nodes => (rows.size() - 1) * SUBDIVISIONS + 1,
-        // Row j at (j + 0.5) / N is node (j + 1/2) * SUBDIVISIONS of N * SUBDIVISIONS.
-        Grid::Centers => rows.size() * SUBDIVISIONS + 1,
-    };
+    let cells = rows.size().max(2) - 1;
+    let refined_start = divides_by_roughness(e).then_some(RefinedStart {
+        cells: REFINED_START.cells.min(cells),
+        ..REFINED_START
+    });
+    let size = size_of(e, refined_start);
     TableSpec {
         quantity: Quantity::FMsNorm,
         ior: None,
@@ -119,9 +214,28 @@ pub fn spec_for(e: &TableSpec) -> TableSpec {
             },
         }),
         lookup_of: Some(Box::new(e.clone())),
+        refined_start,
         // Derived exactly from the lookup (of fitted texels or not), not fitted itself.
         texels: crate::table::Texels::Nodes,
         ..e.clone()
+    }
+}
+
+/// The entries of the normalisation table of the E table `e` with the refined start
+/// `refined_start` (or without one, as in files older than it).
+#[must_use]
+pub fn size_of(e: &TableSpec, refined_start: Option<RefinedStart>) -> usize {
+    let rows = e.roughness_axis();
+    let cells = rows.size().max(2) - 1;
+    match (rows.grid(), refined_start) {
+        (Grid::Nodes, Some(refined)) => {
+            refined.cells * refined.subdivisions
+                + cells.saturating_sub(refined.cells) * SUBDIVISIONS
+                + 1
+        }
+        (Grid::Nodes, None) => cells * SUBDIVISIONS + 1,
+        // Row j at (j + 0.5) / N is node (j + 1/2) * SUBDIVISIONS of N * SUBDIVISIONS.
+        (Grid::Centers, _) => rows.size() * SUBDIVISIONS + 1,
     }
 }
 
@@ -131,18 +245,18 @@ pub fn spec_for(e: &TableSpec) -> TableSpec {
 pub fn derive(e: &Table, command: String) -> Table {
     let spec = spec_for(&e.spec);
     let n = spec.len();
-    let grid = Grid::Nodes;
+    let line = NodeLine::of(&spec);
     let per_x = divides_by_roughness(&e.spec);
     // Entries are independent: in parallel, the same bytes on any thread count.
     let entries: Vec<(f64, f64)> = (0..n)
         .into_par_iter()
         .map(|i| {
-            let x = grid.coordinate(i, n);
+            let x = line.coordinate(i as f64);
             // In the first form g(0) is the limit of (1 - Ē(x)) / x, the slope of 1 - Ē at 0:
-            // taken at a point 1e-4 of the first cell in (where the next term of 1 - Ē, of
+            // taken at a point 1e-4 of the first interval in (where the next term of 1 - Ē, of
             // order x^2, is 1e-4 times smaller).
             let at = if per_x && i == 0 {
-                1e-4 * grid.coordinate(1, n)
+                1e-4 * line.coordinate(1.0)
             } else {
                 x
             };
@@ -255,15 +369,30 @@ mod tests {
     }
 
     /// The normalisation table's axis: every cell of the E table's rows subdivided 16 times,
-    /// on nodes, in the E table's convention (`5` rows on nodes: 65 entries; on centres, whose
-    /// rows sit half a cell in: 81).
+    /// the first four 96 times where it stores `(1 - Ē) / x`, on nodes, in the E table's
+    /// convention (`5` rows on nodes: 385 entries; 32 rows: 817; on centres, whose rows sit
+    /// half a cell in: 81).
     #[test]
     fn the_normalisation_subdivides_every_cell_of_the_rows() {
         let loss = |_: f64, _: f64| 0.5;
         let nodes = spec_for(&e_table(Grid::Nodes, MuMapping::Adaptive, loss).spec);
         let centers = spec_for(&e_table(Grid::Centers, MuMapping::Adaptive, loss).spec);
-        assert_eq!(nodes.shape(), [65]);
+        assert_eq!(nodes.shape(), [385]);
         assert_eq!(centers.shape(), [81]);
+        assert_eq!(centers.refined_start, None);
+        let mut rows_32 = e_table(Grid::Nodes, MuMapping::Adaptive, loss).spec;
+        if let Some(Axis::Roughness { size, .. }) = &mut rows_32.roughness {
+            *size = 32;
+        }
+        let line = NodeLine::of(&spec_for(&rows_32));
+        assert_eq!(spec_for(&rows_32).shape(), [817]);
+        // Rows j / 31 on nodes: 96 j up to row 4, then 384 + 16 (j - 4); and back.
+        for (row, node) in [(0, 0.0), (1, 96.0), (4, 384.0), (5, 400.0), (31, 816.0)] {
+            let t = f64::from(row) / 31.0;
+            assert!((line.position(t) - node).abs() < 1e-12, "row {row}");
+            assert!((line.coordinate(node) - t).abs() < 1e-15, "row {row}");
+        }
+        assert_eq!((line.position(-0.5), line.position(2.0)), (0.0, 816.0));
         assert_eq!(nodes.roughness_axis().grid(), Grid::Nodes);
         assert_eq!(centers.roughness_axis().grid(), Grid::Nodes);
         assert_eq!(nodes.quantity, Quantity::FMsNorm);
@@ -291,8 +420,9 @@ mod tests {
         ));
         let norm = derive(&adaptive, String::new());
         assert!(stores_per_roughness(&norm.spec));
-        for i in [1, 2, 16, 33, 64] {
-            let x = Grid::Nodes.coordinate(i, 65);
+        let line = NodeLine::of(&norm.spec);
+        for i in [1, 2, 16, 33, 64, 97, 384] {
+            let x = line.coordinate(i as f64);
             assert!(
                 (norm.value[i] * x - 0.3).abs() < 1e-13,
                 "{i}: {}",
@@ -306,8 +436,8 @@ mod tests {
         // which the quadrature does not integrate exactly).
         let varying = e_table(Grid::Nodes, MuMapping::Adaptive, |r, t| 0.2 + 0.1 * r * t);
         let varying_norm = derive(&varying, String::new());
-        for i in [1, 7, 64] {
-            let x = Grid::Nodes.coordinate(i, 65);
+        for i in [1, 7, 64, 384] {
+            let x = line.coordinate(i as f64);
             let (_, error) = one_minus_lookup_average(&varying, x);
             assert!(error > 0.0, "{i}");
             assert!(
@@ -315,7 +445,7 @@ mod tests {
                 "{i}"
             );
         }
-        // The first entry is the slope at 1e-4 of the first cell: 0.3 / (1e-4 / 64).
-        assert!((norm.value[0] / (0.3 * 64e4) - 1.0).abs() < 1e-12);
+        // The first entry is the slope at 1e-4 of the first interval: 0.3 / (1e-4 / 384).
+        assert!((norm.value[0] / (0.3 * 384e4) - 1.0).abs() < 1e-12);
     }
 }

@@ -16,7 +16,7 @@
 //! reaches 0.11 in the grazing layer, so a lookup error far below the table's `E` error becomes
 //! a visible energy error there (0.128 for the default tables with the exact `E_avg`). Normalised
 //! by kiln's `f_ms_norm` instead ([`crate::table::normalisation`]), the average of the lookup
-//! itself, the lobe closes the furnace to 1.2e-4. [`turquin`] checks the other compensation
+//! itself, the lobe closes the furnace to 4.1e-6. [`turquin`] checks the other compensation
 //! form, single scattering scaled by `1 / E`.
 
 use crate::table::axis::Axis;
@@ -126,15 +126,26 @@ fn turquin_deviation(
 /// The roughness ladder of the furnace test of an E table with `rows` rows: steps of
 /// `1 / (density (rows - 1))` (at least four per texel) over [0, 1], 400 more steps below 0.1,
 /// where the loss of a mirror-like surface hides in the grazing layer, and the midpoints
-/// between the nodes of the `f_ms_norm` table of a nodes-grid E table.
+/// between the nodes of the `f_ms_norm` table of a nodes-grid E table (with the refined start
+/// of [`crate::table::normalisation::REFINED_START`] and without it).
 #[must_use]
 pub fn roughness_ladder(rows: usize, density: usize) -> Vec<f64> {
     let steps = density.max(4) * (rows.max(2) - 1);
     let mut ladder: Vec<f64> = (0..=steps).map(|j| j as f64 / steps as f64).collect();
     ladder.extend((1..400).map(|j| 0.1 * j as f64 / 400.0));
-    // Halfway between the nodes of the f_ms_norm table, where its interpolation errs most.
-    let fine = crate::table::normalisation::SUBDIVISIONS * (rows.max(2) - 1);
-    ladder.extend((0..fine).map(|j| (j as f64 + 0.5) / fine as f64));
+    // Halfway between the nodes of the f_ms_norm table, where its interpolation errs most
+    // (with kiln's refined start, and without it as older files have it).
+    use crate::table::normalisation::{REFINED_START, SUBDIVISIONS};
+    let cells = rows.max(2) - 1;
+    for per_cell in [SUBDIVISIONS, REFINED_START.subdivisions] {
+        let fine = per_cell * cells;
+        let refined = if per_cell == SUBDIVISIONS {
+            fine
+        } else {
+            REFINED_START.cells.min(cells) * per_cell
+        };
+        ladder.extend((0..refined).map(|j| (j as f64 + 0.5) / fine as f64));
+    }
     ladder.sort_by(f64::total_cmp);
     ladder.dedup();
     ladder
@@ -263,9 +274,9 @@ pub fn audit_normalisation(e: &Table, norm: &Table) -> Result<NormalisationAudit
     }
     let n = norm.spec.len();
     let axis = norm.spec.roughness_axis();
-    let grid = axis.grid();
+    let line = crate::table::normalisation::NodeLine::of(&norm.spec);
     // Nodes and the points halfway between them, in texture coordinates, as roughness values.
-    let at = |t: f64| axis.roughness_at_coordinate(t);
+    let at = |i: f64| axis.roughness_at_coordinate(line.coordinate(i));
     let relative = |x: f64| -> f64 {
         let (truth, _) = one_minus_lookup_average(e, x);
         let table = normalisation_lookup(norm, x);
@@ -275,10 +286,8 @@ pub fn audit_normalisation(e: &Table, norm: &Table) -> Result<NormalisationAudit
             (table / truth - 1.0).abs()
         }
     };
-    let nodes: Vec<f64> = (1..n).map(|i| at(grid.coordinate(i, n))).collect();
-    let between: Vec<f64> = (0..n - 1)
-        .map(|i| at((grid.coordinate(i, n) + grid.coordinate(i + 1, n)) / 2.0))
-        .collect();
+    let nodes: Vec<f64> = (1..n).map(|i| at(i as f64)).collect();
+    let between: Vec<f64> = (0..n - 1).map(|i| at(i as f64 + 0.5)).collect();
     let node_max_relative_error = crate::stats::max_or_nan(nodes.iter().map(|&x| relative(x)));
     let (worst_roughness, lookup_max_relative_error) = between
         .iter()
@@ -584,12 +593,12 @@ mod tests {
         assert!(close(report.max_deviation, 0.1));
         assert_eq!(report.worst.roughness, 1.0);
         // Six bands, each with its largest roughness: below 1/2 that is the midpoint of the
-        // normalisation's last cell there, 31.5 / 64.
+        // normalisation's last node interval there, 191.5 / 384 (all four cells refined).
         assert_eq!(report.bands.len(), 6);
         let band = report.bands[4];
         assert_eq!((band.from, band.to), (0.25, 0.5));
-        assert_eq!(band.worst_roughness, 31.5 / 64.0);
-        assert!(close(band.max_deviation, 0.1 * 31.5 / 64.0));
+        assert_eq!(band.worst_roughness, 191.5 / 384.0);
+        assert!(close(band.max_deviation, 0.1 * 191.5 / 384.0));
         let last = report.bands[5];
         assert_eq!((last.from, last.to, last.worst_roughness), (0.5, 1.0, 1.0));
         assert!(close(last.max_deviation, 0.1));
@@ -635,8 +644,13 @@ mod tests {
         assert!((0..=16).all(|j| has(&ladder, j as f64 / 16.0)));
         assert!((1..400).all(|j| has(&ladder, 0.1 * j as f64 / 400.0)));
         assert!((0..64).all(|j| has(&ladder, (j as f64 + 0.5) / 64.0)));
-        // 17 + 399 + 64, less 1/16, which the grazing decade holds too.
-        assert_eq!(ladder.len(), 479);
+        // The midpoints of the refined start (all four cells here).
+        assert!((0..384).all(|j| has(&ladder, (j as f64 + 0.5) / 384.0)));
+        // 17 + 399 + 64 + 384, less 1/16, which the grazing decade holds too.
+        assert_eq!(ladder.len(), 863);
+        // On 32 rows, only the first four cells are refined.
+        let long = roughness_ladder(33, 4);
+        assert!(has(&long, 383.5 / 3072.0) && !has(&long, 384.5 / 3072.0));
         assert!(!has(&ladder, 17.0 / 32.0));
         assert!(has(&roughness_ladder(5, 8), 17.0 / 32.0));
         // One row is taken as two.

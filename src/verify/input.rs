@@ -524,6 +524,7 @@ fn spec_and_values(
     let spec = |roughness, mu| TableSpec {
         reference_digits: None,
         lookup_of: None,
+        refined_start: None,
         texels: crate::table::Texels::Nodes,
         transmission: crate::model::dielectric::TransmissionConvention::SingleScattering,
         model: layout.model,
