@@ -643,4 +643,37 @@ fn glass_furnace_checks_turquins_form() {
     let output = kiln(&["verify", "--furnace", table, "--form", "kulla-conty"]);
     assert_eq!(output.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&output.stderr).contains("glass"));
+    // Its picture: over sqrt(mu) and the IOR, the command's worst point stated with its eta.
+    let svg = dir.path().join("glass.svg");
+    let output = kiln(&[
+        "verify",
+        "--furnace",
+        table,
+        "--density",
+        "1",
+        "--plot",
+        svg.to_str().unwrap(),
+    ]);
+    assert_eq!(
+        output.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let text = std::fs::read_to_string(&svg).unwrap();
+    let stated = format!(
+        "max |deviation| {:.2e} at mu {}, eta {:.5}",
+        turquin,
+        {
+            let mu = number(&forms[0], "worst_mu");
+            if mu >= 1e-3 {
+                format!("{mu:.4}")
+            } else {
+                format!("{mu:.2e}")
+            }
+        },
+        eta
+    );
+    assert!(text.contains(&stated), "the picture lacks '{stated}'");
+    assert!(text.contains("sqrt(mu)") && text.contains("eta or 1 / eta"));
 }

@@ -361,6 +361,9 @@ pub struct FormReport {
     /// For a glass table, the worst deviation per IOR band ([`ETA_BAND_EDGES`]).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub eta_bands: Vec<EtaBand>,
+    /// For a glass table, its points binned for a picture ([`glass_map`]); not in reports.
+    #[serde(skip)]
+    pub map: Option<FurnaceMap>,
 }
 
 impl FormReport {
@@ -373,6 +376,7 @@ impl FormReport {
             worst_mu: report.worst.worst_mu,
             worst_roughness: report.worst.roughness,
             worst_eta: None,
+            map: None,
             deviation: report.worst.deviation,
             eta_bands: Vec::new(),
         }
@@ -454,6 +458,10 @@ pub fn turquin(
                 })
         })
         .collect();
+    let map = match e.spec.ior {
+        Some(Axis::Ior { max, .. }) => Some(glass_map(&deviations, max.0, GLASS_MAP_CELLS)),
+        _ => None,
+    };
     let (worst_mu, worst_roughness, worst_eta, deviation) = deviations
         .into_iter()
         .max_by(|a, b| a.3.abs().total_cmp(&b.3.abs()))
@@ -466,7 +474,55 @@ pub fn turquin(
         worst_eta,
         deviation,
         eta_bands,
+        map,
     })
+}
+
+/// Rows (IOR) and columns (`mu`) of a glass table's furnace picture ([`glass_map`]): as many
+/// as the 16 x 16 x 16 tables' audit points fill in every layout (48 rows left rows of the
+/// glass layout's empty near `eta = 3`, whose IOR samples are sparser there).
+pub const GLASS_MAP_CELLS: (usize, usize) = (24, 40);
+
+/// Where a glass furnace point `(mu, eta)` falls on its picture ([`MapRows::Ior`]): across
+/// `sqrt(mu)`, up `sqrt((eta - 1) / (eta_max - 1))`, `eta` as the IOR axis lists it (`1 / eta`
+/// from inside). Physical coordinates, the same for every layout, so that two layouts' pictures
+/// compare cell by cell; the square roots open the grazing layer and the band next to `eta = 1`.
+#[must_use]
+pub fn glass_map_position(mu: f64, eta: f64, eta_max: f64) -> (f64, f64) {
+    let index = if eta < 1.0 { 1.0 / eta } else { eta };
+    (
+        mu.clamp(0.0, 1.0).sqrt(),
+        ((index - 1.0) / (eta_max - 1.0)).clamp(0.0, 1.0).sqrt(),
+    )
+}
+
+/// A glass table's furnace deviations `(mu, r, eta, deviation)` (the points of [`turquin`])
+/// binned on a picture of `(rows, columns)` cells ([`glass_map_position`]): each cell the
+/// deviation of largest magnitude among the points in it, over every roughness (NaN where none
+/// falls).
+#[must_use]
+pub fn glass_map(
+    deviations: &[(f64, f64, Option<f64>, f64)],
+    eta_max: f64,
+    (rows, columns): (usize, usize),
+) -> FurnaceMap {
+    let (rows, columns) = (rows.max(2), columns.max(2));
+    let mut deviation = vec![vec![f64::NAN; columns]; rows];
+    let bin = |x: f64, n: usize| ((x * n as f64) as usize).min(n - 1);
+    for &(mu, _, eta, d) in deviations {
+        let (x, y) = glass_map_position(mu, eta.unwrap_or(1.0), eta_max);
+        let cell = &mut deviation[bin(y, rows)][bin(x, columns)];
+        if cell.is_nan() || d.abs() > cell.abs() {
+            *cell = d;
+        }
+    }
+    FurnaceMap {
+        form: Form::Turquin,
+        rows,
+        columns,
+        rows_are: MapRows::Ior { eta_max },
+        deviation,
+    }
 }
 
 /// The deviation of each compensation form over a grid, for a picture: rows of roughness
@@ -480,7 +536,20 @@ pub struct FurnaceMap {
     pub form: Form,
     pub rows: usize,
     pub columns: usize,
+    /// What the rows and columns are.
+    pub rows_are: MapRows,
     pub deviation: Vec<Vec<f64>>,
+}
+
+/// The coordinates of a [`FurnaceMap`].
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub enum MapRows {
+    /// Rows of roughness `r_j = j / (rows - 1)`, columns of the E table's mu coordinate
+    /// `t_k = k / (columns - 1)`, each cell the deviation there.
+    Roughness,
+    /// A glass table's cells ([`glass_map`]): rows `sqrt((eta - 1) / (eta_max - 1))`, columns
+    /// `sqrt(mu)`, each `1 / cells` wide, the cell's worst deviation over every roughness.
+    Ior { eta_max: f64 },
 }
 
 /// [`FurnaceMap`]s of the forms asked for (Kulla-Conty needs `normalisation`).
@@ -539,6 +608,7 @@ pub fn furnace_maps(
             form,
             rows,
             columns,
+            rows_are: MapRows::Roughness,
             deviation,
         });
     }
@@ -632,6 +702,38 @@ mod tests {
         assert_eq!(lobe_deviation(0.0, f64::INFINITY), 0.0);
         assert!((lobe_deviation(0.1, 1.5) - 0.05).abs() < 1e-15);
         assert!((lobe_deviation(0.2, 0.5) + 0.1).abs() < 1e-15);
+    }
+
+    /// A glass furnace picture: each cell keeps its points' deviation of largest magnitude
+    /// (over roughness), with its sign; `1 / eta` from inside lands where `eta` does; cells no
+    /// point falls in are NaN (drawn grey), not 0.
+    #[test]
+    fn the_glass_map_keeps_each_cells_worst_deviation() {
+        assert_eq!(glass_map_position(0.25, 1.5, 3.0), (0.5, 0.5));
+        let inside = glass_map_position(0.25, 1.0 / 1.5, 3.0);
+        assert!((inside.0 - 0.5).abs() < 1e-15 && (inside.1 - 0.5).abs() < 1e-15);
+        assert_eq!(glass_map_position(-1.0, 9.0, 3.0), (0.0, 1.0));
+        let points = [
+            (0.25, 0.1, Some(1.5), 1e-3),
+            (0.26, 0.9, Some(1.5), -4e-3),
+            (0.27, 0.5, Some(1.5), 2e-3),
+            (0.0, 0.5, Some(1.0), 2e-2),
+            (1.0, 0.5, Some(3.0), 5e-4),
+        ];
+        let map = glass_map(&points, 3.0, (4, 5));
+        assert_eq!((map.rows, map.columns), (4, 5));
+        assert_eq!(map.rows_are, MapRows::Ior { eta_max: 3.0 });
+        // sqrt(0.25..0.27) = 0.5..0.52: column 2 of 5; sqrt(1/4) = 0.5: row 2 of 4.
+        assert_eq!(map.deviation[2][2], -4e-3);
+        assert_eq!(map.deviation[0][0], 2e-2);
+        assert_eq!(map.deviation[3][4], 5e-4);
+        let filled = map
+            .deviation
+            .iter()
+            .flatten()
+            .filter(|d| !d.is_nan())
+            .count();
+        assert_eq!(filled, 3);
     }
 
     #[test]

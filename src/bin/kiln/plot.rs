@@ -3,6 +3,7 @@
 
 use kiln::study::estimators::Estimator;
 use kiln::study::{LookupRun, StudyReport};
+use kiln::verify::furnace::MapRows;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::sync::Once;
@@ -302,13 +303,16 @@ pub fn furnace_plot(
 }
 
 /// Where the furnace command measured its worst deviation, to ring on the map: the point in the
-/// map's coordinates (`t`, the E table's mu coordinate, across; roughness up), `mu` itself, and
-/// the deviation there.
+/// map's coordinates (`x` across, `y` up: the E table's mu coordinate and roughness, or a glass
+/// map's, [`kiln::verify::furnace::MapRows`]), `mu`, roughness and `eta` themselves, and the
+/// deviation there.
 #[derive(Clone, Copy, Debug)]
 pub struct FurnaceMark {
-    pub t: f64,
+    pub x: f64,
+    pub y: f64,
     pub mu: f64,
     pub roughness: f64,
+    pub eta: Option<f64>,
     pub deviation: f64,
 }
 
@@ -416,22 +420,28 @@ where
     let panels = maps_area.split_evenly((1, maps.len().max(1)));
     for (k, (panel, map)) in panels.iter().zip(maps).enumerate() {
         let (rows, columns) = (map.rows.max(2), map.columns.max(2));
-        let (dy, dx) = (1.0 / (rows - 1) as f64, 1.0 / (columns - 1) as f64);
+        // Cell centres: the grid's points on a roughness map, the cells' middles on a glass
+        // one (whose cells are 1 / n wide).
+        let (dy, dx, offset) = match map.rows_are {
+            MapRows::Roughness => (1.0 / (rows - 1) as f64, 1.0 / (columns - 1) as f64, 0.0),
+            MapRows::Ior { .. } => (1.0 / rows as f64, 1.0 / columns as f64, 0.5),
+        };
         let sampled = map
             .deviation
             .iter()
             .enumerate()
             .flat_map(|(j, row)| row.iter().enumerate().map(move |(k, d)| (j, k, *d)))
+            .filter(|s| !s.2.is_nan())
             .max_by(|a, b| a.2.abs().total_cmp(&b.2.abs()))
             .unwrap_or((0, 0, 0.0));
         // The ring and the caption give the command's own worst point where it is known (it
         // measures on its own, finer ladder; the map samples a 64 x 64 grid).
         let (x, y, caption) = match marks.get(k).copied().flatten() {
             Some(m) => (
-                m.t,
-                m.roughness,
+                m.x,
+                m.y,
                 format!(
-                    "{}: max |deviation| {:.2e} at mu {}, r {:.4} (ringed)",
+                    "{}: max |deviation| {:.2e} at mu {}{}, r {:.4} (ringed)",
                     map.form.name(),
                     m.deviation.abs(),
                     if m.mu >= 1e-3 {
@@ -439,12 +449,15 @@ where
                     } else {
                         format!("{:.2e}", m.mu)
                     },
+                    m.eta
+                        .map(|eta| format!(", eta {eta:.5}"))
+                        .unwrap_or_default(),
                     m.roughness
                 ),
             ),
             None => (
-                sampled.1 as f64 * dx,
-                sampled.0 as f64 * dy,
+                (sampled.1 as f64 + offset) * dx,
+                (sampled.0 as f64 + offset) * dy,
                 format!(
                     "{}: max |deviation| {:.1e} (ringed)",
                     map.form.name(),
@@ -458,18 +471,33 @@ where
             .x_label_area_size(40)
             .y_label_area_size(50)
             .build_cartesian_2d(0.0..1.0, 0.0..1.0)?;
+        let (x_desc, y_desc) = match map.rows_are {
+            MapRows::Roughness => (
+                "t, the mu axis' coordinate (0 = grazing)".to_string(),
+                "roughness r".to_string(),
+            ),
+            MapRows::Ior { eta_max } => (
+                "sqrt(mu) (0 = grazing; grey: no audit point)".to_string(),
+                format!("sqrt((eta - 1) / {}), eta or 1 / eta", eta_max - 1.0),
+            ),
+        };
         chart
             .configure_mesh()
             .disable_mesh()
-            .x_desc("t, the mu axis' coordinate (0 = grazing)")
-            .y_desc("roughness r")
+            .x_desc(x_desc)
+            .y_desc(y_desc)
             .draw()?;
         chart.draw_series(map.deviation.iter().enumerate().flat_map(|(j, row)| {
             row.iter().enumerate().map(move |(k, &d)| {
-                let (x, y) = (k as f64 * dx, j as f64 * dy);
+                let (x, y) = ((k as f64 + offset) * dx, (j as f64 + offset) * dy);
+                let colour = if d.is_nan() {
+                    RGBColor(215, 215, 215)
+                } else {
+                    deviation_colour(d)
+                };
                 Rectangle::new(
                     [(x - dx / 2.0, y - dy / 2.0), (x + dx / 2.0, y + dy / 2.0)],
-                    deviation_colour(d).filled(),
+                    colour.filled(),
                 )
             })
         }))?;

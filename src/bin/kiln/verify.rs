@@ -8,7 +8,7 @@ use kiln::integrate::reference::ReferenceSettings;
 use kiln::verify::furnace::furnace;
 use kiln::verify::input::{AxisName, Encoding, Layout, read_external, read_kiln};
 use kiln::verify::{Against, AuditSettings, Point, Progress, audit};
-use kiln::{Grid, Masking, Model, MuMapping, Ndf, Quantity, RoughnessConvention, Table};
+use kiln::{Axis, Grid, Masking, Model, MuMapping, Ndf, Quantity, RoughnessConvention, Table};
 use std::path::{Path, PathBuf};
 
 mod fit;
@@ -438,13 +438,6 @@ fn run_furnace(args: &VerifyArgs, table: &Table) -> kiln::Result<bool> {
         }
     });
     let plot_kind = plot_kind(args)?;
-    if plot_kind.is_some() && table.spec.ior.is_some() {
-        return Err(kiln::Error::InvalidInput(format!(
-            "--plot draws the furnace over roughness and mu; {} has an IOR axis too, so its \
-             furnace is reported per IOR band (drop --plot)",
-            table.spec.id()
-        )));
-    }
     let normalisation = match forms.contains(&Form::KullaConty) {
         true => {
             let average_path = match &args.average {
@@ -488,7 +481,34 @@ fn run_furnace(args: &VerifyArgs, table: &Table) -> kiln::Result<bool> {
         .map(|(_, report)| FormReport::of_kulla_conty(report))
         .chain(turquin_report)
         .collect();
-    if let (Some(path), Some(svg)) = (&args.plot, plot_kind) {
+    if let (Some(path), Some(svg), Some(Axis::Ior { max, .. })) =
+        (&args.plot, plot_kind, table.spec.ior)
+    {
+        // A glass table: the furnace's own points, binned over mu and eta (worst over
+        // roughness), with its worst point ringed.
+        let report = form_reports.iter().find(|f| f.form == Form::Turquin);
+        let maps: Vec<_> = report.and_then(|r| r.map.clone()).into_iter().collect();
+        let marks = vec![report.map(|r| {
+            let (x, y) = kiln::verify::furnace::glass_map_position(
+                r.worst_mu,
+                r.worst_eta.unwrap_or(1.0),
+                max.0,
+            );
+            crate::plot::FurnaceMark {
+                x,
+                y,
+                mu: r.worst_mu,
+                roughness: r.worst_roughness,
+                eta: r.worst_eta,
+                deviation: r.deviation,
+            }
+        })];
+        let title = format!(
+            "{}: Turquin furnace deviation, worst over roughness (blue: lost, red: added)",
+            table.spec.id()
+        );
+        write_plot(path, svg, crate::plot::furnace_plot(&title, &maps, &marks))?;
+    } else if let (Some(path), Some(svg)) = (&args.plot, plot_kind) {
         let maps = kiln::verify::furnace::furnace_maps(
             table,
             normalisation.as_ref().map(|(_, t)| t),
@@ -507,9 +527,11 @@ fn run_furnace(args: &VerifyArgs, table: &Table) -> kiln::Result<bool> {
                 };
                 let alpha = convention.to_alpha(report.worst_roughness);
                 Some(crate::plot::FurnaceMark {
-                    t: mapping.coordinate(report.worst_mu, alpha, size),
+                    x: mapping.coordinate(report.worst_mu, alpha, size),
+                    y: report.worst_roughness,
                     mu: report.worst_mu,
                     roughness: report.worst_roughness,
+                    eta: None,
                     deviation: report.deviation,
                 })
             })
