@@ -123,9 +123,10 @@ impl FitText for RationalFit {
     fn function_name(&self) -> String {
         let (p, q) = (self.shape.numerator, self.shape.denominator);
         format!(
-            "{}_e_fit_p{}_{}_q{}_{}",
+            "{}_e_fit_p{}{}{}_q{}_{}",
             model_stem(self.model),
             p.t,
+            if self.shape.additive { "_plus_" } else { "_" },
             p.r,
             q.t,
             q.r
@@ -135,12 +136,17 @@ impl FitText for RationalFit {
     fn description(&self, max_error: f64, command: &str) -> String {
         let (p, q) = (self.shape.numerator, self.shape.denominator);
         format!(
-            "E of {} (F = 1) as the rational 1 - t^2 P(u, s) / Q(u, s), P of degree {} in \
+            "E of {} (F = 1) as the rational 1 - t^2 P(u, s) / Q(u, s), P {}of degree {} in \
              u = 2 t - 1 and {} in s = 2 r^{R_POWER} - 1, Q of degrees {} and {} with constant \
              term 1 ({} coefficients), t = (mu (1 + alpha) / (mu + alpha))^{T_POWER}, \
              alpha = r^2; max error {max_error:.2e} over mu in [0, 1], r in \
              [0, 1] against kiln's reference (kiln verify --fit); made by `{command}`",
             self.model,
+            if self.shape.additive {
+                "= A(u) + B(s) (no cross terms) "
+            } else {
+                ""
+            },
             p.t,
             p.r,
             q.t,
@@ -189,8 +195,13 @@ impl FitText for RationalFit {
         defines.push(format!("n = {}", nested("n", numerator.len())));
         defines.push(format!("d = {}", nested("d", denominator.len())));
         let source = format!(
-            "kiln fit: {} coefficients, P of degrees {} in u and {} in s, Q of degrees {} and {}",
+            "kiln fit: {} coefficients, P {}of degrees {} in u and {} in s, Q of degrees {} and {}",
             self.shape.coefficients(),
+            if self.shape.additive {
+                "= A(u) + B(s) "
+            } else {
+                ""
+            },
             p.t,
             p.r,
             q.t,
@@ -316,6 +327,12 @@ const C: Syntax = Syntax {
 
 /// `c_0 + v (c_1 + v (...))` of one row of coefficients.
 fn horner(coefficients: &[f64], variable: &str, number: fn(f64) -> String) -> String {
+    // Trailing zeros (an additive numerator's cross terms, exactly 0) are left out.
+    let kept = coefficients
+        .iter()
+        .rposition(|&c| c != 0.0)
+        .map_or(1, |last| last + 1);
+    let coefficients = &coefficients[..kept.min(coefficients.len())];
     let mut out = String::new();
     for (k, &c) in coefficients.iter().enumerate() {
         if k > 0 {
@@ -399,7 +416,8 @@ impl MadeFit {
             MadeFit::Polynomial(fit) => format!("{},{}", fit.degrees.t, fit.degrees.r),
             MadeFit::Rational(fit) => {
                 let (p, q) = (fit.shape.numerator, fit.shape.denominator);
-                format!("{},{}/{},{}", p.t, p.r, q.t, q.r)
+                let join = if fit.shape.additive { '+' } else { ',' };
+                format!("{}{join}{}/{},{}", p.t, p.r, q.t, q.r)
             }
         }
     }

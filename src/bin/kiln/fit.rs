@@ -23,8 +23,9 @@ pub struct FitArgs {
     /// The fit's shape. T,R: a polynomial of degree T in t and R in r, (T + 1) (R + 1)
     /// coefficients. PT,PR/QT,QR: the rational 1 - t^2 P / Q, P of degrees PT, PR and Q of
     /// degrees QT, QR (in t and r^3.2), (PT + 1) (PR + 1) + (QT + 1) (QR + 1) - 1
-    /// coefficients; 3,3/3,3 is 31 coefficients within 1e-3. Each degree 1 to 12 (R, PR, QR
-    /// from 0).
+    /// coefficients; 3,3/3,3 is 31 coefficients within 1e-3. PT+PR/QT,QR: P additive, A(t) +
+    /// B(r) without cross terms, PT + PR + 1 coefficients; 2+1/2,2 is 12 coefficients within
+    /// 1e-2. Each degree 1 to 12 (R, PR, QR from 0).
     #[arg(long, default_value = "5,4", value_parser = parse_shape)]
     degrees: Shape,
     /// Print the maximum error of fits of several sizes, polynomial (12 to 64 coefficients)
@@ -67,12 +68,13 @@ fn parse_shape(text: &str) -> Result<Shape, String> {
     let bad = || {
         format!(
             "'{text}': give the degrees in t and r as T,R (a polynomial, 5,4) or as \
-             PT,PR/QT,QR (the rational 1 - t^2 P / Q, 3,3/3,3), each 1 to 12 in t and 0 to 12 \
-             in r (1 to 12 for a polynomial)"
+             PT,PR/QT,QR (the rational 1 - t^2 P / Q, 3,3/3,3; PT+PR/QT,QR for an additive P \
+             without cross terms, 2+1/2,2), each 1 to 12 in t and 0 to 12 in r (1 to 12 for a \
+             polynomial)"
         )
     };
     let degrees = |part: &str, lowest_r: usize| {
-        let (t, r) = part.split_once(',')?;
+        let (t, r) = part.split_once(',').or_else(|| part.split_once('+'))?;
         let parse = |s: &str, lowest: usize| {
             s.trim()
                 .parse::<usize>()
@@ -85,11 +87,14 @@ fn parse_shape(text: &str) -> Result<Shape, String> {
         })
     };
     match text.split_once('/') {
+        None if text.contains('+') => Err(bad()),
         None => degrees(text, 1).map(Shape::Polynomial).ok_or_else(bad),
-        Some((p, q)) => Ok(Shape::Rational(RationalShape {
+        Some((p, q)) if !q.contains('+') => Ok(Shape::Rational(RationalShape {
             numerator: degrees(p, 0).ok_or_else(bad)?,
             denominator: degrees(q, 0).ok_or_else(bad)?,
+            additive: p.contains('+'),
         })),
+        Some(_) => Err(bad()),
     }
 }
 
@@ -106,13 +111,23 @@ const SWEEP: [(usize, usize); 9] = [
     (7, 7),
 ];
 
-/// The rational shapes `--sweep` tries, as (P, Q) degrees.
-const RATIONAL_SWEEP: [((usize, usize), (usize, usize)); 5] = [
-    ((1, 1), (1, 1)),
-    ((1, 1), (2, 2)),
-    ((2, 2), (2, 2)),
-    ((3, 3), (2, 2)),
-    ((3, 3), (3, 3)),
+/// The rational shape of P's and Q's degrees, P additive or not.
+const fn rational(p: (usize, usize), q: (usize, usize), additive: bool) -> RationalShape {
+    RationalShape {
+        numerator: Degrees { t: p.0, r: p.1 },
+        denominator: Degrees { t: q.0, r: q.1 },
+        additive,
+    }
+}
+
+/// The rational shapes `--sweep` tries.
+const RATIONAL_SWEEP: [RationalShape; 6] = [
+    rational((1, 1), (1, 1), false),
+    rational((1, 1), (2, 2), false),
+    rational((2, 1), (2, 2), true),
+    rational((2, 2), (2, 2), false),
+    rational((3, 3), (2, 2), false),
+    rational((3, 3), (3, 3), false),
 ];
 
 /// A fit and its audit: the formula file's text and the audited maximum.
@@ -180,12 +195,7 @@ pub fn run(args: FitArgs) -> kiln::Result<()> {
         let shapes = SWEEP
             .iter()
             .map(|&(t, r)| Shape::Polynomial(Degrees { t, r }))
-            .chain(RATIONAL_SWEEP.iter().map(|&((pt, pr), (qt, qr))| {
-                Shape::Rational(RationalShape {
-                    numerator: Degrees { t: pt, r: pr },
-                    denominator: Degrees { t: qt, r: qr },
-                })
-            }));
+            .chain(RATIONAL_SWEEP.iter().copied().map(Shape::Rational));
         let mut fits = Vec::new();
         for shape in shapes {
             let a = audited(make(model, shape, &truth, quiet)?, model);

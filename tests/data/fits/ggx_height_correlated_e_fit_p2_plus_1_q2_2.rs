@@ -1,0 +1,15 @@
+// E of ggx height-correlated (F = 1) as the rational 1 - t^2 P(u, s) / Q(u, s), P = A(u) + B(s) (no cross terms) of degree 2 in u = 2 t - 1 and 1 in s = 2 r^3.2 - 1, Q of degrees 2 and 2 with constant term 1 (12 coefficients), t = (mu (1 + alpha) / (mu + alpha))^0.3, alpha = r^2; max error 9.18e-3 over mu in [0, 1], r in [0, 1] against kiln's reference (kiln verify --fit); made by `kiln fit --ndf ggx --masking height-correlated --degrees 2+1/2,2`
+#[allow(clippy::all)]
+pub fn ggx_height_correlated_e_fit_p2_plus_1_q2_2(mu: f32, r: f32) -> f32 {
+    let k = r * r;
+    let t = (mu * (1.0 + k) / (mu + k).max(1e-30)).min(1.0).powf(0.3);
+    let u = 2e0_f32 * t - 1e0_f32;
+    let s = 2e0_f32 * r.powf(3.2) - 1e0_f32;
+    let mut n = 1.3032663e-1_f32;
+    n = n * u + -3.5413e-1_f32;
+    n = n * u + 3.5354453e-1_f32 + s * (1.3241081e-1_f32);
+    let mut d = 6.6804785e-1_f32 + s * (-9.254912e-1_f32 + s * (6.659628e-1_f32));
+    d = d * u + -1.3790286e0_f32 + s * (1.4781656e0_f32 + s * (-9.2926794e-1_f32));
+    d = d * u + 1e0_f32 + s * (-5.067203e-1_f32 + s * (3.1160355e-1_f32));
+    return 1e0_f32 - t * t * n / d;
+}
