@@ -13,15 +13,16 @@
 //! Its table: over the E table's roughness coordinate `x` (`r` or `alpha` on linear rows; the
 //! rows' texture coordinate on balanced rows, whose spacing it shares), on nodes that
 //! subdivide every cell of the E table's roughness axis [`SUBDIVISIONS`] times (497 entries for a
-//! 32-row table; so the kinks of the bilinear lookup, at the E table's rows, fall on nodes and
-//! the linear interpolation between them is smooth), one of two forms
+//! 32-row table; 817 with the first form's refined start, below; so the kinks of the bilinear
+//! lookup, at the E table's rows, fall on nodes and the linear interpolation between them is
+//! smooth), one of two forms
 //! ([`divides_by_roughness`]):
 //!
 //! - `g(x) = (1 - Ē(x)) / x` for an E table on the adaptive or balanced `mu` axis with its rows
 //!   on nodes (kiln's default). There the lookup's columns move with `alpha`, and between the first two
 //!   rows `1 - Ē` starts linearly in `x` (3.4e-5 x for the default GGX table) and then grows
-//!   like `alpha`; divided by `x` it is close to linear over the first cell, where `1 - Ē`
-//!   itself varies over orders of magnitude. `g(0)` is the limit, the slope of `1 - Ē` at 0;
+//!   like `alpha`; divided by `x` it bends far less over the first cell than `1 - Ē`, which
+//!   varies over orders of magnitude there. `g(0)` is the limit, the slope of `1 - Ē` at 0;
 //!   the product `x g(x)` is 0 at `x = 0` (a mirror loses nothing).
 //! - `g(x) = 1 - Ē(x)` for every other E table (linear or square-root `mu` axis, or rows on
 //!   texel centres, as the engines' tables are). Its columns do not move with roughness, so the
