@@ -110,7 +110,16 @@ fn the_normalisation_closes_the_furnace_in_half_floats() {
     let e = read("ggx-height-correlated-E");
     let norm = read("ggx-height-correlated-f_ms_norm");
     let report = furnace(&e, &norm, 4).unwrap();
-    assert!(report.max_deviation <= 1e-3, "{:?}", report.worst);
+    // f_ms_norm stays f32 in an f16 bake (its smallest values would be f16 subnormals): the
+    // lobe closes as in f32 (4.1e-6; 2.6e-4 when f_ms_norm was rounded to f16), and the
+    // table is within 1e-4 relative of its f16 E table's lookup average.
+    assert!(report.max_deviation <= 2e-5, "{:?}", report.worst);
+    let audit = kiln::verify::furnace::audit_normalisation(&e, &norm).unwrap();
+    assert!(
+        audit.lookup_max_relative_error <= 1e-4,
+        "{}",
+        audit.lookup_max_relative_error
+    );
 }
 
 /// The lobe's albedo integrated independently: `E(mu_o) + ∫ f_ms mu_i dω_i`, with `E` the

@@ -109,6 +109,20 @@ impl Precision {
         }
     }
 
+    /// The precision `table`'s value channels are stored in when this one is asked: as asked,
+    /// but `f_ms_norm` always in f32. Its values, `(1 - Ē) / r`, fall to 3.4e-5 at low
+    /// roughness, below f16's smallest normal number (6.1e-5), where half floats are 6e-8
+    /// apart (2e-3 relative; 4e-4 relative at the top), far from the 1e-4 relative the table
+    /// is made to; it is 817 values (3 KB in f32).
+    #[must_use]
+    pub fn stored_for(self, table: &Table) -> Precision {
+        if table.spec.quantity == crate::table::Quantity::FMsNorm {
+            Precision::F32
+        } else {
+            self
+        }
+    }
+
     /// Bytes per value.
     #[must_use]
     pub fn bytes(self) -> usize {
@@ -147,7 +161,9 @@ pub fn encode_all(
 ) -> Result<Vec<(String, Vec<u8>)>> {
     let mut files = Vec::new();
     let tables = as_stored(tables, precision);
+    let asked = precision;
     for table in &tables {
+        let precision = asked.stored_for(table);
         let id = table.spec.id();
         let fail = |format: Format, message: String| Error::Format {
             path: PathBuf::from(format!("{id}.{}", format.name())),

@@ -159,7 +159,8 @@ pub struct BakeArgs {
     )]
     format: Vec<Format>,
     /// Storage precision of the value and 1 - value channels in EXR, binary, KTX2 and DDS files
-    /// (std_error stays f32; JSON is always f64, Rust, C and shader code always f32).
+    /// (std_error stays f32, and so does f_ms_norm, whose smallest values would be f16
+    /// subnormals; JSON is always f64, Rust, C and shader code always f32).
     #[arg(long, value_enum, default_value = "f32")]
     precision: Precision,
     /// Roughness axis: perceptual r (alpha = r^2) or alpha.
