@@ -360,9 +360,6 @@ mod tests {
         }
     }
 
-    /// `1 - t^2 / (1 + t)` by `1 - c t^2` (`P` and `Q` of degree 0): the error is
-    /// `t^2 |1 / (1 + t) - c|`, and the differential correction's maximum is the smallest a
-    /// scan over `c` finds.
     /// An additive `P` of degrees 2, 1 keeps `1, s, u, u^2` (tensor indices 0, 1, 2, 4): 12
     /// coefficients over `Q` of degrees 2, 2; its cross terms come back exactly 0, so the
     /// emitted code has 12 coefficients too.
@@ -398,6 +395,9 @@ mod tests {
         }
     }
 
+    /// `1 - t^2 / (1 + t)` by `1 - c t^2` (`P` and `Q` of degree 0): the error is
+    /// `t^2 |1 / (1 + t) - c|`, and the differential correction's maximum is the smallest a
+    /// scan over `c` finds.
     #[test]
     fn a_constant_numerator_is_the_minimax_one() {
         let truth: Vec<((f64, f64), f64)> = (0..=400)

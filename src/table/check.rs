@@ -114,7 +114,7 @@ impl TableSpec {
                 e.check().map_err(|m| format!("its E table: {m}"))?;
                 // kiln's layout of the normalisation of that E table, or the one of files
                 // older than the refined start (the same without it).
-                let kiln = super::normalisation::spec_for(e).refined_start;
+                let kiln = super::normalisation::refined_start_for(e);
                 if self.refined_start.is_some() && self.refined_start != kiln {
                     return Err(format!(
                         "f_ms_norm's refined_start {:?} is not kiln's for its E table ({kiln:?})",

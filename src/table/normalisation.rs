@@ -124,16 +124,11 @@ impl NodeLine {
             .clamp(0.0, self.last)
     }
 
-    /// The roughness coordinate of node `i` (the inverse of [`NodeLine::position`]).
+    /// The roughness coordinate of node `i` (the inverse of [`NodeLine::position`]: the
+    /// larger of the two lines' inverses, as the position is the smaller of the lines).
     #[must_use]
     pub fn coordinate(&self, i: f64) -> f64 {
-        let refined_end =
-            self.offset * self.steep / (self.steep - self.shallow).max(f64::MIN_POSITIVE);
-        if self.offset == 0.0 || i <= refined_end {
-            i / self.steep
-        } else {
-            (i - self.offset) / self.shallow
-        }
+        (i / self.steep).max((i - self.offset) / self.shallow)
     }
 }
 
@@ -193,11 +188,7 @@ pub fn stores_per_roughness(norm: &TableSpec) -> bool {
 #[must_use]
 pub fn spec_for(e: &TableSpec) -> TableSpec {
     let rows = e.roughness_axis();
-    let cells = rows.size().max(2) - 1;
-    let refined_start = divides_by_roughness(e).then_some(RefinedStart {
-        cells: REFINED_START.cells.min(cells),
-        ..REFINED_START
-    });
+    let refined_start = refined_start_for(e);
     let size = size_of(e, refined_start);
     TableSpec {
         quantity: Quantity::FMsNorm,
@@ -220,6 +211,17 @@ pub fn spec_for(e: &TableSpec) -> TableSpec {
         texels: crate::table::Texels::Nodes,
         ..e.clone()
     }
+}
+
+/// kiln's refined start of the normalisation of the E table `e`: [`REFINED_START`] (at most
+/// all its cells) where it stores `(1 - Ē) / x` ([`divides_by_roughness`]), none otherwise.
+#[must_use]
+pub fn refined_start_for(e: &TableSpec) -> Option<RefinedStart> {
+    let cells = e.roughness_axis().size().max(2) - 1;
+    divides_by_roughness(e).then_some(RefinedStart {
+        cells: REFINED_START.cells.min(cells),
+        ..REFINED_START
+    })
 }
 
 /// The entries of the normalisation table of the E table `e` with the refined start
