@@ -101,9 +101,10 @@ fn looser_bounds_cost_fewer_samples() {
     .resolved()
     .specs();
     let spec_digits: Vec<_> = specs.iter().map(|s| s.reference_digits).collect();
-    // kiln's glass layout computes at 1e-9 at least (kiln::bake::GLASS_LAYOUT_MIN_DIGITS): the
-    // reference at coarser tolerances understates its error at some of its nodes.
-    assert_eq!(spec_digits, [Some(5), Some(9), Some(9)]);
+    // kiln's glass layout (the default) too: until numerics version 13 it computed at 1e-9 at
+    // least, as the dielectric reference understated its error at some of its nodes near
+    // eta = 1 at coarser tolerances (tests/dielectric_reference_margin.rs).
+    assert_eq!(spec_digits, [Some(5), Some(5), Some(5)]);
     let product_grid = BakeOptions {
         max_error: Some(1e-5),
         quantities: vec![Quantity::EDielectric, Quantity::EAvgDielectricInside],
