@@ -1073,7 +1073,8 @@ pub fn estimated_core_seconds(spec: &TableSpec) -> f64 {
 }
 
 /// The cost of a lookup fit ([`fit_texels`]; 0 for point samples), in seconds of one core: its
-/// reference evaluations at the fit's tolerance 1e-8, each at 0.45 of a texel's figure of
+/// reference evaluations at the fit's tolerance ([`crate::table::lookup_fit::LookupFitSettings`]),
+/// each at 0.45 of a texel's figure of
 /// [`reference_seconds_per_point`] (the fit's points are between the texels, where the
 /// integrands are tamer; measured on 32 x 32 and 64 x 64 `E` bakes, 3.4 s and 5.3 s whole
 /// process on 2 cores, 2026-12-04), and its Lawson iterations, each a banded Cholesky solve of
@@ -1085,9 +1086,10 @@ pub fn lookup_fit_core_seconds(spec: &TableSpec) -> f64 {
         return 0.0;
     }
     let band = spec.mu.map_or(1, |mu| mu.size()) as f64 + 1.0;
-    let iterations = lookup_fit_settings(spec).iterations as f64;
-    let solve = iterations * spec.len() as f64 * band * band * 1.2e-9;
-    0.45 * evaluations as f64 * reference_seconds_per_point(spec, 8) + solve
+    let settings = lookup_fit_settings(spec);
+    let solve = settings.iterations as f64 * spec.len() as f64 * band * band * 1.2e-9;
+    let digits = (-settings.tolerance.log10()).round().max(1.0) as u32;
+    0.45 * evaluations as f64 * reference_seconds_per_point(spec, digits) + solve
 }
 
 /// [`estimated_core_seconds`] of the texels' integration alone.
