@@ -55,7 +55,7 @@ const GOLDEN: &[(u32, &str, &str)] = &[
     (
         13,
         "ggx-height-correlated-E_avg_dielectric-ior-cycles Reference",
-        "187a7bdcc6797d6a",
+        "0ac0e7f33eecbccc",
     ),
     (
         13,
@@ -76,7 +76,7 @@ const GOLDEN: &[(u32, &str, &str)] = &[
     (
         13,
         "ggx-height-correlated-E_avg_dielectric Reference",
-        "83d242845ff7cb11",
+        "f185cd27d01bb1bd",
     ),
     (
         13,

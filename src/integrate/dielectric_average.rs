@@ -247,6 +247,14 @@ pub(crate) fn average<N: MicrofacetDistribution>(
         // theta_m = pi / 2 - theta_c: the views' horizon enters the slice at the critical angle.
         outer_breaks.push(s_of_x(((FRAC_PI_2 - c).tan() / alpha).ln()));
     }
+    if eta > 1.0 {
+        // tan(theta_m) = sqrt(eta^2 - 1): where the refracted direction's horizon first enters
+        // the slices (at theta_h = pi / 2, below), a kink of the middle integral. Without the
+        // break the outer rule split toward it (GGX alpha 0.09, eta 1.5 at 1e-7: 1.44 M
+        // evaluations, 0.45 M with it; the 16 x 16 outside average baked in 2.0 s, was 2.5 s).
+        let tan_m = ((eta - 1.0) * (eta + 1.0)).sqrt();
+        outer_breaks.push(s_of_x((tan_m / alpha).ln()));
+    }
     tidy(&mut outer_breaks, 0.0, 1.0);
     // The tolerance is shared between the levels as in the nested reference: the outer rule
     // gets half; each middle integral `tolerance / (4 W)` (half its own rule's, half the inner

@@ -308,7 +308,7 @@ impl RoughnessSpacing {
 pub enum IorMapping {
     /// `eta = 1 + t (eta_max - 1)`.
     Linear,
-    /// Linear in `z = sqrt((eta - 1) / (eta + 1))` (Cycles' glass tables); kiln's default.
+    /// Linear in `z = sqrt((eta - 1) / (eta + 1))` (Cycles' glass tables); `F_avg`'s axis.
     Cycles,
     /// Blender's own glass tables (`shader.tables`): `z = t` clamped to `[1e-4, 0.99]` at the
     /// nodes, so the axis runs from `eta = 1 + 2e-8` to `eta = 99.5` whatever `eta_max`, and
