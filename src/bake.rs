@@ -198,12 +198,13 @@ impl BakeOptions {
             )));
         }
         if self.mu_mapping.depends_on_roughness()
+            && self.mu_mapping != MuMapping::SplitSum
             && let Some(q) = self.quantities.iter().find(|q| q.varies_on_a_mirror())
         {
             return Err(Error::InvalidInput(format!(
-                "--quantity {} needs --mu-axis linear or sqrt: the {} mu axis follows E's \
-                 grazing layer and maps every mu > 0 to t = 1 at roughness 0, where {} still \
-                 varies with mu",
+                "--quantity {} needs --mu-axis split-sum (kiln's layout for it), linear or sqrt: \
+                 the {} mu axis follows E's grazing layer and maps every mu > 0 to t = 1 at \
+                 roughness 0, where {} still varies with mu",
                 q.cli_name(),
                 self.mu_mapping.name(),
                 if *q == Quantity::EF {

@@ -13,12 +13,13 @@ use kiln::verify::{Against, AuditSettings, audit};
 use kiln::{BakeOptions, Masking, Model, MuMapping, Ndf, RoughnessSpacing};
 use rayon::prelude::*;
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
 
 #[path = "common/cxx.rs"]
 mod cxx;
 #[path = "common/rng.rs"]
 mod rng;
+#[path = "common/rustc.rs"]
+mod rustc;
 
 fn bake(size: usize, mu_mapping: MuMapping, roughness_spacing: RoughnessSpacing) -> Table {
     BakeOptions {
@@ -88,36 +89,6 @@ struct Tex2 {
 template <typename T> using Texture2D = Tex2;
 ";
 
-/// Compiles the Rust program `source` with rustc into `dir` as `name`.
-fn compile_rust(dir: &Path, name: &str, source: &str) -> PathBuf {
-    let file = dir.join(format!("{name}.rs"));
-    std::fs::write(&file, source).unwrap();
-    let program = dir.join(name);
-    let rustc = std::env::var("RUSTC").unwrap_or_else(|_| "rustc".into());
-    let compiled = std::process::Command::new(rustc)
-        .args(["--edition", "2021", "-O", "-A", "warnings", "-o"])
-        .arg(&program)
-        .arg(&file)
-        .output()
-        .expect("rustc runs");
-    assert!(
-        compiled.status.success(),
-        "the generated Rust does not compile:\n{}",
-        String::from_utf8_lossy(&compiled.stderr)
-    );
-    program
-}
-
-fn run(program: &Path) -> Vec<f64> {
-    let output = std::process::Command::new(program).output().unwrap();
-    assert!(output.status.success());
-    String::from_utf8(output.stdout)
-        .unwrap()
-        .lines()
-        .map(|l| l.parse().unwrap())
-        .collect()
-}
-
 /// The generated HLSL (as C++) and Rust lookups of the fitted 32 x 32 balanced `E` table, in
 /// f32, are within 2.5e-4 of the reference at every hidden point (measured 2026-12-05: 2.08e-4
 /// both), and within 2e-5 of the library's own lookup.
@@ -170,7 +141,7 @@ fn the_fitted_32x32_lookup_meets_2_5e_4_through_the_generated_code() {
         );
     }
     source += "}\n";
-    let from_rust = run(&compile_rust(dir.path(), "lookup_rs", &source));
+    let from_rust = rustc::compile_and_run(dir.path(), "lookup_rs", &source);
     assert_eq!(from_hlsl.len(), points.len());
     assert_eq!(from_rust.len(), points.len());
 
@@ -291,7 +262,7 @@ fn the_normalisation_of_balanced_rows_round_trips_through_the_generated_code() {
         );
     }
     source += "}\n";
-    let generated = run(&compile_rust(dir.path(), "norm", &source));
+    let generated = rustc::compile_and_run(dir.path(), "norm", &source);
     for (&r, &g) in rs.iter().zip(&generated) {
         let library = normalisation_lookup(norm, f64::from(r as f32));
         assert!(

@@ -7,7 +7,8 @@ use kiln::format::shader::{Language, encode, name};
 use kiln::{BakeOptions, Grid, MuMapping, Quantity, Table};
 
 /// Tables of every shape and axis kind: E on the adaptive axis with nodes and on the sqrt axis
-/// with centres, E_avg (1-D), E_dielectric (3-D, IOR axis) and F_avg (1-D over the IOR).
+/// with centres, E_avg (1-D), E_dielectric (3-D, IOR axis) and F_avg (1-D over the IOR), and
+/// kiln's balanced, split-sum and glass layouts.
 fn tables() -> Vec<Table> {
     let base = BakeOptions {
         size: 3,
@@ -32,6 +33,16 @@ fn tables() -> Vec<Table> {
         BakeOptions {
             mu_mapping: MuMapping::Balanced,
             roughness_spacing: kiln::RoughnessSpacing::Balanced,
+            ..base.clone()
+        }
+        .bake(&|_| {})
+        .unwrap(),
+    );
+    // kiln's split-sum layout (the default axis of the split-sum channels).
+    tables.extend(
+        BakeOptions {
+            quantities: vec![Quantity::EScale, Quantity::EBias],
+            mu_mapping: MuMapping::SplitSum,
             ..base.clone()
         }
         .bake(&|_| {})

@@ -87,6 +87,7 @@ fn axis_descriptor(axis: Option<&Axis>) -> [u32; 4] {
                 MuMapping::Adaptive => 2,
                 MuMapping::Glass => 3,
                 MuMapping::Balanced => 4,
+                MuMapping::SplitSum => 5,
             };
             [1, m, grid(g), 0]
         }

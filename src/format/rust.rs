@@ -12,6 +12,7 @@ use crate::table::axis::{
 };
 use crate::table::balanced_layout::BalancedLayout;
 use crate::table::glass_layout;
+use crate::table::split_sum_layout::SplitSumLayout;
 use std::fmt::Write as _;
 
 /// The glass layout the `glass` mappings stand for.
@@ -116,6 +117,17 @@ fn coordinate_code(axis: &Axis) -> String {
                     eps0 as f32,
                     l.offset_decay as f32,
                     p = l.power as f32,
+                )
+            }
+            MuMapping::SplitSum => {
+                let l = SplitSumLayout::KILN;
+                format!(
+                    "{{\n        {SATURATION}\n        \
+                     {:?} * a(mu, {:?}, {:?}) + {:?} * a(mu, {ADAPTIVE_SCALE:?} * alpha, {ADAPTIVE_POWER:?})\n    }}",
+                    l.share as f32,
+                    l.scale as f32,
+                    l.power as f32,
+                    (1.0 - l.share) as f32,
                 )
             }
             MuMapping::Glass => {

@@ -21,6 +21,7 @@ use crate::table::axis::{
 };
 use crate::table::balanced_layout::BalancedLayout;
 use crate::table::glass_layout;
+use crate::table::split_sum_layout::SplitSumLayout;
 use std::fmt::Write as _;
 
 /// The glass layout the `glass` mappings stand for.
@@ -118,6 +119,21 @@ fn coordinate(language: Language, axis: &Axis) -> String {
                 format!(
                     "(pow({u} + balanced_eps, {p}) - pow(balanced_eps, {p})) / (pow(1.0 + \
                      balanced_eps, {p}) - pow(balanced_eps, {p}))"
+                )
+            }
+            MuMapping::SplitSum => {
+                let l = SplitSumLayout::KILN;
+                format!(
+                    "{} * {} + {} * {}",
+                    literal(l.share),
+                    saturation(language, "mu", &literal(l.scale), l.power),
+                    literal(1.0 - l.share),
+                    saturation(
+                        language,
+                        "mu",
+                        &format!("{} * alpha", literal(ADAPTIVE_SCALE)),
+                        ADAPTIVE_POWER
+                    )
                 )
             }
             MuMapping::Glass => {

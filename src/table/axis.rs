@@ -112,6 +112,11 @@ pub enum MuMapping {
     /// more texels near `mu = 1` at moderate roughness and fewer at `mu < 1e-4`, for the lookup
     /// of fitted texels (`--texels lookup-fit`).
     Balanced,
+    /// kiln's split-sum layout (`table::split_sum_layout`), for the quantities that vary with
+    /// `mu` on a mirror (`e-scale`, `e-bias`, `e-f`): `t = 0.6 A(mu; 0.3, 0.5) + 0.4 A(mu; 4
+    /// alpha, 0.4)` with `A(y; k, p) = (y (1 + k) / (y + k))^p`: the adaptive axis' grazing
+    /// layer, and texels for `Fc(mu)` on the mirror row (which the adaptive axis maps to `t = 1`).
+    SplitSum,
 }
 
 impl MuMapping {
@@ -124,6 +129,19 @@ impl MuMapping {
             MuMapping::Adaptive => "adaptive",
             MuMapping::Glass => "glass",
             MuMapping::Balanced => "balanced",
+            MuMapping::SplitSum => "split-sum",
+        }
+    }
+
+    /// kiln's `mu` axis for a bake of `quantities`: [`MuMapping::SplitSum`] when one of them
+    /// varies with `mu` on a mirror (the adaptive axis maps every `mu > 0` to `t = 1` there),
+    /// [`MuMapping::Adaptive`] otherwise.
+    #[must_use]
+    pub fn default_for(quantities: &[crate::integrate::quantity::Quantity]) -> Self {
+        if quantities.iter().any(|q| q.varies_on_a_mirror()) {
+            MuMapping::SplitSum
+        } else {
+            MuMapping::Adaptive
         }
     }
 
@@ -132,7 +150,7 @@ impl MuMapping {
     pub fn depends_on_roughness(self) -> bool {
         matches!(
             self,
-            MuMapping::Adaptive | MuMapping::Glass | MuMapping::Balanced
+            MuMapping::Adaptive | MuMapping::Glass | MuMapping::Balanced | MuMapping::SplitSum
         )
     }
 
@@ -163,6 +181,7 @@ impl MuMapping {
             MuMapping::Balanced => {
                 super::balanced_layout::BalancedLayout::KILN.mu_at(t, alpha, size)
             }
+            MuMapping::SplitSum => super::split_sum_layout::SplitSumLayout::KILN.mu_at(t, alpha),
         }
     }
 
@@ -187,6 +206,9 @@ impl MuMapping {
             }
             MuMapping::Balanced => {
                 super::balanced_layout::BalancedLayout::KILN.mu_coordinate(mu, alpha, size)
+            }
+            MuMapping::SplitSum => {
+                super::split_sum_layout::SplitSumLayout::KILN.mu_coordinate(mu, alpha)
             }
         }
     }
@@ -228,6 +250,19 @@ impl MuMapping {
                     z = l.offset,
                     w = l.offset_size_power,
                     y = l.offset_decay,
+                )
+            }
+            MuMapping::SplitSum => {
+                let l = super::split_sum_layout::SplitSumLayout::KILN;
+                format!(
+                    "lookup coordinate t = {w} A(mu; {k}, {p}) + {v} A(mu; 4 alpha, 0.4) with \
+                     A(y; k, p) = (y (1 + k) / (y + k))^p (0 at y = 0; 1 at k = 0, y > 0); mu at \
+                     t by bisection; the row at alpha = 0 holds the limit alpha -> 0+ (computed \
+                     at alpha = 1e-7)",
+                    w = l.share,
+                    k = l.scale,
+                    p = l.power,
+                    v = 1.0 - l.share,
                 )
             }
         }

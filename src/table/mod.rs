@@ -6,6 +6,7 @@ pub mod check;
 pub mod glass_layout;
 pub mod lookup_fit;
 pub mod normalisation;
+pub mod split_sum_layout;
 
 use crate::integrate::QmcSettings;
 use crate::model::dielectric::TransmissionConvention;
@@ -280,6 +281,10 @@ impl TableSpec {
             Some(MuMapping::Linear) => tags.push("mu-linear"),
             Some(MuMapping::Sqrt) => tags.push("mu-sqrt"),
             Some(MuMapping::Balanced) => tags.push("mu-balanced"),
+            // kiln's axis for the quantities that vary on a mirror, untagged for them.
+            Some(MuMapping::SplitSum) if !self.quantity.varies_on_a_mirror() => {
+                tags.push("mu-split-sum");
+            }
             _ => {}
         }
         // The balanced rows go with the balanced mu axis, which names them.

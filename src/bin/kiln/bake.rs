@@ -178,14 +178,13 @@ pub struct BakeArgs {
     /// --texels lookup-fit: the grazing layer, and more texels near mu = 1 at moderate
     /// roughness, so that the fitted lookup's largest error is about even over the domain;
     /// 2.1e-4 at 32 x 32 with balanced rows, against 3.3e-4 on the adaptive axis; see
-    /// docs/accuracy.md), linear (mu = t) or sqrt (mu = t^2). See "Conventions" below.
-    #[arg(
-        long,
-        value_enum,
-        default_value = "adaptive",
-        hide_possible_values = true
-    )]
-    mu_axis: MuMapping,
+    /// docs/accuracy.md), split-sum (kiln's layout for the quantities that vary with mu on a
+    /// mirror, e-scale, e-bias and e-f: the grazing layer, and texels for Fc(mu) on the mirror
+    /// row; t = 0.6 A(mu; 0.3, 0.5) + 0.4 A(mu; 4 alpha, 0.4), A(y; k, p) = (y (1 + k) / (y +
+    /// k))^p), linear (mu = t) or sqrt (mu = t^2). See "Conventions" below. [default: split-sum
+    /// when a quantity varies with mu on a mirror, otherwise adaptive].
+    #[arg(long, value_enum, hide_possible_values = true)]
+    mu_axis: Option<MuMapping>,
     /// Where samples sit: nodes i/(N - 1) on the axis ends (lookups must remap, see below) or
     /// texel centres (i + 0.5)/N.
     #[arg(long, value_enum, default_value = "nodes")]
@@ -259,16 +258,20 @@ pub fn run(args: BakeArgs) -> kiln::Result<()> {
         None => Some(BakeOptions::DEFAULT_MAX_ERROR),
     };
     let samples = args.samples.unwrap_or(QmcSettings::DEFAULT_SAMPLES);
+    let quantities = args.quantity.clone().unwrap_or_else(|| {
+        if args.fresnel.given() {
+            vec![Quantity::EF]
+        } else {
+            BakeOptions::DEFAULT_QUANTITIES.to_vec()
+        }
+    });
+    let mu_mapping = args
+        .mu_axis
+        .unwrap_or_else(|| MuMapping::default_for(&quantities));
     let options = BakeOptions {
         ndfs: args.ndf,
         maskings: args.masking,
-        quantities: args.quantity.unwrap_or_else(|| {
-            if args.fresnel.given() {
-                vec![Quantity::EF]
-            } else {
-                BakeOptions::DEFAULT_QUANTITIES.to_vec()
-            }
-        }),
+        quantities,
         fresnel: if args.fresnel.given() {
             Some(args.fresnel.model()?)
         } else {
@@ -290,8 +293,8 @@ pub fn run(args: BakeArgs) -> kiln::Result<()> {
         roughness_convention: args.roughness_axis,
         roughness_spacing: args
             .roughness_spacing
-            .unwrap_or(RoughnessSpacing::paired_with(args.mu_axis)),
-        mu_mapping: args.mu_axis,
+            .unwrap_or(RoughnessSpacing::paired_with(mu_mapping)),
+        mu_mapping,
         grid: args.grid,
         ior_size: args.ior_size.unwrap_or(BakeOptions::DEFAULT_IOR_SIZE),
         ior_mapping: args.ior_axis.unwrap_or(IorMapping::Glass),
