@@ -130,20 +130,8 @@ fn the_fitted_32x32_lookup_meets_2_5e_4_through_the_generated_code() {
     let from_hlsl = cxx::compile_and_run(dir.path(), "lookup_cpp", &source);
 
     // Rust, compiled by rustc.
-    let rust = std::fs::read_to_string(dir.path().join(format!("{id}.rs"))).unwrap();
-    let constant = kiln::format::rust::const_prefix(&table);
-    let mut source = format!("{rust}\nfn main() {{\n");
-    for &(mu, r) in &points {
-        let _ = writeln!(
-            source,
-            "    println!(\"{{}}\", {}_lookup(&{constant}, {mu:?}_f32, {r:?}_f32));",
-            constant.to_lowercase()
-        );
-    }
-    source += "}\n";
-    let from_rust = rustc::compile_and_run(dir.path(), "lookup_rs", &source);
+    let from_rust = rustc::generated_lookups(dir.path(), &table, &points);
     assert_eq!(from_hlsl.len(), points.len());
-    assert_eq!(from_rust.len(), points.len());
 
     let model = Model {
         ndf: Ndf::Ggx,

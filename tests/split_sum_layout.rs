@@ -14,7 +14,6 @@ use kiln::table::{Quantity, Table, Texels};
 use kiln::verify::{Against, AuditSettings, audit};
 use kiln::{BakeOptions, MuMapping};
 use rayon::prelude::*;
-use std::fmt::Write as _;
 
 #[path = "common/rng.rs"]
 mod rng;
@@ -101,20 +100,7 @@ fn the_generated_lookup_computes_the_split_sum_coordinates() {
                 ..
             })
         ));
-        let rust =
-            std::fs::read_to_string(dir.path().join(format!("{}.rs", table.spec.id()))).unwrap();
-        let constant = kiln::format::rust::const_prefix(table);
-        let mut source = format!("{rust}\nfn main() {{\n");
-        for &(mu, r) in &points {
-            let _ = writeln!(
-                source,
-                "    println!(\"{{}}\", {}_lookup(&{constant}, {mu:?}_f32, {r:?}_f32));",
-                constant.to_lowercase()
-            );
-        }
-        source += "}\n";
-        let generated = rustc::compile_and_run(dir.path(), "lookup", &source);
-        assert_eq!(generated.len(), points.len());
+        let generated = rustc::generated_lookups(dir.path(), table, &points);
         let integral = table.spec.integral();
         let settings = ReferenceSettings {
             tolerance: 1e-8,

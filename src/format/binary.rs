@@ -15,7 +15,9 @@
 //!                                     1 = sqrt: mu = t^2, 2 = adaptive:
 //!                                     t = (mu (1 + 4a) / (mu + 4a))^0.4, 3 = glass: kiln's
 //!                                     glass layout, `table::glass_layout`, 4 = balanced:
-//!                                     kiln's balanced layout, `table::balanced_layout`;
+//!                                     kiln's balanced layout, `table::balanced_layout`,
+//!                                     5 = split-sum: kiln's split-sum layout,
+//!                                     `table::split_sum_layout`;
 //!                                     r or alpha: 0 = linear, 1 = balanced; eta: 0 = linear,
 //!                                     1 = cycles: linear in sqrt((eta - 1) / (eta + 1)),
 //!                                     2 = blender, 3 = glass),

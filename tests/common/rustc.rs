@@ -27,3 +27,29 @@ pub fn compile_and_run(dir: &std::path::Path, name: &str, source: &str) -> Vec<f
         .map(|l| l.parse().unwrap())
         .collect()
 }
+
+/// The generated Rust lookup of the 2-D `table`, written as `{id}.rs` in `dir`, compiled and run
+/// in f32 at `points` (`mu`, roughness): what it returns at each.
+#[allow(dead_code)] // not every test that includes this file runs a lookup
+pub fn generated_lookups(
+    dir: &std::path::Path,
+    table: &kiln::Table,
+    points: &[(f64, f64)],
+) -> Vec<f64> {
+    use std::fmt::Write as _;
+    let id = table.spec.id();
+    let rust = std::fs::read_to_string(dir.join(format!("{id}.rs"))).unwrap();
+    let constant = kiln::format::rust::const_prefix(table);
+    let mut source = format!("{rust}\nfn main() {{\n");
+    for &(mu, r) in points {
+        let _ = writeln!(
+            source,
+            "    println!(\"{{}}\", {}_lookup(&{constant}, {mu:?}_f32, {r:?}_f32));",
+            constant.to_lowercase()
+        );
+    }
+    source += "}\n";
+    let values = compile_and_run(dir, &format!("{id}_lookup"), &source);
+    assert_eq!(values.len(), points.len());
+    values
+}
