@@ -532,11 +532,11 @@ impl Scene {
             }
             if asked(Effect::ImageBasedLighting) {
                 // The split-sum channels vary with mu on a mirror (`Fc(mu) = (1 - mu)^5`),
-                // which the adaptive mu axis cannot follow: on kiln's linear mu axis, as
-                // `kiln bake --quantity e-scale,e-bias --mu-axis linear` and the engines' own.
+                // which the adaptive mu axis cannot follow: on kiln's split-sum mu axis, as
+                // `kiln bake --quantity e-scale,e-bias` (an engine's scene gets the engine's).
                 let split_sum = crate::BakeOptions {
                     quantities: vec![Quantity::EScale, Quantity::EBias],
-                    mu_mapping: crate::MuMapping::Linear,
+                    mu_mapping: crate::MuMapping::SplitSum,
                     // The balanced rows are laid out for the balanced mu axis.
                     roughness_spacing: crate::RoughnessSpacing::Linear,
                     ..base.clone()
