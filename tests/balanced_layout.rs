@@ -9,13 +9,14 @@ use kiln::format::replace::Replace;
 use kiln::format::{Format, Precision, write_tables};
 use kiln::integrate::reference::{ReferenceSettings, reference_albedo};
 use kiln::table::{Quantity, Table, Texels};
-use kiln::verify::{Against, AuditSettings, audit};
 use kiln::{BakeOptions, Masking, Model, MuMapping, Ndf, RoughnessSpacing};
 use rayon::prelude::*;
 use std::fmt::Write as _;
 
 #[path = "common/cxx.rs"]
 mod cxx;
+#[path = "common/lookup_audit.rs"]
+mod lookup_audit;
 #[path = "common/rng.rs"]
 mod rng;
 #[path = "common/rustc.rs"]
@@ -174,15 +175,7 @@ fn the_fitted_32x32_lookup_meets_2_5e_4_through_the_generated_code() {
 /// 8.7e-5 at 64).
 #[test]
 fn the_balanced_layout_beats_the_adaptive_at_other_sizes() {
-    let max_error = |table: &Table| {
-        audit(
-            table,
-            &Against::Reference(ReferenceSettings::default()),
-            &AuditSettings::default(),
-            &|_| {},
-        )
-        .lookup_max_error
-    };
+    let max_error = lookup_audit::lookup_max_error;
     for size in [16, 64] {
         let balanced = max_error(&bake(size, MuMapping::Balanced, RoughnessSpacing::Balanced));
         let adaptive = max_error(&bake(size, MuMapping::Adaptive, RoughnessSpacing::Linear));

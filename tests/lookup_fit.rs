@@ -29,24 +29,14 @@ fn bake(size: usize, quantity: Quantity, texels: Texels) -> Table {
     options.bake(&|_| {}).unwrap().remove(0)
 }
 
-fn lookup_max_error(table: &Table) -> f64 {
-    audit(
-        table,
-        &Against::Reference(ReferenceSettings::default()),
-        &AuditSettings::default(),
-        &|_| {},
-    )
-    .lookup_max_error
-}
-
 /// At every size the fitted lookup beats the point samples' by at least 1.5x (measured
 /// 2026-12-04: 1.6x at 8, 1.9x at 16, 2.0x at 32, 1.9x at 64 and 128), for `E` and `E_avg`.
 #[test]
 fn a_fitted_table_beats_the_node_table_at_every_size() {
     for size in [8, 16, 64] {
-        let nodes = lookup_max_error(&bake(size, Quantity::E, Texels::Nodes));
+        let nodes = lookup_audit::lookup_max_error(&bake(size, Quantity::E, Texels::Nodes));
         let fitted_table = bake(size, Quantity::E, Texels::LookupFit);
-        let fitted = lookup_max_error(&fitted_table);
+        let fitted = lookup_audit::lookup_max_error(&fitted_table);
         assert!(
             fitted * 1.5 < nodes,
             "E {size}: fitted {fitted:.3e}, nodes {nodes:.3e}"
@@ -63,8 +53,8 @@ fn a_fitted_table_beats_the_node_table_at_every_size() {
             "audit {fitted:.3e}, stated {stated:.3e}"
         );
     }
-    let nodes = lookup_max_error(&bake(32, Quantity::EAvg, Texels::Nodes));
-    let fitted = lookup_max_error(&bake(32, Quantity::EAvg, Texels::LookupFit));
+    let nodes = lookup_audit::lookup_max_error(&bake(32, Quantity::EAvg, Texels::Nodes));
+    let fitted = lookup_audit::lookup_max_error(&bake(32, Quantity::EAvg, Texels::LookupFit));
     assert!(
         fitted * 1.8 < nodes,
         "E_avg: fitted {fitted:.3e}, nodes {nodes:.3e}"
@@ -185,9 +175,11 @@ fn a_fitted_table_states_its_node_deviation_honestly() {
     );
 }
 
-#[cfg(feature = "cli")]
 #[path = "common/command.rs"]
 mod command;
+#[cfg(feature = "cli")]
+#[path = "common/lookup_audit.rs"]
+mod lookup_audit;
 
 /// The flag's errors, and `verify --max-error` judging a fitted table by its lookup.
 #[cfg(feature = "cli")]

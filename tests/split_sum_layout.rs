@@ -11,10 +11,11 @@ use kiln::format::{Format, Precision, write_tables};
 use kiln::integrate::reference::ReferenceSettings;
 use kiln::integrate::value::Point;
 use kiln::table::{Quantity, Table, Texels};
-use kiln::verify::{Against, AuditSettings, audit};
 use kiln::{BakeOptions, MuMapping};
 use rayon::prelude::*;
 
+#[path = "common/lookup_audit.rs"]
+mod lookup_audit;
 #[path = "common/rng.rs"]
 mod rng;
 #[path = "common/rustc.rs"]
@@ -32,16 +33,6 @@ fn bake(mu_mapping: MuMapping, texels: Texels) -> Vec<Table> {
     .unwrap()
 }
 
-fn lookup_max_error(table: &Table) -> f64 {
-    audit(
-        table,
-        &Against::Reference(ReferenceSettings::default()),
-        &AuditSettings::default(),
-        &|_| {},
-    )
-    .lookup_max_error
-}
-
 /// The lookup's largest error at the audit's points (mu = 0 and the grazing probes included),
 /// measured 2026-12-05 at `--density 4`: point samples `E_scale` 6.6e-3 and `E_bias` 8.3e-3 on
 /// the split-sum axis against 4.5e-2 and 1.0e-1 on the linear one; fitted 4.4e-3 and 5.6e-3.
@@ -51,7 +42,10 @@ fn the_split_sum_axis_more_than_halves_the_lookup_error() {
     for texels in [Texels::Nodes, Texels::LookupFit] {
         let split_sum = bake(MuMapping::SplitSum, texels);
         for (ours, theirs) in split_sum.iter().zip(&linear) {
-            let (ours_error, theirs_error) = (lookup_max_error(ours), lookup_max_error(theirs));
+            let (ours_error, theirs_error) = (
+                lookup_audit::lookup_max_error(ours),
+                lookup_audit::lookup_max_error(theirs),
+            );
             eprintln!(
                 "{} ({texels:?}): split-sum {ours_error:.3e}, linear nodes {theirs_error:.3e}",
                 ours.spec.id()
