@@ -197,8 +197,7 @@ impl BakeOptions {
                 self.mu_mapping.name()
             )));
         }
-        if self.mu_mapping.depends_on_roughness()
-            && self.mu_mapping != MuMapping::SplitSum
+        if !self.mu_mapping.resolves_mu_on_a_mirror()
             && let Some(q) = self.quantities.iter().find(|q| q.varies_on_a_mirror())
         {
             return Err(Error::InvalidInput(format!(

@@ -202,14 +202,8 @@ fn the_normalisation_of_balanced_rows_round_trips_through_the_generated_code() {
     }
     .bake(&|_| {})
     .unwrap();
-    let e = tables
-        .iter()
-        .find(|t| t.spec.quantity == Quantity::E)
-        .unwrap();
-    let norm = tables
-        .iter()
-        .find(|t| t.spec.quantity == Quantity::FMsNorm)
-        .unwrap();
+    let find = |q: Quantity| tables.iter().find(|t| t.spec.quantity == q).unwrap();
+    let (e, norm) = (find(Quantity::E), find(Quantity::FMsNorm));
     use kiln::table::normalisation::{normalisation_lookup, one_minus_lookup_average};
     let axis = norm.spec.roughness_axis();
     let line = kiln::table::normalisation::NodeLine::of(&norm.spec);

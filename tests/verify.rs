@@ -27,6 +27,17 @@ fn verify(args: &[&str]) -> (Option<i32>, Value) {
     (output.status.code(), report)
 }
 
+/// Runs kiln with `args` and asserts that it exits 0, showing its stderr if not.
+fn succeeded(args: &[&str]) {
+    let output = kiln(args);
+    assert_eq!(
+        output.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+}
+
 fn number(report: &Value, field: &str) -> f64 {
     report[field]
         .as_f64()
@@ -481,7 +492,7 @@ fn furnace_plot_draws_each_form() {
     let e = tables.join("ggx-height-correlated-E.json");
     let dir = tempfile::tempdir().unwrap();
     let svg = dir.path().join("furnace.svg");
-    let output = kiln(&[
+    succeeded(&[
         "verify",
         "--furnace",
         e.to_str().unwrap(),
@@ -491,12 +502,6 @@ fn furnace_plot_draws_each_form() {
         svg.to_str().unwrap(),
         "--quiet",
     ]);
-    assert_eq!(
-        output.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&output.stderr)
-    );
     let text = std::fs::read_to_string(&svg).unwrap();
     assert!(text.starts_with("<svg") && text.contains("kulla-conty: max |deviation|"));
     // The picture states the command's own worst point (issue 42: the map's 64 x 64 grid alone
@@ -544,7 +549,7 @@ fn plot_draws_where_a_table_is_wrong() {
         Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/engines/three/DFGLUTData-16.js");
     let dir = tempfile::tempdir().unwrap();
     let svg = dir.path().join("three.svg");
-    let output = kiln(&[
+    succeeded(&[
         "verify",
         "--preset",
         "three",
@@ -555,12 +560,6 @@ fn plot_draws_where_a_table_is_wrong() {
         "--density",
         "1",
     ]);
-    assert_eq!(
-        output.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&output.stderr)
-    );
     for quantity in ["E_scale", "E_bias"] {
         let text = std::fs::read_to_string(dir.path().join(format!("three-{quantity}.svg")))
             .unwrap_or_else(|e| panic!("{quantity}: {e}"));
@@ -645,7 +644,7 @@ fn glass_furnace_checks_turquins_form() {
     assert!(String::from_utf8_lossy(&output.stderr).contains("glass"));
     // Its picture: over sqrt(mu) and the IOR, the command's worst point stated with its eta.
     let svg = dir.path().join("glass.svg");
-    let output = kiln(&[
+    succeeded(&[
         "verify",
         "--furnace",
         table,
@@ -654,12 +653,6 @@ fn glass_furnace_checks_turquins_form() {
         "--plot",
         svg.to_str().unwrap(),
     ]);
-    assert_eq!(
-        output.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&output.stderr)
-    );
     let text = std::fs::read_to_string(&svg).unwrap();
     let stated = format!(
         "max |deviation| {:.2e} at mu {}, eta {:.5}",

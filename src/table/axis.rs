@@ -154,6 +154,18 @@ impl MuMapping {
         )
     }
 
+    /// Whether the axis keeps `mu` apart on a mirror row (`alpha = 0`), where the split-sum
+    /// and Fresnel-weighted quantities still vary with `mu`: every axis but those that follow
+    /// only the grazing layer (`adaptive`, `balanced`, `glass` map every `mu > 0` to `t = 1`
+    /// there).
+    #[must_use]
+    pub fn resolves_mu_on_a_mirror(self) -> bool {
+        matches!(
+            self,
+            MuMapping::Linear | MuMapping::Sqrt | MuMapping::SplitSum
+        )
+    }
+
     /// Whether the texture coordinate depends on the index of refraction (only on a table over
     /// the IOR).
     #[must_use]

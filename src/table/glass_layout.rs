@@ -201,7 +201,7 @@ pub fn limit_slice_eta(alpha: f64) -> f64 {
 
 /// Halvings of a coordinate's inversion: from `[0, 1]` to below 1e-30 absolute, so that a `mu`
 /// or `x` as small as 1e-20 keeps ten digits.
-const INVERSION_STEPS: u32 = 110;
+pub(crate) const INVERSION_STEPS: u32 = 110;
 
 /// `A(y; k, p) = (y (1 + k) / (y + k))^p` on `[0, 1]`: 0 at `y = 0`, 1 at `y = 1`, and 1 for
 /// every `y > 0` when `k = 0`.

@@ -15,7 +15,7 @@
 //! chosen ones, 9.2e-3 to 4.0e-2 elsewhere, against 1.01e-1 on the linear `mu` axis and
 //! 9.6e-2 on the sqrt one (where the near-mirror grazing layer of `E_bias` falls between texels).
 
-use super::glass_layout::saturation;
+use super::glass_layout::{INVERSION_STEPS, saturation};
 use crate::numerics::bisection::bisect;
 
 /// The constants of the split-sum `mu` axis (module docs).
@@ -28,9 +28,6 @@ pub struct SplitSumLayout {
     /// `p` of the fixed warp.
     pub power: f64,
 }
-
-/// Halvings of the inversion: from `[0, 1]` to below 1e-30 absolute.
-const INVERSION_STEPS: u32 = 110;
 
 impl SplitSumLayout {
     /// kiln's split-sum layout.
