@@ -39,10 +39,14 @@ pub struct BakeOptions {
     pub seed: u64,
     pub roughness_convention: RoughnessConvention,
     /// How the roughness samples are spaced along the convention's value (linear only with a
-    /// table over the IOR: [`BakeOptions::validate`]).
+    /// table over the IOR: [`BakeOptions::validate`]); `None`: the spacing of each table's `mu`
+    /// axis ([`BakeOptions::roughness_spacing_for`]).
     #[serde(default)]
-    pub roughness_spacing: RoughnessSpacing,
-    pub mu_mapping: MuMapping,
+    pub roughness_spacing: Option<RoughnessSpacing>,
+    /// The `mu` axis of every table; `None`: kiln's axis for each quantity
+    /// ([`BakeOptions::mu_mapping_for`]).
+    #[serde(default)]
+    pub mu_mapping: Option<MuMapping>,
     pub grid: Grid,
     /// Samples on the index-of-refraction axis of the dielectric tables and `F_avg` (their
     /// roughness and `mu` axes have `size` samples).
@@ -67,10 +71,11 @@ pub struct BakeOptions {
     /// `method`, `samples`, `average_samples` and `check_against_reference`, then confirms the
     /// result against the reference on a sample of texels. `None` bakes with `method` as given.
     pub max_error: Option<f64>,
-    /// Point samples (the default) or texels fitted for the bilinear lookup
-    /// ([`crate::table::lookup_fit`]), for the tables over roughness and `mu` (not over IOR).
+    /// Point samples or texels fitted for the bilinear lookup ([`crate::table::lookup_fit`]),
+    /// for the tables over roughness and `mu` (not over IOR); `None`: those of each table's `mu`
+    /// axis ([`BakeOptions::texels_for`]: fitted on the balanced axis, `E`'s default).
     #[serde(default)]
-    pub texels: Texels,
+    pub texels: Option<Texels>,
 }
 
 impl Default for BakeOptions {
@@ -85,8 +90,8 @@ impl Default for BakeOptions {
             scrambles: QmcSettings::DEFAULT_SCRAMBLES,
             seed: 0,
             roughness_convention: RoughnessConvention::Perceptual,
-            roughness_spacing: RoughnessSpacing::Linear,
-            mu_mapping: MuMapping::Adaptive,
+            roughness_spacing: None,
+            mu_mapping: None,
             grid: Grid::Nodes,
             ior_size: Self::DEFAULT_IOR_SIZE,
             ior_mapping: IorMapping::Glass,
@@ -96,7 +101,7 @@ impl Default for BakeOptions {
             check_against_reference: true,
             method: Method::Qmc,
             max_error: Some(Self::DEFAULT_MAX_ERROR),
-            texels: Texels::Nodes,
+            texels: None,
         }
     }
 }
@@ -112,6 +117,12 @@ impl BakeOptions {
     /// The tables baked per model by default: `E`, `E_avg` and the lookup-consistent
     /// normalisation of the Kulla-Conty lobe (`f_ms_norm`, [`crate::table::normalisation`]).
     pub const DEFAULT_QUANTITIES: [Quantity; 3] = [Quantity::E, Quantity::EAvg, Quantity::FMsNorm];
+    /// The largest table whose texels are fitted for the lookup unless `texels` says otherwise
+    /// ([`BakeOptions::texels_for`]), per axis. The fit's cost grows with the texels times its
+    /// points a cell (4.0 s at 64, 22 s at 128 on 2 cores, 2026-12-05) and beyond 128 it
+    /// would cost more than any other part of the bake, while the point samples' lookup
+    /// error is already 4.1e-5 at 128 and falls as `N^-2`.
+    pub const LARGEST_FITTED_BY_DEFAULT: usize = 128;
     /// The largest size accepted per axis.
     pub const MAX_SIZE: usize = 4096;
     /// The default IOR axis size, 16 (Cycles' glass tables are 16 x 16 x 16).
@@ -142,7 +153,7 @@ impl BakeOptions {
                 crate::error::shown(self.ior_max)
             )));
         }
-        if self.texels == Texels::LookupFit
+        if self.texels == Some(Texels::LookupFit)
             && let Some(q) = self.quantities().into_iter().find(|q| q.has_ior())
         {
             return Err(Error::InvalidInput(format!(
@@ -152,8 +163,10 @@ impl BakeOptions {
                 q.symbol()
             )));
         }
-        if self.roughness_spacing == RoughnessSpacing::Balanced
-            && let Some(q) = self.quantities().into_iter().find(|q| q.has_ior())
+        if let Some(q) = self
+            .quantities()
+            .into_iter()
+            .find(|&q| q.has_ior() && self.roughness_spacing_for(q) == RoughnessSpacing::Balanced)
         {
             return Err(Error::InvalidInput(format!(
                 "--roughness-spacing balanced (the default with --mu-axis balanced) lays out the \
@@ -185,27 +198,31 @@ impl BakeOptions {
             )));
         }
         if self.ior_mapping == IorMapping::Glass
-            && self.mu_mapping != MuMapping::Adaptive
-            && let Some(q) = self.quantities.iter().find(|q| q.has_ior() && q.has_mu())
+            && let Some(q) = self.quantities.iter().find(|&&q| {
+                q.has_ior() && q.has_mu() && self.mu_mapping_for(q) != MuMapping::Adaptive
+            })
         {
+            let mapping = self.mu_mapping_for(*q);
             return Err(Error::InvalidInput(format!(
                 "--quantity {} with --mu-axis {}: kiln's glass layout (--ior-axis glass, the \
                  default) lays out mu itself, tied to roughness and the IOR; for a {} mu axis \
                  use the product grid, --ior-axis cycles or linear",
                 q.cli_name(),
-                self.mu_mapping.name(),
-                self.mu_mapping.name()
+                mapping.name(),
+                mapping.name()
             )));
         }
-        if !self.mu_mapping.resolves_mu_on_a_mirror()
-            && let Some(q) = self.quantities.iter().find(|q| q.varies_on_a_mirror())
+        if let Some(q) = self
+            .quantities
+            .iter()
+            .find(|&&q| q.varies_on_a_mirror() && !self.mu_mapping_for(q).resolves_mu_on_a_mirror())
         {
             return Err(Error::InvalidInput(format!(
                 "--quantity {} needs --mu-axis split-sum (kiln's layout for it), linear or sqrt: \
                  the {} mu axis follows E's grazing layer and maps every mu > 0 to t = 1 at \
                  roughness 0, where {} still varies with mu",
                 q.cli_name(),
-                self.mu_mapping.name(),
+                self.mu_mapping_for(*q).name(),
                 if *q == Quantity::EF {
                     "E_F = F(mu)"
                 } else {
@@ -387,6 +404,40 @@ impl BakeOptions {
         options
     }
 
+    /// The `mu` axis of `quantity`'s table: the one named, or kiln's axis for it
+    /// ([`MuMapping::kiln_default`]). `f_ms_norm` and `E_avg` follow `E`'s.
+    #[must_use]
+    pub fn mu_mapping_for(&self, quantity: Quantity) -> MuMapping {
+        self.mu_mapping
+            .unwrap_or_else(|| MuMapping::kiln_default(quantity))
+    }
+
+    /// The roughness spacing of `quantity`'s table: the one named, or the one that goes with
+    /// its `mu` axis ([`RoughnessSpacing::paired_with`]).
+    #[must_use]
+    pub fn roughness_spacing_for(&self, quantity: Quantity) -> RoughnessSpacing {
+        self.roughness_spacing
+            .unwrap_or_else(|| RoughnessSpacing::paired_with(self.mu_mapping_for(quantity)))
+    }
+
+    /// The texels of `quantity`'s table: point samples over the IOR; elsewhere those named, or
+    /// those that go with its `mu` axis ([`Texels::paired_with`]: fitted on the balanced axis)
+    /// up to [`BakeOptions::LARGEST_FITTED_BY_DEFAULT`] texels a side, point samples beyond
+    /// (named `-nodes`).
+    #[must_use]
+    pub fn texels_for(&self, quantity: Quantity) -> Texels {
+        if quantity.has_ior() {
+            return Texels::Nodes;
+        }
+        self.texels.unwrap_or_else(|| {
+            if self.size > Self::LARGEST_FITTED_BY_DEFAULT {
+                Texels::Nodes
+            } else {
+                Texels::paired_with(self.mu_mapping_for(quantity))
+            }
+        })
+    }
+
     /// With a `max_error` the quadrature bakes (below 1e-3, or any for glass): its tolerance
     /// `10^-digits` (see [`BakeOptions::resolved`]).
     #[must_use]
@@ -448,15 +499,15 @@ impl BakeOptions {
             }),
             grid: self.grid,
         };
-        let roughness = Axis::Roughness {
+        let roughness = |quantity| Axis::Roughness {
             size: self.size,
             convention: self.roughness_convention,
             grid: self.grid,
-            spacing: self.roughness_spacing,
+            spacing: self.roughness_spacing_for(quantity),
         };
-        let mu = Axis::Mu {
+        let mu = |quantity| Axis::Mu {
             size: self.size,
-            mapping: self.mu_mapping,
+            mapping: self.mu_mapping_for(quantity),
             grid: self.grid,
         };
         // A tolerance only means something to the quadrature.
@@ -481,11 +532,7 @@ impl BakeOptions {
                             reference_digits,
                             lookup_of: None,
                             refined_start: None,
-                            texels: if quantity.has_ior() {
-                                Texels::Nodes
-                            } else {
-                                self.texels
-                            },
+                            texels: self.texels_for(quantity),
                             transmission: if quantity.has_ior() && quantity != Quantity::FAvg {
                                 self.transmission
                             } else {
@@ -501,12 +548,12 @@ impl BakeOptions {
                                 },
                             ),
                             fresnel: self.fresnel.filter(|_| quantity == Quantity::EF),
-                            roughness: quantity.has_roughness().then_some(roughness),
+                            roughness: quantity.has_roughness().then(|| roughness(quantity)),
                             mu: quantity.has_mu().then_some(
                                 if glass_layout && quantity.has_ior() {
                                     glass_mu
                                 } else {
-                                    mu
+                                    mu(quantity)
                                 },
                             ),
                             method: self.method,
@@ -568,53 +615,49 @@ impl BakeOptions {
     /// every setting spelled out.
     #[must_use]
     pub fn command_for(&self, model: Model) -> String {
-        let command = self.command_without_texels(model);
-        // The CLI's default spacing goes with the mu axis.
-        let command = if self.roughness_spacing == RoughnessSpacing::paired_with(self.mu_mapping) {
-            command
-        } else {
-            format!(
-                "{command} --roughness-spacing {}",
-                self.roughness_spacing.name()
-            )
-        };
-        match self.texels {
-            Texels::Nodes => command,
-            texels => format!("{command} --texels {}", texels.name()),
+        let mut command = self.command_without_layout(model);
+        // What is not named is kiln's layout for each quantity, which the metadata spells out.
+        if let Some(mapping) = self.mu_mapping {
+            command += &format!(" --mu-axis {}", mapping.name());
         }
+        if let Some(spacing) = self.roughness_spacing {
+            command += &format!(" --roughness-spacing {}", spacing.name());
+        }
+        if let Some(texels) = self.texels {
+            command += &format!(" --texels {}", texels.name());
+        }
+        command
     }
 
-    fn command_without_texels(&self, model: Model) -> String {
+    fn command_without_layout(&self, model: Model) -> String {
         if let Some(max_error) = self.max_error {
             return format!(
                 "kiln bake --max-error {max_error:e}{} --ndf {} --masking {} --size {} --seed {} \
-                 --roughness-axis {} --mu-axis {} --grid {}",
+                 --roughness-axis {} --grid {}",
                 self.quantity_flag(),
                 model.ndf,
                 model.masking,
                 self.size,
                 self.seed,
                 self.roughness_convention,
-                self.mu_mapping.name(),
                 self.grid.name()
             );
         }
         if self.method == Method::Reference {
             return format!(
                 "kiln bake --method reference{} --ndf {} --masking {} --size {} --roughness-axis {} \
-                 --mu-axis {} --grid {}",
+                 --grid {}",
                 self.quantity_flag(),
                 model.ndf,
                 model.masking,
                 self.size,
                 self.roughness_convention,
-                self.mu_mapping.name(),
                 self.grid.name()
             );
         }
         format!(
             "kiln bake{} --ndf {} --masking {} --size {} --samples {} --avg-samples {} \
-             --scrambles {} --seed {} --roughness-axis {} --mu-axis {} --grid {}",
+             --scrambles {} --seed {} --roughness-axis {} --grid {}",
             self.quantity_flag(),
             model.ndf,
             model.masking,
@@ -624,7 +667,6 @@ impl BakeOptions {
             self.scrambles,
             self.seed,
             self.roughness_convention,
-            self.mu_mapping.name(),
             self.grid.name()
         )
     }

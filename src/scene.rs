@@ -531,14 +531,10 @@ impl Scene {
                 needs.push((base.clone(), Some(Effect::MultipleScattering), model));
             }
             if asked(Effect::ImageBasedLighting) {
-                // The split-sum channels vary with mu on a mirror (`Fc(mu) = (1 - mu)^5`),
-                // which the adaptive mu axis cannot follow: on kiln's split-sum mu axis, as
-                // `kiln bake --quantity e-scale,e-bias` (an engine's scene gets the engine's).
+                // On kiln's split-sum mu axis, as `kiln bake --quantity e-scale,e-bias` (an
+                // engine's scene gets the engine's layout).
                 let split_sum = crate::BakeOptions {
                     quantities: vec![Quantity::EScale, Quantity::EBias],
-                    mu_mapping: crate::MuMapping::SplitSum,
-                    // The balanced rows are laid out for the balanced mu axis.
-                    roughness_spacing: crate::RoughnessSpacing::Linear,
                     ..base.clone()
                 };
                 needs.push((split_sum, Some(Effect::ImageBasedLighting), model));

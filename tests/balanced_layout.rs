@@ -26,9 +26,9 @@ fn bake(size: usize, mu_mapping: MuMapping, roughness_spacing: RoughnessSpacing)
     BakeOptions {
         quantities: vec![Quantity::E],
         size,
-        mu_mapping,
-        roughness_spacing,
-        texels: Texels::LookupFit,
+        mu_mapping: Some(mu_mapping),
+        roughness_spacing: Some(roughness_spacing),
+        texels: Some(Texels::LookupFit),
         ..BakeOptions::default()
     }
     .bake(&|_| {})
@@ -195,9 +195,9 @@ fn the_balanced_layout_beats_the_adaptive_at_other_sizes() {
 fn the_normalisation_of_balanced_rows_round_trips_through_the_generated_code() {
     let tables = BakeOptions {
         size: 8,
-        mu_mapping: MuMapping::Balanced,
-        roughness_spacing: RoughnessSpacing::Balanced,
-        texels: Texels::LookupFit,
+        mu_mapping: Some(MuMapping::Balanced),
+        roughness_spacing: Some(RoughnessSpacing::Balanced),
+        texels: Some(Texels::LookupFit),
         ..BakeOptions::default()
     }
     .bake(&|_| {})

@@ -678,8 +678,8 @@ fn generated_rust_compiles_for_every_layout() {
     let lib = dir.path().join("lib.rs");
     std::fs::write(
         &lib,
-        "#![deny(warnings)]\ninclude!(\"tables/ggx-height-correlated-E-alpha-mu-sqrt.rs\");\ninclude!(\"tables/ggx-height-correlated-E_avg-alpha.rs\");\n\
-         pub fn corner() -> f32 { GGX_HEIGHT_CORRELATED_E_ALPHA_MU_SQRT[4][0] + GGX_HEIGHT_CORRELATED_E_AVG_ALPHA[0] + GGX_HEIGHT_CORRELATED_E_ALPHA_MU_SQRT_MU[4] }\n",
+        "#![deny(warnings)]\ninclude!(\"tables/ggx-height-correlated-E-alpha-mu-sqrt.rs\");\ninclude!(\"tables/ggx-height-correlated-E_avg-alpha-rows-linear.rs\");\n\
+         pub fn corner() -> f32 { GGX_HEIGHT_CORRELATED_E_ALPHA_MU_SQRT[4][0] + GGX_HEIGHT_CORRELATED_E_AVG_ALPHA_ROWS_LINEAR[0] + GGX_HEIGHT_CORRELATED_E_ALPHA_MU_SQRT_MU[4] }\n",
     )
     .unwrap();
     let rustc = std::env::var("RUSTC").unwrap_or_else(|_| "rustc".into());

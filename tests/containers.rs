@@ -13,7 +13,7 @@ fn tables() -> &'static [Table] {
         let options = BakeOptions {
             size: 5,
             ior_size: 3,
-            mu_mapping: MuMapping::Linear,
+            mu_mapping: Some(MuMapping::Linear),
             max_error: Some(1e-4),
             ..BakeOptions::default()
         };
@@ -23,7 +23,7 @@ fn tables() -> &'static [Table] {
                 quantities: vec![Quantity::EDielectric, Quantity::FAvg],
                 size: 3,
                 // kiln's glass layout, whose mu coordinate is its own.
-                mu_mapping: MuMapping::Adaptive,
+                mu_mapping: Some(MuMapping::Adaptive),
                 ..options
             }
             .bake(&|_| {})

@@ -36,10 +36,12 @@ fn committed(name: &str) -> kiln::Table {
     kiln::verify::input::read_kiln(&path).unwrap().unwrap()
 }
 
-/// The lookup-error goal: the default 32 x 32 E table's bilinear lookup is within 1e-3 of the
-/// reference everywhere `verify` looks (a ladder at half-texel steps over both axes including
-/// their ends, and grazing probes down to mu = 0 on every roughness rung). A linear-mu table of
-/// the same size misses by about 1e-1 near grazing (README).
+/// The lookup-error goal (issue 39): the default 32 x 32 E table's bilinear lookup is within
+/// 2.5e-4 of the reference everywhere `verify` looks (a ladder at half-texel steps over both
+/// axes including their ends, and grazing probes down to mu = 0 on every roughness rung); the
+/// point samples of the adaptive axis, the default before, were 6.5e-4 off. Its texels are
+/// fitted for the lookup, so they are off the truth at their nodes by design: by no more than
+/// the file states, and the lookup error it states is no smaller than the audit finds.
 #[test]
 fn default_e_table_meets_the_lookup_error_goal() {
     use kiln::integrate::reference::ReferenceSettings;
@@ -53,12 +55,27 @@ fn default_e_table_meets_the_lookup_error_goal() {
     );
     assert!(report.reference_converged);
     assert!(
-        report.lookup_max_error <= 1e-3,
+        report.lookup_max_error <= 2.5e-4,
         "lookup max error {:.2e} at {:?}",
         report.lookup_max_error,
         report.worst_lookup
     );
-    // The stored values meet the default bake's max error at every node, not only on the
-    // sample the bake checked.
-    assert!(report.node_max_error <= kiln::BakeOptions::DEFAULT_MAX_ERROR);
+    // What the sidecar states.
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tables/ggx-height-correlated-E.json");
+    let meta: serde_json::Value = serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap();
+    let stated_lookup = meta["lookup_fit"]["lookup_max_error"]
+        .as_f64()
+        .expect("the default E is fitted for the lookup");
+    // The fit's truth is at 1e-6, the audit's at its own tolerance: 2e-6 between them.
+    assert!(
+        report.lookup_max_error <= stated_lookup + 2e-6,
+        "{:.3e} found, {stated_lookup:.3e} stated",
+        report.lookup_max_error,
+    );
+    let stated = meta["node_max_error"].as_f64().unwrap();
+    assert!(
+        report.node_max_error <= stated && stated < 2.5e-4,
+        "{:.3e} found, {stated:.3e} stated",
+        report.node_max_error
+    );
 }

@@ -114,7 +114,7 @@ fn split_sum_tables_bake_verify_and_round_trip() {
     let options = BakeOptions {
         size: 8,
         quantities: vec![Quantity::EScale, Quantity::EBias, Quantity::E],
-        mu_mapping: MuMapping::Linear,
+        mu_mapping: Some(MuMapping::Linear),
         max_error: Some(1e-6),
         ..BakeOptions::default()
     };
@@ -172,7 +172,7 @@ fn split_sum_tables_bake_verify_and_round_trip() {
 
     // The adaptive mu axis cannot hold a split-sum channel at roughness 0; kiln names its own.
     let adaptive = BakeOptions {
-        mu_mapping: MuMapping::Adaptive,
+        mu_mapping: Some(MuMapping::Adaptive),
         ..options
     };
     let error = adaptive.validate().unwrap_err().to_string();
@@ -188,7 +188,7 @@ fn split_sum_qmc_tables_match_the_reference() {
     let options = BakeOptions {
         size: 6,
         quantities: vec![Quantity::EBias],
-        mu_mapping: MuMapping::Linear,
+        mu_mapping: Some(MuMapping::Linear),
         samples: 1 << 14,
         max_error: None,
         ..BakeOptions::default()
@@ -226,7 +226,7 @@ fn fresnel_weighted_tables_bake_for_the_model_named() {
     use kiln::{BakeOptions, MuMapping, Quantity};
     let base = BakeOptions {
         size: 6,
-        mu_mapping: MuMapping::Sqrt,
+        mu_mapping: Some(MuMapping::Sqrt),
         max_error: Some(1e-6),
         ..BakeOptions::default()
     };
@@ -312,7 +312,7 @@ fn fresnel_weighted_tables_bake_for_the_model_named() {
             BakeOptions {
                 quantities: vec![Quantity::EF],
                 fresnel: Some(Fresnel::Dielectric { eta: 1.5 }),
-                mu_mapping: MuMapping::Adaptive,
+                mu_mapping: Some(MuMapping::Adaptive),
                 ..base.clone()
             },
             "E_F = F(mu)",

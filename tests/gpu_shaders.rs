@@ -56,9 +56,9 @@ const TASKS: [Task; 5] = [
     },
     Task {
         outputs: 2,
-        wgsl: "let v = ggx_height_correlated_e_mu_balanced_centers_lookup_fit_lookup(c_table, kiln_sampler, points[2u * k], points[2u * k + 1u]);\n\
+        wgsl: "let v = ggx_height_correlated_e_bias_centers_lookup(c_table, kiln_sampler, points[2u * k], points[2u * k + 1u]);\n\
                results[2u * k] = v.x; results[2u * k + 1u] = v.y;",
-        glsl: "vec2 v = textureLod(sampler2D(c_table, kiln_sampler), ggx_height_correlated_e_mu_balanced_centers_lookup_fit_uv(points[2u * k], points[2u * k + 1u]), 0.0).rg;\n\
+        glsl: "vec2 v = textureLod(sampler2D(c_table, kiln_sampler), ggx_height_correlated_e_bias_centers_uv(points[2u * k], points[2u * k + 1u]), 0.0).rg;\n\
                results[2u * k] = v.x; results[2u * k + 1u] = v.y;",
     },
     Task {

@@ -11,6 +11,8 @@ fn small_e_table() -> Table {
         quantities: vec![Quantity::E],
         size: 4,
         max_error: Some(1e-4),
+        // Point samples, exact to the bound at every node.
+        texels: Some(kiln::table::Texels::Nodes),
         ..BakeOptions::default()
     }
     .bake(&|_| {})

@@ -1,12 +1,14 @@
 //! Texels fitted for the lookup (`kiln bake --texels lookup-fit`, issue 39): what a renderer
 //! reads, the bilinear lookup, is about half as far from the truth as the point samples'
 //! lookup, at every size from 8 to 64, measured at `kiln verify`'s audit points (not the fit's)
-//! against the reference and through the generated Rust lookup executed.
+//! against the reference and through the generated Rust lookup executed. On the adaptive mu
+//! axis (the default before the balanced layout, `tests/balanced_layout.rs`), whose figures
+//! these are.
 
 #[allow(dead_code)] // the files' ONE_MINUS, STD_ERROR and axis constants are not read here
 mod generated {
-    include!("data/lookup-fit/ggx-height-correlated-E-lookup-fit.rs");
-    include!("../tables/ggx-height-correlated-E.rs");
+    include!("data/lookup-fit/ggx-height-correlated-E-mu-adaptive-lookup-fit.rs");
+    include!("data/lookup-fit/ggx-height-correlated-E-mu-adaptive.rs");
 }
 
 use kiln::integrate::reference::ReferenceSettings;
@@ -23,7 +25,8 @@ fn bake(size: usize, quantity: Quantity, texels: Texels) -> Table {
         maskings: vec![Masking::HeightCorrelated],
         quantities: vec![quantity],
         size,
-        texels,
+        mu_mapping: Some(kiln::MuMapping::Adaptive),
+        texels: Some(texels),
         ..BakeOptions::default()
     };
     options.bake(&|_| {}).unwrap().remove(0)
@@ -70,8 +73,8 @@ fn where_the_axis_cannot_follow_the_fit_is_no_worse() {
     let bake = |texels| {
         let options = BakeOptions {
             quantities: vec![Quantity::EBias],
-            mu_mapping: kiln::table::axis::MuMapping::Sqrt,
-            texels,
+            mu_mapping: Some(kiln::table::axis::MuMapping::Sqrt),
+            texels: Some(texels),
             ..BakeOptions::default()
         };
         let table = options.bake(&|_| {}).unwrap().remove(0);
@@ -97,21 +100,29 @@ fn where_the_axis_cannot_follow_the_fit_is_no_worse() {
     );
 }
 
-/// The committed fitted 32 x 32 table (`kiln bake --quantity e --texels lookup-fit --format
-/// rs,json --out tests/data/lookup-fit`) is what the code bakes now, its generated Rust lookup
+/// The committed fitted 32 x 32 table (`kiln bake --quantity e --mu-axis adaptive --texels
+/// lookup-fit --format rs,json --out tests/data/lookup-fit`, and its point samples without
+/// `--texels` as `rs`) is what the code bakes now, its generated Rust lookup
 /// executed is within 3.4e-4 of the truth at the audit's 5980 points where the point samples'
 /// is 6.5e-4 off, and Turquin's furnace closes to 1e-3 with it (6.5e-4; 1.25e-3 with the point
 /// samples).
 #[test]
 fn the_generated_lookup_of_a_fitted_table_halves_the_error() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/data/lookup-fit/ggx-height-correlated-E-lookup-fit.json");
+        .join("tests/data/lookup-fit/ggx-height-correlated-E-mu-adaptive-lookup-fit.json");
     let committed = read_kiln(&path).unwrap().unwrap();
     assert_eq!(committed.spec.texels, Texels::LookupFit);
     let fresh = bake(32, Quantity::E, Texels::LookupFit);
+    let nodes_table = bake(32, Quantity::E, Texels::Nodes);
+    let stored: Vec<f32> = generated::GGX_HEIGHT_CORRELATED_E_MU_ADAPTIVE
+        .iter()
+        .flatten()
+        .copied()
+        .collect();
+    let baked: Vec<f32> = nodes_table.value.iter().map(|&v| v as f32).collect();
     assert!(
-        committed.value == fresh.value,
-        "tests/data/lookup-fit is not what the code bakes now: re-bake it with the command above"
+        committed.value == fresh.value && stored == baked,
+        "tests/data/lookup-fit is not what the code bakes now: re-bake it with the commands above"
     );
 
     let integral = committed.spec.integral();
@@ -128,13 +139,13 @@ fn the_generated_lookup_of_a_fitted_table_halves_the_error() {
                 .reference(kiln::integrate::value::Point { alpha, mu, eta }, &reference)
                 .value;
             let (mu, r) = (mu.unwrap() as f32, alpha.sqrt() as f32);
-            let fitted = generated::ggx_height_correlated_e_lookup_fit_lookup(
-                &generated::GGX_HEIGHT_CORRELATED_E_LOOKUP_FIT,
+            let fitted = generated::ggx_height_correlated_e_mu_adaptive_lookup_fit_lookup(
+                &generated::GGX_HEIGHT_CORRELATED_E_MU_ADAPTIVE_LOOKUP_FIT,
                 mu,
                 r,
             );
-            let nodes = generated::ggx_height_correlated_e_lookup(
-                &generated::GGX_HEIGHT_CORRELATED_E,
+            let nodes = generated::ggx_height_correlated_e_mu_adaptive_lookup(
+                &generated::GGX_HEIGHT_CORRELATED_E_MU_ADAPTIVE,
                 mu,
                 r,
             );
@@ -152,11 +163,6 @@ fn the_generated_lookup_of_a_fitted_table_halves_the_error() {
             .unwrap()
             .max_deviation
     };
-    let nodes_table = read_kiln(
-        &Path::new(env!("CARGO_MANIFEST_DIR")).join("tables/ggx-height-correlated-E.json"),
-    )
-    .unwrap()
-    .unwrap();
     let (fitted, nodes) = (turquin(&committed), turquin(&nodes_table));
     assert!(fitted <= 1e-3 && nodes > 1.2e-3, "{fitted:.3e} {nodes:.3e}");
 }
@@ -199,7 +205,7 @@ fn the_command_line_fits_what_it_can_and_judges_fitted_tables_by_their_lookup() 
     assert_eq!(scene.status.code(), Some(2));
     let file = concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/tests/data/lookup-fit/ggx-height-correlated-E-lookup-fit.json"
+        "/tests/data/lookup-fit/ggx-height-correlated-E-mu-adaptive-lookup-fit.json"
     );
     let out = command::kiln(&["verify", file, "--max-error", "1e-3"]);
     assert_eq!(out.status.code(), Some(0));
@@ -265,7 +271,7 @@ fn a_fitted_bake_reports_its_fit_to_the_progress_bar() {
             maskings: vec![Masking::HeightCorrelated],
             quantities: vec![Quantity::E],
             size: 8,
-            texels,
+            texels: Some(texels),
             ..BakeOptions::default()
         };
         let reported = AtomicU64::new(0);

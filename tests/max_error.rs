@@ -7,10 +7,13 @@ mod common;
 use common::reference_e;
 use kiln::{BakeOptions, Method, Quantity};
 
+/// The default tables to `max_error`, as point samples: the bound is on the integration, which
+/// fitted texels then move by the lookup error they remove (tests/lookup_fit.rs).
 fn bake(max_error: f64) -> Vec<kiln::Table> {
     let options = BakeOptions {
         size: 8,
         max_error: Some(max_error),
+        texels: Some(kiln::table::Texels::Nodes),
         ..BakeOptions::default()
     };
     options.bake(&|_| {}).expect("a valid bound")

@@ -162,9 +162,9 @@ fn the_default_normalisation_through_its_generated_lookup_is_within_1e_4_relativ
 #[test]
 fn the_balanced_fitted_normalisation_is_within_1e_4_relative() {
     let tables = BakeOptions {
-        mu_mapping: MuMapping::Balanced,
-        roughness_spacing: RoughnessSpacing::Balanced,
-        texels: Texels::LookupFit,
+        mu_mapping: Some(MuMapping::Balanced),
+        roughness_spacing: Some(RoughnessSpacing::Balanced),
+        texels: Some(Texels::LookupFit),
         ..BakeOptions::default()
     }
     .bake(&|_| {})

@@ -94,10 +94,12 @@ fn bakes_and_refuses_beckmann() {
         maskings: vec![Masking::SchlickGgx],
         size: 5,
         max_error: Some(1e-6),
+        // Point samples, exact to the bound at every node.
+        texels: Some(kiln::table::Texels::Nodes),
         ..BakeOptions::default()
     };
     let tables = options.bake(&|_| {}).unwrap();
-    assert_eq!(tables[0].spec.id(), "ggx-schlick-ggx-E");
+    assert_eq!(tables[0].spec.id(), "ggx-schlick-ggx-E-nodes");
     for t in tables
         .iter()
         .filter(|t| t.spec.quantity != Quantity::FMsNorm)
@@ -107,7 +109,7 @@ fn bakes_and_refuses_beckmann() {
     // Its split-sum channels add up to its E (Godot imports this model's DFG table).
     let split = BakeOptions {
         quantities: vec![Quantity::EScale, Quantity::EBias, Quantity::E],
-        mu_mapping: MuMapping::Linear,
+        mu_mapping: Some(MuMapping::Linear),
         ..options.clone()
     }
     .bake(&|_| {})

@@ -298,11 +298,7 @@ fn generated_shaders_run_and_agree_with_the_library() {
         main += "int main() {\n";
         for (texture, stem, array) in [
             ("E", "ggx_height_correlated_e", "E_POINTS"),
-            (
-                "C",
-                "ggx_height_correlated_e_mu_balanced_centers_lookup_fit",
-                "C_POINTS",
-            ),
+            ("C", "ggx_height_correlated_e_bias_centers", "C_POINTS"),
         ] {
             let _ = writeln!(
                 main,

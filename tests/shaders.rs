@@ -20,7 +20,7 @@ fn tables() -> Vec<Table> {
     tables.extend(
         BakeOptions {
             quantities: vec![Quantity::E, Quantity::EDielectric, Quantity::FAvg],
-            mu_mapping: MuMapping::Sqrt,
+            mu_mapping: Some(MuMapping::Sqrt),
             grid: Grid::Centers,
             ior_mapping: kiln::IorMapping::Cycles,
             ..base.clone()
@@ -31,8 +31,8 @@ fn tables() -> Vec<Table> {
     // kiln's balanced layout, whose lookups compute both coordinates.
     tables.extend(
         BakeOptions {
-            mu_mapping: MuMapping::Balanced,
-            roughness_spacing: kiln::RoughnessSpacing::Balanced,
+            mu_mapping: Some(MuMapping::Balanced),
+            roughness_spacing: Some(kiln::RoughnessSpacing::Balanced),
             ..base.clone()
         }
         .bake(&|_| {})
@@ -42,7 +42,7 @@ fn tables() -> Vec<Table> {
     tables.extend(
         BakeOptions {
             quantities: vec![Quantity::EScale, Quantity::EBias],
-            mu_mapping: MuMapping::SplitSum,
+            mu_mapping: Some(MuMapping::SplitSum),
             ..base.clone()
         }
         .bake(&|_| {})

@@ -25,8 +25,8 @@ mod rustc;
 fn bake(mu_mapping: MuMapping, texels: Texels) -> Vec<Table> {
     BakeOptions {
         quantities: vec![Quantity::EScale, Quantity::EBias],
-        mu_mapping,
-        texels,
+        mu_mapping: Some(mu_mapping),
+        texels: Some(texels),
         ..BakeOptions::default()
     }
     .bake(&|_| {})

@@ -194,6 +194,8 @@ fn scaling_study_measures_what_it_reports() {
         size: 4,
         ior_size: 4,
         max_error: Some(1e-4),
+        // The study's layout: the adaptive axis' point samples on linear rows.
+        mu_mapping: Some(MuMapping::Adaptive),
         ..BakeOptions::default()
     }
     .bake(&|_| {})

@@ -165,15 +165,15 @@ fn coordinate_code(axis: &Axis) -> String {
                 RoughnessConvention::Alpha => "roughness.clamp(0.0, 1.0).sqrt()",
             };
             let p = l.roughness_power_terms();
+            // P's numerator as d^2h ((1 + s)^h - 1), s = r^2 / d^2, by ln_1p and exp_m1: the
+            // difference of the powers cancels in f32 below r ~ d.
             format!(
                 "{{\n        let r = {r};\n        \
-                 let power = ((r * r + {:?}).powf({:?}) - {:?}) / {:?};\n        \
-                 {:?} * power + {:?} * r * r * (3.0 - 2.0 * r)\n    }}",
+                 let rise = ((r * r / {:?}).ln_1p() * {:?}).exp_m1();\n        \
+                 {:?} * rise + {:?} * r * r * (3.0 - 2.0 * r)\n    }}",
                 p.offset_squared as f32,
                 p.half_power as f32,
-                p.low as f32,
-                p.scale as f32,
-                (1.0 - l.roughness_knee) as f32,
+                ((1.0 - l.roughness_knee) * p.low / p.scale) as f32,
                 l.roughness_knee as f32,
             )
         }

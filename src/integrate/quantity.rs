@@ -161,9 +161,9 @@ impl Quantity {
             Quantity::FMsNorm => {
                 "lookup-consistent Kulla-Conty normalisation, Ebar(r) = 2 * integral of \
                  E_lookup(mu, r) mu dmu the average of the E table's own bilinear lookup (the \
-                 table in lookup_of), stored as (1 - Ebar(r)) / r when that E table has an \
-                 adaptive mu axis on nodes (multiply the lookup by r, the roughness coordinate) \
-                 and as 1 - Ebar(r) otherwise; 1 - Ebar is the denominator of f_ms = (1 - E(mu_o)) \
+                 table in lookup_of), stored as (1 - Ebar(r)) / x when that E table has an \
+                 adaptive or balanced mu axis on nodes (multiply the lookup by x, the rows' \
+                 coordinate: r on linear rows) and as 1 - Ebar(r) otherwise; 1 - Ebar is the denominator of f_ms = (1 - E(mu_o)) \
                  (1 - E(mu_i)) / (pi (1 - Ebar)); not E_avg, which is the exact average; \
                  one_minus_f_ms_norm is 1 - the value"
             }

@@ -318,11 +318,11 @@ impl Preset {
             quantities: layout.tables.to_vec(),
             size: layout.size,
             grid: layout.grid,
-            mu_mapping: layout.mu_mapping,
+            mu_mapping: Some(layout.mu_mapping),
             roughness_convention: RoughnessConvention::Perceptual,
             // The engines' files: linear rows, point samples (`--texels lookup-fit` asks).
-            roughness_spacing: crate::table::axis::RoughnessSpacing::Linear,
-            texels: crate::table::Texels::Nodes,
+            roughness_spacing: Some(crate::table::axis::RoughnessSpacing::Linear),
+            texels: Some(crate::table::Texels::Nodes),
             ..BakeOptions::default()
         }
     }

@@ -118,12 +118,12 @@ impl StudySettings {
 fn e_spec(model: Model, size: usize, mapping: MuMapping, method: Method) -> TableSpec {
     let options = BakeOptions {
         size,
-        mu_mapping: mapping,
+        mu_mapping: Some(mapping),
         grid: Grid::Nodes,
         method,
         max_error: None,
-        roughness_spacing: crate::table::axis::RoughnessSpacing::Linear,
-        texels: crate::table::Texels::Nodes,
+        roughness_spacing: Some(crate::table::axis::RoughnessSpacing::Linear),
+        texels: Some(crate::table::Texels::Nodes),
         ..BakeOptions::default()
     };
     let mut spec = options.specs().remove(0);

@@ -103,11 +103,11 @@ impl ScalingSettings {
             quantities: case.quantities.clone(),
             size,
             ior_size: size,
-            mu_mapping: case.mu_mapping,
+            mu_mapping: Some(case.mu_mapping),
             max_error: Some(self.max_error),
             // The study measures point samples on linear rows, whatever the mu axis.
-            roughness_spacing: crate::table::axis::RoughnessSpacing::Linear,
-            texels: crate::table::Texels::Nodes,
+            roughness_spacing: Some(crate::table::axis::RoughnessSpacing::Linear),
+            texels: Some(crate::table::Texels::Nodes),
             ..BakeOptions::default()
         }
     }

@@ -133,15 +133,36 @@ impl MuMapping {
         }
     }
 
-    /// kiln's `mu` axis for a bake of `quantities`: [`MuMapping::SplitSum`] when one of them
-    /// varies with `mu` on a mirror (the adaptive axis maps every `mu > 0` to `t = 1` there),
-    /// [`MuMapping::Adaptive`] otherwise.
+    /// The tag of a table on this axis where it is not kiln's axis for the quantity
+    /// ([`crate::table::TableSpec::id`]): `mu-` and the name.
     #[must_use]
-    pub fn default_for(quantities: &[crate::integrate::quantity::Quantity]) -> Self {
-        if quantities.iter().any(|q| q.varies_on_a_mirror()) {
+    pub fn tag(self) -> &'static str {
+        match self {
+            MuMapping::Linear => "mu-linear",
+            MuMapping::Sqrt => "mu-sqrt",
+            MuMapping::Adaptive => "mu-adaptive",
+            MuMapping::Glass => "mu-glass",
+            MuMapping::Balanced => "mu-balanced",
+            MuMapping::SplitSum => "mu-split-sum",
+        }
+    }
+
+    /// kiln's `mu` axis for `quantity` (the layout a bake gives it when no `--mu-axis` is
+    /// named, and the one its file name leaves untagged):
+    /// - [`MuMapping::SplitSum`] for the quantities that vary with `mu` on a mirror (the split-sum
+    ///   channels and `E_F`: the grazing-layer axes map every `mu > 0` to `t = 1` there);
+    /// - [`MuMapping::Adaptive`] for the tables over the IOR (kiln's glass layout replaces it
+    ///   with [`MuMapping::Glass`]; Cycles' product grid keeps it);
+    /// - [`MuMapping::Balanced`] for `E` and what derives from it (`E_avg`, `f_ms_norm`), whose
+    ///   texels are fitted for the lookup on it ([`crate::table::Texels::paired_with`]).
+    #[must_use]
+    pub fn kiln_default(quantity: crate::integrate::quantity::Quantity) -> Self {
+        if quantity.varies_on_a_mirror() {
             MuMapping::SplitSum
-        } else {
+        } else if quantity.has_ior() {
             MuMapping::Adaptive
+        } else {
+            MuMapping::Balanced
         }
     }
 
@@ -304,6 +325,16 @@ impl RoughnessSpacing {
         match self {
             RoughnessSpacing::Linear => "linear",
             RoughnessSpacing::Balanced => "balanced",
+        }
+    }
+
+    /// The tag of rows spaced so where they are not those of the table's `mu` axis
+    /// ([`crate::table::TableSpec::id`]).
+    #[must_use]
+    pub fn tag(self) -> &'static str {
+        match self {
+            RoughnessSpacing::Linear => "rows-linear",
+            RoughnessSpacing::Balanced => "rows-balanced",
         }
     }
 

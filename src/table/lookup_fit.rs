@@ -208,8 +208,24 @@ pub fn fit_for_lookup(
         .map(|(w, f)| f - w.apply(&table.value))
         .collect();
     let node_lookup_max_error = residual.iter().fold(0.0_f64, |m, r| m.max(r.abs()));
+    // The texels the mirror's lookup reads keep their node values: the fit solves for the
+    // others only.
+    let pinned = mirror_texels(table);
+    let free: Vec<super::LookupWeights> = weights
+        .iter()
+        .map(|w| {
+            let mut kept = super::LookupWeights::default();
+            for &(k, weight) in w.terms() {
+                if !pinned.contains(&k) {
+                    kept.terms[kept.count] = (k, weight);
+                    kept.count += 1;
+                }
+            }
+            kept
+        })
+        .collect();
     let correction = blend_capped(
-        &weights,
+        &free,
         &residual,
         node_lookup_max_error,
         table.value.len(),
@@ -235,6 +251,21 @@ pub fn fit_for_lookup(
         lookup_rms_error: (errors.iter().map(|e| e * e).sum::<f64>() / errors.len() as f64).sqrt(),
         max_correction,
     }
+}
+
+/// The texels a lookup at the mirror (`roughness = 0`) and normal incidence reads, which the
+/// fit leaves at their node values: the mirror's value is exact (`E = 1`: a mirror loses
+/// nothing), and on the axes that follow the grazing layer every `mu > 0` reads them at
+/// `roughness = 0`, so that the lookup's loss `1 - Ē` starts from 0 there, as `f_ms_norm`'s
+/// `(1 - Ē) / x` needs ([`super::normalisation`]).
+fn mirror_texels(table: &Table) -> Vec<usize> {
+    table
+        .lookup_weights(1.0, 0.0, 1.0)
+        .terms()
+        .iter()
+        .filter(|&&(_, w)| w > 0.0)
+        .map(|&(k, _)| k)
+        .collect()
 }
 
 /// The corrections: the capped fit's where its maximum is no worse than the point samples'

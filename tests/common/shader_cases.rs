@@ -1,6 +1,7 @@
-//! What the shader tests run and what they expect: the default tables and a second layout
-//! (texel centres, kiln's balanced layout with fitted texels: both of its coordinates computed
-//! in the shader; 8 x 8) baked with the generated shaders, the points the
+//! What the shader tests run and what they expect: the default tables (kiln's balanced layout
+//! with fitted texels: both of its coordinates computed in the shader) and a second layout
+//! (the split-sum `E_bias` on its own mu axis, on texel centres, 8 x 8) baked with the
+//! generated shaders, the points the
 //! shaders are called at, and the library's value at each with the tolerance f32 allows.
 //! `tests/shader_execution.rs` runs the points as C++, `tests/gpu_shaders.rs` on Vulkan.
 
@@ -17,7 +18,7 @@ mod command;
 /// The generated files every test loads, by stem.
 pub const TABLE_FILES: [&str; 4] = [
     "ggx-height-correlated-E",
-    "ggx-height-correlated-E-mu-balanced-centers-lookup-fit",
+    "ggx-height-correlated-E_bias-centers",
     "ggx-height-correlated-E_avg",
     "ggx-height-correlated-f_ms_norm",
 ];
@@ -86,29 +87,15 @@ impl Cases {
         let other = d.join("centres");
         bake(
             &formats,
-            &[
-                "--mu-axis",
-                "balanced",
-                "--texels",
-                "lookup-fit",
-                "--grid",
-                "centers",
-                "--size",
-                "8",
-                "--quantity",
-                "e",
-            ],
+            &["--grid", "centers", "--size", "8", "--quantity", "e-bias"],
             &other,
         );
         for language in languages {
-            let name = format!("ggx-height-correlated-E-mu-balanced-centers-lookup-fit.{language}");
+            let name = format!("ggx-height-correlated-E_bias-centers.{language}");
             std::fs::copy(other.join(&name), d.join(&name)).unwrap();
         }
-        let centres = read(
-            &other,
-            "ggx-height-correlated-E-mu-balanced-centers-lookup-fit",
-        );
-        assert_eq!(centres.spec.quantity, Quantity::E);
+        let centres = read(&other, "ggx-height-correlated-E_bias-centers");
+        assert_eq!(centres.spec.quantity, Quantity::EBias);
         let e = read(&d, "ggx-height-correlated-E");
         let points = |t: &Table| -> Vec<f64> {
             lookup_coordinates(&t.spec, &AuditSettings::default())

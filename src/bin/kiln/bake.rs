@@ -102,15 +102,16 @@ pub struct BakeArgs {
     /// QMC: base seed of the scrambles [default: 0].
     #[arg(long)]
     seed: Option<u64>,
-    /// What the texels are: nodes (each the quantity at its node, exact to --max-error; for a
-    /// renderer that reads nodes) or lookup-fit (chosen so that the bilinear lookup, the way a
-    /// GPU samples the file, is closest to the quantity everywhere: about half the lookup
-    /// error, nodes off by as much; the metadata's lookup_fit says what the fit measured). For
-    /// the tables over roughness and mu; their names get -lookup-fit. With --preset, the
-    /// engine's tables in its layout (the glass tables stay point samples). See
-    /// docs/accuracy.md [default: nodes].
-    #[arg(long, value_enum, default_value = "nodes", hide_default_value = true)]
-    texels: kiln::table::Texels,
+    /// What the texels are: lookup-fit (chosen so that the bilinear lookup, the way a GPU
+    /// samples the file, is closest to the quantity everywhere: about half the lookup error,
+    /// nodes off by as much; the metadata's lookup_fit says what the fit measured) or nodes
+    /// (each the quantity at its node, exact to --max-error: for a renderer that reads nodes,
+    /// or its own interpolation). For the tables over roughness and mu; the glass tables stay
+    /// point samples. With --preset, the engine's tables in its layout. See docs/accuracy.md
+    /// [default: lookup-fit on the balanced mu axis (E, E_avg, f_ms_norm) up to --size 128,
+    /// nodes on the others and beyond, named -nodes].
+    #[arg(long, value_enum)]
+    texels: Option<kiln::table::Texels>,
     /// Output directory, created if missing.
     /// [default: tables, or the scene's output.dir]
     #[arg(long)]
@@ -173,16 +174,17 @@ pub struct BakeArgs {
     /// [default: balanced with --mu-axis balanced, otherwise linear].
     #[arg(long, value_enum, hide_possible_values = true)]
     roughness_spacing: Option<RoughnessSpacing>,
-    /// Spacing of the mu axis: adaptive (follows the grazing layer mu ~ alpha; lookup
-    /// coordinate t = (mu (1 + 4 alpha) / (mu + 4 alpha))^0.4), balanced (kiln's layout for
-    /// --texels lookup-fit: the grazing layer, and more texels near mu = 1 at moderate
-    /// roughness, so that the fitted lookup's largest error is about even over the domain;
-    /// 2.1e-4 at 32 x 32 with balanced rows, against 3.3e-4 on the adaptive axis; see
-    /// docs/accuracy.md), split-sum (kiln's layout for the quantities that vary with mu on a
+    /// Spacing of the mu axis: balanced (kiln's layout for E, E_avg and f_ms_norm, with
+    /// balanced rows and texels fitted for the lookup: the grazing layer, and more texels near
+    /// mu = 1 at moderate roughness, so that the fitted lookup's largest error is about even
+    /// over the domain; 2.1e-4 at 32 x 32, against 6.5e-4 for the adaptive axis' point samples;
+    /// see docs/accuracy.md), adaptive (follows the grazing layer mu ~ alpha; lookup coordinate
+    /// t = (mu (1 + 4 alpha) / (mu + 4 alpha))^0.4; the glass tables' product grid), split-sum (kiln's layout for the quantities that vary with mu on a
     /// mirror, e-scale, e-bias and e-f: the grazing layer, and texels for Fc(mu) on the mirror
     /// row; t = 0.6 A(mu; 0.3, 0.5) + 0.4 A(mu; 4 alpha, 0.4), A(y; k, p) = (y (1 + k) / (y +
-    /// k))^p), linear (mu = t) or sqrt (mu = t^2). See "Conventions" below. [default: split-sum
-    /// when a quantity varies with mu on a mirror, otherwise adaptive].
+    /// k))^p), linear (mu = t) or sqrt (mu = t^2). See "Conventions" below. [default: kiln's
+    /// axis for each quantity: balanced for e, e-avg and f-ms-norm, split-sum for e-scale, e-bias
+    /// and e-f; the glass tables lay out mu themselves].
     #[arg(long, value_enum, hide_possible_values = true)]
     mu_axis: Option<MuMapping>,
     /// Where samples sit: nodes i/(N - 1) on the axis ends (lookups must remap, see below) or
@@ -265,9 +267,6 @@ pub fn run(args: BakeArgs) -> kiln::Result<()> {
             BakeOptions::DEFAULT_QUANTITIES.to_vec()
         }
     });
-    let mu_mapping = args
-        .mu_axis
-        .unwrap_or_else(|| MuMapping::default_for(&quantities));
     let options = BakeOptions {
         ndfs: args.ndf,
         maskings: args.masking,
@@ -291,10 +290,8 @@ pub fn run(args: BakeArgs) -> kiln::Result<()> {
         scrambles,
         seed: args.seed.unwrap_or(0),
         roughness_convention: args.roughness_axis,
-        roughness_spacing: args
-            .roughness_spacing
-            .unwrap_or(RoughnessSpacing::paired_with(mu_mapping)),
-        mu_mapping,
+        roughness_spacing: args.roughness_spacing,
+        mu_mapping: args.mu_axis,
         grid: args.grid,
         ior_size: args.ior_size.unwrap_or(BakeOptions::DEFAULT_IOR_SIZE),
         ior_mapping: args.ior_axis.unwrap_or(IorMapping::Glass),
@@ -494,13 +491,15 @@ fn bake_preset(preset: kiln::preset::Preset, args: &BakeArgs) -> kiln::Result<()
     let mut bakes = preset.bakes(args.max_error);
     // The engine's own tables (the first bake) get the texels asked for; glass tables, over
     // the IOR, stay point samples.
-    bakes[0].texels = args.texels;
-    if args.texels != kiln::table::Texels::Nodes && bakes.len() > 1 && !args.quiet {
-        eprintln!(
-            "kiln: --texels {}: the {} glass tables (over the IOR) stay point samples",
-            args.texels.name(),
-            preset.name()
-        );
+    if let Some(texels) = args.texels {
+        bakes[0].texels = Some(texels);
+        if texels != kiln::table::Texels::Nodes && bakes.len() > 1 && !args.quiet {
+            eprintln!(
+                "kiln: --texels {}: the {} glass tables (over the IOR) stay point samples",
+                texels.name(),
+                preset.name()
+            );
+        }
     }
     for options in &bakes {
         options.validate()?;
