@@ -482,7 +482,10 @@ fn a_long_bake_says_how_long_on_any_stderr() {
     let (reflection, glass) = costs.split_at(3);
     let cheap = reflection[1].max(reflection[2]);
     assert!(
-        glass.iter().chain(&reflection[..1]).all(|&c| c > 4.0 * cheap)
+        glass
+            .iter()
+            .chain(&reflection[..1])
+            .all(|&c| c > 4.0 * cheap)
             && costs.iter().all(|&c| c > 0.0),
         "{costs:?}"
     );

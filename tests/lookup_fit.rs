@@ -167,6 +167,34 @@ fn the_generated_lookup_of_a_fitted_table_halves_the_error() {
     assert!(fitted <= 1e-3 && nodes > 1.2e-3, "{fitted:.3e} {nodes:.3e}");
 }
 
+/// A mirror loses nothing: on kiln's default (fitted, balanced) layout the lookup at roughness
+/// 0 is exactly 1 for every `mu > 0` at every size, so that the lookup's loss `1 - Ē` starts
+/// from 0 and the default bake's `f_ms_norm`, `(1 - Ē) / x`, stays finite and within [0, 1]
+/// (the bake refuses a table outside it). Before the fit kept the mirror's texel, the 6 x 6
+/// default bake failed with `f_ms_norm` 2.7e4 at r = 0.
+#[test]
+fn a_fitted_mirror_loses_nothing_at_every_size() {
+    for size in [3, 4, 5, 6, 7, 9, 12, 17] {
+        let tables = BakeOptions {
+            size,
+            ..BakeOptions::default()
+        }
+        .bake(&|_| {})
+        .unwrap_or_else(|e| panic!("size {size}: {e}"));
+        let e = &tables[0];
+        assert_eq!(e.spec.texels, Texels::LookupFit);
+        for mu in [1e-6, 0.01, 0.3, 1.0] {
+            assert_eq!(e.lookup(mu, 0.0), 1.0, "size {size}, mu {mu}");
+        }
+        let norm = &tables[2];
+        assert_eq!(norm.spec.quantity, Quantity::FMsNorm);
+        assert!(
+            norm.value.iter().all(|v| (0.0..=1.0).contains(v)),
+            "size {size}"
+        );
+    }
+}
+
 /// The fitted texels' nodes are off the truth by design, and the metadata bounds by how much:
 /// the recorded node error is at least the largest node deviation measured independently.
 #[test]
