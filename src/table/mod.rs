@@ -318,14 +318,18 @@ impl TableSpec {
         if self.axes().iter().any(|axis| axis.grid() == Grid::Centers) {
             tags.push("centers");
         }
-        // A table without a mu axis (E_avg) takes its texels' baseline from its rows: fitted
-        // with balanced rows, point samples with linear ones.
         let texels_paired = match (mu_mapping, self.roughness) {
-            (None, Some(Axis::Roughness { spacing, .. })) => Texels::paired_with(match spacing {
-                axis::RoughnessSpacing::Balanced => MuMapping::Balanced,
-                axis::RoughnessSpacing::Linear => MuMapping::Adaptive,
-            }),
-            _ => Texels::paired_with(paired_mu),
+            (Some(mapping), _) => Texels::paired_with(mapping),
+            // A table without a mu axis (E_avg) takes its texels' baseline from its rows:
+            // fitted with balanced rows, point samples with linear ones.
+            (
+                None,
+                Some(Axis::Roughness {
+                    spacing: axis::RoughnessSpacing::Balanced,
+                    ..
+                }),
+            ) => Texels::LookupFit,
+            (None, _) => Texels::Nodes,
         };
         if self.texels != texels_paired && !self.quantity.has_ior() {
             tags.push(self.texels.tag());
