@@ -20,12 +20,17 @@ Conventions:
              sits at texel centre t = (i + 0.5) / N, sampled at raw t by a GPU, but the outer
              half texel on each side is clamped: at 32 x 32 the lookup error reaches 2.5e-2
              there (E, adaptive mu axis; 1.4e-2 for E_avg), against 6.5e-4 on nodes.
-  mu axis    'adaptive' (bake's default): look up at t = (mu (1 + 4 alpha) / (mu + 4 alpha))^0.4
-             (t = 0 at mu = 0, t = 1 at alpha = 0 and mu > 0). It keeps the grazing boundary
-             layer mu ~ alpha at the same t for every roughness: 6.5e-4 max lookup error at
-             32 x 32 against 1e-1 for 'linear' and 'sqrt'. The row alpha = 0 holds the limit
-             alpha -> 0+ (computed at alpha = 1e-7). 'linear': mu = t. 'sqrt': mu = t^2 (look up
-             at t = sqrt(mu)).
+  mu axis    kiln's axis for each quantity unless --mu-axis names one. 'balanced' (E, E_avg,
+             f_ms_norm; with balanced rows): the grazing boundary layer mu ~ alpha at the same t
+             for every roughness, and more texels near mu = 1 at moderate roughness (the
+             metadata and the generated lookups give its formula). 'split-sum' (e-scale,
+             e-bias, e-f, which vary with mu on a mirror). 'adaptive': t = (mu (1 + 4 alpha) /
+             (mu + 4 alpha))^0.4 (t = 0 at mu = 0, t = 1 at alpha = 0 and mu > 0): 6.5e-4 max
+             lookup error at 32 x 32 against 1e-1 for 'linear' (mu = t) and 'sqrt' (mu = t^2).
+             The row alpha = 0 holds the limit alpha -> 0+ (computed at alpha = 1e-7).
+  texels     'lookup-fit' (bake's default on the balanced axis): chosen so that the bilinear
+             lookup is closest to the truth everywhere (2.1e-4 at 32 x 32 for E), the nodes off
+             by about as much; 'nodes': each texel the quantity at its node.
   layout     row-major, roughness rows (slow), mu columns (fast); as an image x = mu, y = roughness.
   E          directional albedo of the single-scattering BRDF with F = 1; E_avg = 2 ∫ E(mu) mu dmu.
              one_minus_E is stored beside E, estimated directly: use it when E is near 1,
