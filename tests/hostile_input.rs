@@ -358,7 +358,10 @@ fn targets(dir: &Path) -> Vec<Target> {
         order: vec![AxisName::R, AxisName::Mu],
         grid: Grid::Nodes,
         roughness: RoughnessConvention::Perceptual,
-        mu_mapping: MuMapping::Adaptive,
+        // kiln's layout of the table baked above: the balanced axis and rows, fitted.
+        mu_mapping: MuMapping::Balanced,
+        roughness_spacing: kiln::RoughnessSpacing::Balanced,
+        texels: kiln::table::Texels::LookupFit,
     };
     let text: String = e.value.iter().map(|v| format!("{v}\n")).collect();
     let raw: Vec<u8> = e

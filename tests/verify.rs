@@ -231,6 +231,56 @@ fn every_input_format_and_layout_gives_the_same_audit() {
     );
 }
 
+/// kiln's default table read as an external one: `--mu-axis balanced` brings the balanced rows
+/// kiln lays out with it, and `--texels lookup-fit` has it judged by its lookup, as its sidecar
+/// is. The same audit as the file's own, within f32 rounding; with linear rows named instead,
+/// the lookups are far off; without `--texels` the nodes (off by 2.3e-4 by design) judge it.
+#[test]
+fn an_external_table_in_kilns_default_layout_audits_as_its_file_does() {
+    let json = Path::new(env!("CARGO_MANIFEST_DIR")).join("tables/ggx-height-correlated-E.json");
+    let (_, own) = verify(&[json.to_str().unwrap()]);
+    let dir = tempfile::tempdir().unwrap();
+    let raw = dir.path().join("e.f32");
+    let bytes: Vec<u8> = sidecar_values(&json, "E")
+        .iter()
+        .flat_map(|&v| (v as f32).to_le_bytes())
+        .collect();
+    std::fs::write(&raw, bytes).unwrap();
+    let external = |extra: &[&str]| {
+        let mut args = vec![
+            raw.to_str().unwrap(),
+            "--shape",
+            "32x32",
+            "--grid",
+            "nodes",
+            "--mu-axis",
+            "balanced",
+            "--dtype",
+            "f32",
+            "--max-error",
+            "2.2e-4",
+        ];
+        args.extend_from_slice(extra);
+        verify(&args)
+    };
+    let (status, fitted) = external(&["--texels", "lookup-fit"]);
+    let lookup = number(&own, "lookup_max_error");
+    assert!(lookup < 2.2e-4, "{own}");
+    assert_eq!(status, Some(0), "{fitted}");
+    assert!(
+        (number(&fitted, "lookup_max_error") - lookup).abs() < 1e-6,
+        "{fitted} vs {own}"
+    );
+    let (status, nodes) = external(&[]);
+    assert_eq!(status, Some(1), "{nodes}");
+    assert!(number(&nodes, "node_max_error") > 2.2e-4, "{nodes}");
+    let (_, wrong) = external(&["--texels", "lookup-fit", "--roughness-spacing", "linear"]);
+    assert!(
+        number(&wrong, "lookup_max_error") > 10.0 * lookup,
+        "{wrong}"
+    );
+}
+
 #[test]
 fn layout_flags_match_the_tables_they_describe() {
     let dir = tempfile::tempdir().unwrap();

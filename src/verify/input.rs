@@ -36,6 +36,10 @@ pub struct Layout {
     pub grid: Grid,
     pub roughness: RoughnessConvention,
     pub mu_mapping: MuMapping,
+    /// The roughness rows' spacing (kiln's balanced rows, or linear as engines' are).
+    pub roughness_spacing: crate::table::axis::RoughnessSpacing,
+    /// Point samples, or texels fitted for the lookup (which verify judges by the lookup).
+    pub texels: crate::table::Texels,
 }
 
 /// How to read the numbers of an external table.
@@ -514,7 +518,7 @@ fn spec_and_values(
         size,
         convention: layout.roughness,
         grid: layout.grid,
-        spacing: crate::table::axis::RoughnessSpacing::Linear,
+        spacing: layout.roughness_spacing,
     };
     let mu_axis = |size| Axis::Mu {
         size,
@@ -525,7 +529,7 @@ fn spec_and_values(
         reference_digits: None,
         lookup_of: None,
         refined_start: None,
-        texels: crate::table::Texels::Nodes,
+        texels: layout.texels,
         transmission: crate::model::dielectric::TransmissionConvention::SingleScattering,
         model: layout.model,
         quantity: layout.quantity,
@@ -962,6 +966,8 @@ mod tests {
             grid: Grid::Nodes,
             roughness: RoughnessConvention::Perceptual,
             mu_mapping: MuMapping::Linear,
+            roughness_spacing: crate::table::axis::RoughnessSpacing::Linear,
+            texels: crate::table::Texels::Nodes,
         }
     }
 
@@ -1122,6 +1128,8 @@ mod tests {
             grid: Grid::Nodes,
             roughness: RoughnessConvention::Perceptual,
             mu_mapping: MuMapping::Linear,
+            roughness_spacing: crate::table::axis::RoughnessSpacing::Linear,
+            texels: crate::table::Texels::Nodes,
         };
         // value = 10 * mu_index + r_index, stored mu-major.
         let values = vec![0.0, 1.0, 10.0, 11.0, 20.0, 21.0];

@@ -42,7 +42,8 @@ pub struct VerifyArgs {
     /// of --ndf and --masking (default GGX height-correlated), and where it is.
     #[arg(long, value_name = "NAME|FILE.toml", conflicts_with_all = ["file", "furnace",
         "preset", "shape", "channel", "dtype", "order", "grid", "roughness_axis", "mu_axis",
-        "quantity", "average", "clamp_min", "density", "only", "form", "against"])]
+        "roughness_spacing", "texels", "quantity", "average", "clamp_min", "density", "only",
+        "form", "against"])]
     fit: Option<String>,
     /// With --fit: points per axis of the (sqrt(mu), r) grid the fit is compared on, the ends
     /// included; a finer grid then surrounds each quantity's worst point.
@@ -86,7 +87,8 @@ pub struct VerifyArgs {
     /// beside the measured error; a blue channel (Filament's and Godot's cloth, HDRP's
     /// Disney diffuse) is compared with kiln's values at its texels (node errors only).
     #[arg(long, value_enum, conflicts_with_all = ["furnace", "shape", "channel", "dtype",
-        "order", "grid", "roughness_axis", "mu_axis", "ndf", "masking", "quantity"])]
+        "order", "grid", "roughness_axis", "mu_axis", "roughness_spacing", "texels", "ndf",
+        "masking", "quantity"])]
     preset: Option<kiln::preset::Preset>,
     /// With --preset: audit only these of the file's tables, comma-separated (e,e-avg of a
     /// Cycles shader.tables skips its four glass arrays, whose audit takes most of a minute).
@@ -125,6 +127,15 @@ pub struct VerifyArgs {
     /// External tables: the mu axis spacing [default: linear, as engines' tables are].
     #[arg(long, value_enum)]
     mu_axis: Option<MuMapping>,
+    /// External tables: the roughness rows' spacing [default: balanced with --mu-axis balanced,
+    /// as kiln lays them out, otherwise linear].
+    #[arg(long, value_enum)]
+    roughness_spacing: Option<kiln::RoughnessSpacing>,
+    /// External tables: what the texels are, nodes (judged by their nodes) or lookup-fit
+    /// (fitted for the lookup: judged by the lookup, as kiln's own fitted tables are)
+    /// [default: nodes].
+    #[arg(long, value_enum)]
+    texels: Option<kiln::table::Texels>,
     /// External tables: the normal distribution [default: ggx].
     #[arg(long, value_enum)]
     ndf: Option<Ndf>,
@@ -190,6 +201,8 @@ impl VerifyArgs {
             ("--grid", self.grid.is_some()),
             ("--roughness-axis", self.roughness_axis.is_some()),
             ("--mu-axis", self.mu_axis.is_some()),
+            ("--roughness-spacing", self.roughness_spacing.is_some()),
+            ("--texels", self.texels.is_some()),
             ("--ndf", self.ndf.is_some()),
             ("--masking", self.masking.is_some()),
             ("--quantity", self.quantity.is_some()),
@@ -299,6 +312,10 @@ impl VerifyArgs {
                 .roughness_axis
                 .unwrap_or(RoughnessConvention::Perceptual),
             mu_mapping: self.mu_axis.unwrap_or(MuMapping::Linear),
+            roughness_spacing: self.roughness_spacing.unwrap_or_else(|| {
+                kiln::RoughnessSpacing::paired_with(self.mu_axis.unwrap_or(MuMapping::Linear))
+            }),
+            texels: self.texels.unwrap_or_default(),
         })
     }
 
