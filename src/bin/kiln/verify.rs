@@ -127,14 +127,11 @@ pub struct VerifyArgs {
     /// External tables: the mu axis spacing [default: linear, as engines' tables are].
     #[arg(long, value_enum)]
     mu_axis: Option<MuMapping>,
-    /// External tables: the roughness rows' spacing [default: balanced with --mu-axis balanced,
-    /// as kiln lays them out, otherwise linear].
-    #[arg(long, value_enum)]
+    /// External tables: the rows, linear or balanced [default: balanced with --mu-axis balanced].
+    #[arg(long, value_enum, hide_possible_values = true)]
     roughness_spacing: Option<kiln::RoughnessSpacing>,
-    /// External tables: what the texels are, nodes (judged by their nodes) or lookup-fit
-    /// (fitted for the lookup: judged by the lookup, as kiln's own fitted tables are)
-    /// [default: nodes].
-    #[arg(long, value_enum)]
+    /// External tables: nodes, or lookup-fit to judge the lookup (as kiln's fitted tables).
+    #[arg(long, value_enum, hide_possible_values = true)]
     texels: Option<kiln::table::Texels>,
     /// External tables: the normal distribution [default: ggx].
     #[arg(long, value_enum)]
