@@ -612,7 +612,9 @@ impl BakeOptions {
     }
 
     /// The `kiln bake` command that reproduces the tables of `model` with these options, with
-    /// every setting spelled out.
+    /// every setting spelled out but the layout flags not given (`--mu-axis`,
+    /// `--roughness-spacing`, `--texels`: kiln's layout for each quantity, which each table's
+    /// metadata states).
     #[must_use]
     pub fn command_for(&self, model: Model) -> String {
         let mut command = self.command_without_layout(model);

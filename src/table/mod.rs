@@ -88,13 +88,6 @@ impl Texels {
         }
     }
 
-    /// The tag of a table with these texels where they are not those of its `mu` axis
-    /// ([`TableSpec::id`]): the name.
-    #[must_use]
-    pub fn tag(self) -> &'static str {
-        self.name()
-    }
-
     /// A sentence for metadata.
     #[must_use]
     pub fn describe(self) -> &'static str {
@@ -332,7 +325,7 @@ impl TableSpec {
             (None, _) => Texels::Nodes,
         };
         if self.texels != texels_paired && !self.quantity.has_ior() {
-            tags.push(self.texels.tag());
+            tags.push(self.texels.name());
         }
         match self.ior {
             Some(Axis::Ior {

@@ -260,17 +260,16 @@ pub fn run(args: BakeArgs) -> kiln::Result<()> {
         None => Some(BakeOptions::DEFAULT_MAX_ERROR),
     };
     let samples = args.samples.unwrap_or(QmcSettings::DEFAULT_SAMPLES);
-    let quantities = args.quantity.clone().unwrap_or_else(|| {
-        if args.fresnel.given() {
-            vec![Quantity::EF]
-        } else {
-            BakeOptions::DEFAULT_QUANTITIES.to_vec()
-        }
-    });
     let options = BakeOptions {
         ndfs: args.ndf,
         maskings: args.masking,
-        quantities,
+        quantities: args.quantity.clone().unwrap_or_else(|| {
+            if args.fresnel.given() {
+                vec![Quantity::EF]
+            } else {
+                BakeOptions::DEFAULT_QUANTITIES.to_vec()
+            }
+        }),
         fresnel: if args.fresnel.given() {
             Some(args.fresnel.model()?)
         } else {

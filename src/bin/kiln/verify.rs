@@ -295,6 +295,7 @@ impl VerifyArgs {
             }
             (_, false) => None,
         };
+        let mu_mapping = self.mu_axis.unwrap_or(MuMapping::Linear);
         Ok(Layout {
             model: Model {
                 ndf: self.ndf.unwrap_or(Ndf::Ggx),
@@ -308,10 +309,10 @@ impl VerifyArgs {
             roughness: self
                 .roughness_axis
                 .unwrap_or(RoughnessConvention::Perceptual),
-            mu_mapping: self.mu_axis.unwrap_or(MuMapping::Linear),
-            roughness_spacing: self.roughness_spacing.unwrap_or_else(|| {
-                kiln::RoughnessSpacing::paired_with(self.mu_axis.unwrap_or(MuMapping::Linear))
-            }),
+            mu_mapping,
+            roughness_spacing: self
+                .roughness_spacing
+                .unwrap_or_else(|| kiln::RoughnessSpacing::paired_with(mu_mapping)),
             texels: self.texels.unwrap_or_default(),
         })
     }
