@@ -153,16 +153,6 @@ impl BakeOptions {
                 crate::error::shown(self.ior_max)
             )));
         }
-        if self.texels == Some(Texels::LookupFit)
-            && let Some(q) = self.quantities().into_iter().find(|q| q.has_ior())
-        {
-            return Err(Error::InvalidInput(format!(
-                "--texels lookup-fit fits the tables over roughness and mu; {} is over the \
-                 IOR too, which it does not fit yet: bake it in a separate command without \
-                 --texels",
-                q.symbol()
-            )));
-        }
         if let Some(q) = self
             .quantities()
             .into_iter()
@@ -420,14 +410,15 @@ impl BakeOptions {
             .unwrap_or_else(|| RoughnessSpacing::paired_with(self.mu_mapping_for(quantity)))
     }
 
-    /// The texels of `quantity`'s table: point samples over the IOR; elsewhere those named, or
-    /// those that go with its `mu` axis ([`Texels::paired_with`]: fitted on the balanced axis)
-    /// up to [`BakeOptions::LARGEST_FITTED_BY_DEFAULT`] texels a side, point samples beyond
-    /// (named `-nodes`).
+    /// The texels of `quantity`'s table: those named, or those that go with its `mu` axis
+    /// ([`Texels::paired_with`]: fitted on the balanced axis) up to
+    /// [`BakeOptions::LARGEST_FITTED_BY_DEFAULT`] texels a side, point samples beyond (named
+    /// `-nodes`); point samples over the IOR unless named (a fit there costs about fifteen
+    /// times the bake).
     #[must_use]
     pub fn texels_for(&self, quantity: Quantity) -> Texels {
         if quantity.has_ior() {
-            return Texels::Nodes;
+            return self.texels.unwrap_or(Texels::Nodes);
         }
         self.texels.unwrap_or_else(|| {
             if self.size > Self::LARGEST_FITTED_BY_DEFAULT {
@@ -951,6 +942,9 @@ fn integrated_texels(spec: &TableSpec) -> u64 {
 
 /// The settings of [`fit_texels`] for a table of `spec`.
 fn lookup_fit_settings(spec: &TableSpec) -> crate::table::lookup_fit::LookupFitSettings {
+    if spec.ior.is_some() {
+        return crate::table::lookup_fit::LookupFitSettings::over_ior();
+    }
     let cells = spec.shape().into_iter().max().unwrap_or(1);
     crate::table::lookup_fit::LookupFitSettings::for_cells(cells)
 }
@@ -1129,7 +1123,12 @@ pub fn lookup_fit_core_seconds(spec: &TableSpec) -> f64 {
     if evaluations == 0 {
         return 0.0;
     }
-    let band = spec.mu.map_or(1, |mu| mu.size()) as f64 + 1.0;
+    // A lookup blends texels up to one step along every axis: the band is the sum of the
+    // row-major strides (`mu + 1` for rows of `mu` texels, `n^2 + n + 1` for an `n^3` table).
+    let shape = spec.shape();
+    let band = (0..shape.len())
+        .map(|d| shape[d + 1..].iter().product::<usize>())
+        .sum::<usize>() as f64;
     let settings = lookup_fit_settings(spec);
     let solve = settings.iterations as f64 * spec.len() as f64 * band * band * 1.2e-9;
     let digits = (-settings.tolerance.log10()).round().max(1.0) as u32;

@@ -209,26 +209,85 @@ fn a_fitted_table_states_its_node_deviation_honestly() {
     );
 }
 
+/// Over the IOR (issue 38, `--texels lookup-fit` with a glass quantity): the lookup of the
+/// glass average from inside at its default 16 x 16, fitted, is within the issue's 1e-3 of the
+/// reference at `kiln verify`'s audit points (measured 2026-12-06: 8.2e-4, its point samples'
+/// 1.71e-3; from outside 5.8e-4 and 1.21e-3), and the 8 x 8 x 8 `E_dielectric`'s
+/// fitted lookup beats its point samples' by at least 1.3x (1.9x: 1.4e-2 against 2.7e-2).
+/// The truth at 1e-6, a thousandth of the figures.
+#[test]
+fn the_glass_tables_fitted_for_their_lookup_read_closer() {
+    // Point samples unless asked, and a fitted glass table says so in its name.
+    let named = |texels| -> Vec<String> {
+        let options = BakeOptions {
+            quantities: vec![Quantity::EDielectric, Quantity::EAvgDielectricInside],
+            texels,
+            ..BakeOptions::default()
+        };
+        options
+            .specs()
+            .iter()
+            .map(kiln::table::TableSpec::id)
+            .collect()
+    };
+    assert_eq!(
+        named(None),
+        [
+            "ggx-height-correlated-E_dielectric",
+            "ggx-height-correlated-E_avg_dielectric_inside"
+        ]
+    );
+    assert_eq!(
+        named(Some(Texels::LookupFit)),
+        [
+            "ggx-height-correlated-E_dielectric-lookup-fit",
+            "ggx-height-correlated-E_avg_dielectric_inside-lookup-fit"
+        ]
+    );
+    let audit_of = |quantity, size, texels| {
+        let options = BakeOptions {
+            quantities: vec![quantity],
+            size,
+            ior_size: size,
+            texels: Some(texels),
+            ..BakeOptions::default()
+        };
+        let table = options.bake(&|_| {}).unwrap().remove(0);
+        assert_eq!(table.spec.texels, texels);
+        let settings = ReferenceSettings {
+            tolerance: 1e-6,
+            ..ReferenceSettings::default()
+        };
+        audit(
+            &table,
+            &Against::Reference(settings),
+            &AuditSettings::default(),
+            &|_| {},
+        )
+        .lookup_max_error
+    };
+    // From inside, the side further from the goal (the outside average is in docs/verify.md).
+    let fitted = audit_of(Quantity::EAvgDielectricInside, 16, Texels::LookupFit);
+    assert!(fitted <= 1e-3, "E_avg_dielectric_inside: {fitted:.3e}");
+    let nodes = audit_of(Quantity::EDielectric, 8, Texels::Nodes);
+    let fitted = audit_of(Quantity::EDielectric, 8, Texels::LookupFit);
+    assert!(
+        fitted * 1.3 < nodes,
+        "E_dielectric 8^3: fitted {fitted:.3e}, nodes {nodes:.3e}"
+    );
+}
+
 #[path = "common/command.rs"]
 mod command;
 #[cfg(feature = "cli")]
 #[path = "common/lookup_audit.rs"]
 mod lookup_audit;
 
-/// The flag's errors, and `verify --max-error` judging a fitted table by its lookup.
+/// The flag's error with a scene, and `verify --max-error` judging a fitted table by its
+/// lookup.
 #[cfg(feature = "cli")]
 #[test]
-fn the_command_line_fits_what_it_can_and_judges_fitted_tables_by_their_lookup() {
-    let glass = command::kiln(&[
-        "bake",
-        "--quantity",
-        "e-dielectric",
-        "--texels",
-        "lookup-fit",
-    ]);
-    assert_eq!(glass.status.code(), Some(2));
-    let stderr = String::from_utf8_lossy(&glass.stderr);
-    assert!(stderr.contains("over the IOR"), "{stderr}");
+fn the_command_line_judges_fitted_tables_by_their_lookup() {
     let scene = command::kiln(&["bake", "--scene", "s.toml", "--texels", "lookup-fit"]);
     assert_eq!(scene.status.code(), Some(2));
     let file = concat!(

@@ -312,6 +312,8 @@ impl TableSpec {
             tags.push("centers");
         }
         let texels_paired = match (mu_mapping, self.roughness) {
+            // Over the IOR: point samples unless a fit was asked for.
+            _ if self.quantity.has_ior() => Texels::Nodes,
             (Some(mapping), _) => Texels::paired_with(mapping),
             // A table without a mu axis (E_avg) takes its texels' baseline from its rows:
             // fitted with balanced rows, point samples with linear ones.
@@ -324,7 +326,7 @@ impl TableSpec {
             ) => Texels::LookupFit,
             (None, _) => Texels::Nodes,
         };
-        if self.texels != texels_paired && !self.quantity.has_ior() {
+        if self.texels != texels_paired {
             tags.push(self.texels.name());
         }
         match self.ior {
