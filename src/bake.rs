@@ -413,8 +413,8 @@ impl BakeOptions {
     /// The texels of `quantity`'s table: those named, or those that go with its `mu` axis
     /// ([`Texels::paired_with`]: fitted on the balanced axis) up to
     /// [`BakeOptions::LARGEST_FITTED_BY_DEFAULT`] texels a side, point samples beyond (named
-    /// `-nodes`); point samples over the IOR unless named (a fit there costs about fifteen
-    /// times the bake).
+    /// `-nodes`); point samples over the IOR unless named (a fit there costs about ten times
+    /// the bake: 108 s for the four glass tables at 16^3, docs/verify.md).
     #[must_use]
     pub fn texels_for(&self, quantity: Quantity) -> Texels {
         if quantity.has_ior() {

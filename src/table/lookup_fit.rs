@@ -78,9 +78,7 @@ impl LookupFitSettings {
             weight_cap: 30.0,
         }
     }
-}
 
-impl LookupFitSettings {
     /// Settings for a table over the IOR (the glass tables, three axes): the texture's points
     /// and the midpoints between them, 2 per cell and axis (31^3 points at 16^3, about a
     /// minute of one core's reference evaluations), the truth at 1e-6 (the lookup errs by
