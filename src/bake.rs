@@ -71,9 +71,9 @@ pub struct BakeOptions {
     /// `method`, `samples`, `average_samples` and `check_against_reference`, then confirms the
     /// result against the reference on a sample of texels. `None` bakes with `method` as given.
     pub max_error: Option<f64>,
-    /// Point samples or texels fitted for the bilinear lookup ([`crate::table::lookup_fit`]),
-    /// for the tables over roughness and `mu` (not over IOR); `None`: those of each table's `mu`
-    /// axis ([`BakeOptions::texels_for`]: fitted on the balanced axis, `E`'s default).
+    /// Point samples or texels fitted for the bilinear lookup ([`crate::table::lookup_fit`]);
+    /// `None`: those of each table's `mu` axis ([`BakeOptions::texels_for`]: fitted on the
+    /// balanced axis, `E`'s default; point samples over the IOR).
     #[serde(default)]
     pub texels: Option<Texels>,
 }

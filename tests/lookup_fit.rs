@@ -254,17 +254,7 @@ fn the_glass_tables_fitted_for_their_lookup_read_closer() {
         };
         let table = options.bake(&|_| {}).unwrap().remove(0);
         assert_eq!(table.spec.texels, texels);
-        let settings = ReferenceSettings {
-            tolerance: 1e-6,
-            ..ReferenceSettings::default()
-        };
-        audit(
-            &table,
-            &Against::Reference(settings),
-            &AuditSettings::default(),
-            &|_| {},
-        )
-        .lookup_max_error
+        lookup_audit::lookup_max_error_to(&table, 1e-6)
     };
     // From inside, the side further from the goal (the outside average is in docs/verify.md).
     let fitted = audit_of(Quantity::EAvgDielectricInside, 16, Texels::LookupFit);

@@ -207,8 +207,6 @@ fn coordinate(language: Language, axis: &Axis) -> String {
     }
 }
 
-/// `A(y; k, p) = (y (1 + k) / (y + k))^p`, 0 at `y <= 0` (1 at `k = 0`, `y > 0`):
-/// [`glass_layout::saturation`].
 /// `(1 + s)^h - 1` by its binomial series to `s^6`, in Horner form: `h s (1 + (h - 1)/2 s (1 +
 /// (h - 2)/3 s (...)))`. For `s < 0.1` the first term left out is below 1e-7 of the sum.
 fn binomial_rise(s: &str, h: f64) -> String {
@@ -222,6 +220,8 @@ fn binomial_rise(s: &str, h: f64) -> String {
     format!("{} * {s} * ({inner})", literal(h))
 }
 
+/// `A(y; k, p) = (y (1 + k) / (y + k))^p`, 0 at `y <= 0` (1 at `k = 0`, `y > 0`):
+/// [`glass_layout::saturation`].
 fn saturation(language: Language, y: &str, k: &str, p: f64) -> String {
     let t = format!(
         "pow(min(({y}) * (1.0 + {k}) / max(({y}) + {k}, 1e-30), 1.0), {})",
