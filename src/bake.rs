@@ -818,6 +818,10 @@ impl BakeOptions {
         }
         if table.spec.texels == Texels::LookupFit {
             fit_texels(&mut table, progress);
+            // The fit moved every texel by what the reference said at its points: the same
+            // checks again, so that a value the fit could not make (not a number) is refused
+            // by name before anything is written.
+            check_computed(&table)?;
         }
         Ok(table)
     }
