@@ -11,6 +11,7 @@ pub mod reference;
 pub mod sheen;
 pub mod sobol;
 pub mod value;
+pub mod walk;
 
 /// The quadrature rules, at home in [`crate::numerics`].
 pub use crate::numerics::{gauss_kronrod, gauss_legendre};

@@ -1,0 +1,162 @@
+//! One random walk on a conductor's microsurface (Heitz, Hanika, d'Eon and Dachsbacher 2016,
+//! "Multiple-Scattering Microfacet BSDFs with the Smith Model", ACM TOG 35(4), algorithm 2),
+//! with the escape taken as its expectation at every vertex.
+//!
+//! The ray starts above the surface travelling down along `-w_i`. At each vertex it meets a
+//! microfacet at height `h`, draws the facet's normal `m` from the normals visible from
+//! `v = -w` (the direction it came from; **below the horizon** when the ray was travelling up,
+//! which [`crate::model::Ggx::sample_visible_normal`]'s spherical cap accepts), reflects about
+//! `m` and picks up `F(v.m)`. Travelling up from `h` it escapes with probability
+//! `P = C1(h)^Lambda(w)` (section 4.2); the walk tallies `P` times its throughput to the order
+//! just completed (the expected-value estimator: no escape is ever sampled, so every order's
+//! estimate is smooth in the walk's numbers) and goes on with the throughput times `1 - P`, to
+//! a hit drawn from the heights below `h` given that it does not escape. Travelling down it
+//! always hits, at `ln C1(h') = ln C1(h) + ln(u) / (1 + Lambda(-w))` (`Lambda(w) = -1 -
+//! Lambda(-w)` for a downward `w`, section 4.1).
+
+use super::heights::Heights;
+use super::random::WalkRandom;
+use crate::model::fresnel::{Fresnel, Rgb};
+use crate::model::ndf::MicrofacetDistribution;
+use crate::model::vector::Vec3;
+
+/// Below this throughput (with `F = 1`) a walk that must go on plays Russian roulette: it ends
+/// with probability `1 - t / ROULETTE`, else goes on with its throughput raised to `ROULETTE`.
+/// Unbiased; the tail beyond it is at most a thousandth of the energy.
+pub const ROULETTE: f64 = 1e-3;
+
+/// The most vertices a walk may have before what it still carries is set aside (and reported
+/// as the bound on what was dropped): far beyond any walk kiln has seen (the longest at
+/// `alpha = 1000`, grazing, is a few hundred).
+pub const MAX_VERTICES: u32 = 1 << 20;
+
+/// What a set of walks leaves: sums over the walks.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Tallies {
+    /// `orders[k - 1]`: the energy that left after exactly `k` vertices (`F = 1`).
+    pub orders: Vec<f64>,
+    /// The energy that left after more vertices than `orders` holds (`F = 1`).
+    pub beyond: f64,
+    /// The energy that left, every order, with the Fresnel factor of every vertex (per channel).
+    pub albedo: Rgb,
+    /// The throughput set aside by [`MAX_VERTICES`] (per channel, with Fresnel).
+    pub dropped: Rgb,
+    /// Vertices visited, over all walks.
+    pub vertices: u64,
+}
+
+impl Tallies {
+    /// Empty tallies for `orders` orders.
+    #[must_use]
+    pub fn new(orders: usize) -> Self {
+        Self {
+            orders: vec![0.0; orders],
+            beyond: 0.0,
+            albedo: [0.0; 3],
+            dropped: [0.0; 3],
+            vertices: 0,
+        }
+    }
+
+    /// Adds `other`'s sums to these.
+    pub fn add(&mut self, other: &Tallies) {
+        for (a, b) in self.orders.iter_mut().zip(&other.orders) {
+            *a += b;
+        }
+        self.beyond += other.beyond;
+        for j in 0..3 {
+            self.albedo[j] += other.albedo[j];
+            self.dropped[j] += other.dropped[j];
+        }
+        self.vertices += other.vertices;
+    }
+}
+
+/// Walks once from the incident direction `wi` (unit, `wi.z > 0`) and adds what leaves to
+/// `tallies`. With `fresnel` equal to [`Fresnel::None`] the walk stops after the last order
+/// tallied and puts what it still carries into `beyond` (with `F = 1` every walk leaves in the
+/// end, so that is exactly the expected energy of the later orders); otherwise it goes on to
+/// the end for the Fresnel-weighted albedo.
+pub fn walk<N: MicrofacetDistribution>(
+    ndf: &N,
+    wi: Vec3,
+    fresnel: &Fresnel,
+    heights: Heights,
+    random: &mut WalkRandom<'_>,
+    tallies: &mut Tallies,
+) {
+    let to_the_end = *fresnel != Fresnel::None;
+    let tallied = tallies.orders.len() as u32;
+    // Throughput with F = 1 (for the orders) and with the Fresnel factors (per channel).
+    let mut plain = 1.0;
+    let mut coloured: Rgb = [1.0; 3];
+    // The first hit, travelling down from above the surface (ln C1 = 0).
+    let mut w = Vec3::new(-wi.x, -wi.y, -wi.z);
+    let mut h = heights.height(random.uniform().ln() / (1.0 + ndf.lambda(wi)));
+    let mut vertex = 0;
+    loop {
+        vertex += 1;
+        tallies.vertices += 1;
+        let log_c1 = heights.log_c1(h);
+        let v = Vec3::new(-w.x, -w.y, -w.z);
+        let m = ndf.sample_visible_normal(v, [random.uniform(), random.uniform()]);
+        let cosine = v.dot(m);
+        if to_the_end {
+            let f = fresnel.reflectance(cosine);
+            for (c, f) in coloured.iter_mut().zip(f) {
+                *c *= f;
+            }
+        }
+        w = v.reflect(m).normalize();
+        if w.z > 0.0 {
+            let lambda = ndf.lambda(w);
+            // At the very top (a grazing entry that met the surface at once) every upward
+            // direction leaves; `inf * 0` would say otherwise.
+            let escape = if log_c1 == 0.0 {
+                1.0
+            } else {
+                (lambda * log_c1).exp()
+            };
+            if vertex <= tallied {
+                tallies.orders[vertex as usize - 1] += plain * escape;
+            } else {
+                tallies.beyond += plain * escape;
+            }
+            for (a, c) in tallies.albedo.iter_mut().zip(coloured) {
+                *a += c * escape;
+            }
+            if escape >= 1.0 {
+                return;
+            }
+            plain *= 1.0 - escape;
+            for c in &mut coloured {
+                *c *= 1.0 - escape;
+            }
+            // A hit below h given no escape: C1(h') = C1(h) / (1 - u (1 - P))^(1 / Lambda).
+            let u = random.uniform();
+            h = heights.height(log_c1 - (-u * (1.0 - escape)).ln_1p() / lambda);
+        } else {
+            h = heights.height(log_c1 + random.uniform().ln() / (1.0 + ndf.lambda(w)));
+        }
+        if !to_the_end && vertex == tallied {
+            tallies.beyond += plain;
+            return;
+        }
+        if vertex >= MAX_VERTICES {
+            for (d, c) in tallies.dropped.iter_mut().zip(coloured) {
+                *d += c;
+            }
+            return;
+        }
+        if plain < ROULETTE {
+            let survive = plain / ROULETTE;
+            if random.uniform() >= survive {
+                return;
+            }
+            plain = ROULETTE;
+            for c in &mut coloured {
+                *c /= survive;
+            }
+        }
+    }
+}

@@ -1,0 +1,278 @@
+//! The microsurface random walk: the light a microfacet conductor reflects after any number of
+//! bounces between its facets, the ground truth that energy compensation stands for.
+//!
+//! Heitz, Hanika, d'Eon and Dachsbacher 2016, "Multiple-Scattering Microfacet BSDFs with the
+//! Smith Model" (ACM TOG 35(4)): under Smith's assumptions (uncorrelated heights and normals)
+//! a ray on the microsurface is a walk in height whose free paths follow from `Lambda` and
+//! whose vertices draw visible normals. Its first order is exactly the height-correlated Smith
+//! BRDF (`E`); the orders after it are what the single-scattering BRDF loses and Kulla-Conty's
+//! lobe (or Turquin's scaling) puts back. `docs/multiple-scattering.md` says what the walk
+//! measures; [`conductor`] is one walk, [`walk_albedo`] many, in parallel and deterministic.
+//!
+//! Estimates: each scramble of the Owen-scrambled Sobol points (the first two vertices; a
+//! counter-seeded generator after them) is an independent replicate, and the standard error is
+//! their spread ([`crate::integrate::Estimate::from_replicates`]), as for kiln's QMC. Walks are
+//! summed in fixed chunks in a fixed order: the same settings give the same bits on any number
+//! of threads.
+
+pub mod conductor;
+pub mod heights;
+pub mod random;
+
+pub use conductor::Tallies;
+pub use heights::Heights;
+
+use crate::integrate::sobol::{OwenSobol, mix_seed};
+use crate::model::fresnel::{Fresnel, Rgb};
+use crate::model::ndf::Ggx;
+use crate::model::vector::Vec3;
+use crate::model::{Masking, Model, Ndf};
+use rayon::prelude::*;
+
+/// The largest order `e_k` kiln tallies one by one (later ones are summed as `beyond`).
+pub const MAX_ORDER: usize = 64;
+
+/// Walks per chunk: the unit of parallel work and of the fixed summation order.
+const CHUNK: u32 = 4096;
+
+/// How many walks, and from which numbers.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WalkSettings {
+    /// Walks in all, a power of two, split evenly over the scrambles.
+    pub walks: u64,
+    /// Independent scrambles (replicates) for the standard error: a power of two, 2 to 1024.
+    pub scrambles: u32,
+    /// Base seed of the scrambles.
+    pub seed: u64,
+    /// The microsurface's height distribution (the walk's result does not depend on it).
+    pub heights: Heights,
+}
+
+impl WalkSettings {
+    /// `2^22` walks: a standard error of about `1e-4` on the multiple-scattering albedo of the
+    /// roughest GGX (`alpha = 1`), well below it on `e_1`.
+    pub const DEFAULT_WALKS: u64 = 1 << 22;
+    /// Replicates for the standard error.
+    pub const DEFAULT_SCRAMBLES: u32 = 16;
+    /// Most walks one request may ask for: `2^36`, hours on two cores.
+    pub const MAX_WALKS: u64 = 1 << 36;
+
+    /// Checks the counts, naming the bad one and the range.
+    pub fn validate(&self) -> Result<(), WalkError> {
+        let s = u64::from(self.scrambles);
+        if !self.scrambles.is_power_of_two() || !(2..=1024).contains(&self.scrambles) {
+            return Err(WalkError::Scrambles(self.scrambles));
+        }
+        if !self.walks.is_power_of_two() || self.walks < s || self.walks > Self::MAX_WALKS {
+            return Err(WalkError::Walks {
+                walks: self.walks,
+                scrambles: self.scrambles,
+            });
+        }
+        Ok(())
+    }
+}
+
+impl Default for WalkSettings {
+    fn default() -> Self {
+        Self {
+            walks: Self::DEFAULT_WALKS,
+            scrambles: Self::DEFAULT_SCRAMBLES,
+            seed: 0,
+            heights: Heights::default(),
+        }
+    }
+}
+
+/// Why a walk cannot be run; each names the value and the range.
+#[derive(Clone, Debug, PartialEq)]
+pub enum WalkError {
+    /// `walks` is not a power of two in `[scrambles, 2^36]`.
+    Walks { walks: u64, scrambles: u32 },
+    /// `scrambles` is not a power of two in `[2, 1024]`.
+    Scrambles(u32),
+    /// The order asked for is not in `[1, MAX_ORDER]`.
+    Order(u64),
+    /// `mu` is not in `[0, 1]`.
+    Mu(f64),
+    /// `alpha` is not in `[0, 1000]` (or is NaN).
+    Alpha(f64),
+    /// The walk is written for this model's distribution and masking only.
+    Model(Model),
+}
+
+impl std::fmt::Display for WalkError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        use crate::error::shown;
+        match self {
+            WalkError::Walks { walks, scrambles } => write!(
+                f,
+                "walks {walks} must be a power of two from the scrambles' {scrambles} to 2^36 \
+                 (68719476736)"
+            ),
+            WalkError::Scrambles(s) => {
+                write!(f, "scrambles {s} must be a power of two from 2 to 1024")
+            }
+            WalkError::Order(k) => write!(
+                f,
+                "order {k} is out of range: the walk tallies orders 1 to {MAX_ORDER} one by one"
+            ),
+            WalkError::Mu(mu) => write!(f, "mu {} is out of range [0, 1]", shown(*mu)),
+            WalkError::Alpha(a) => write!(f, "alpha {} is out of range [0, 1000]", shown(*a)),
+            WalkError::Model(model) => write!(
+                f,
+                "the microsurface walk is written for GGX (its masking is the walk's own, \
+                 height-correlated); {} {} is not in this version",
+                model.ndf, model.masking
+            ),
+        }
+    }
+}
+
+impl std::error::Error for WalkError {}
+
+impl From<WalkError> for crate::Error {
+    fn from(e: WalkError) -> Self {
+        crate::Error::InvalidInput(e.to_string())
+    }
+}
+
+/// A value the walk estimated, with its standard error.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Measured {
+    pub value: f64,
+    pub std_error: f64,
+}
+
+impl Measured {
+    /// The mean and standard error of independent replicate means (`R >= 2`).
+    #[must_use]
+    pub fn from_replicates(means: &[f64]) -> Self {
+        let r = means.len() as f64;
+        let mean = means.iter().sum::<f64>() / r;
+        let var = means.iter().map(|&x| (x - mean) * (x - mean)).sum::<f64>();
+        Self {
+            value: mean,
+            std_error: (var / (r * (r - 1.0))).sqrt(),
+        }
+    }
+}
+
+/// What [`walk_albedo`] measured at one view.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct WalkEstimate {
+    /// `e_k` for `k = 1 ..= orders.len()`: the energy (`F = 1`) that leaves after exactly `k`
+    /// scattering events.
+    pub orders: Vec<Measured>,
+    /// The energy of every later order (`F = 1`), so that the orders with it sum to 1.
+    pub beyond: Measured,
+    /// The directional albedo with the Fresnel model at every vertex, per channel (`E` of the
+    /// whole microsurface, every order); with `F = 1`, 1.
+    pub albedo: [Measured; 3],
+    /// The most energy any channel had set aside by the vertex cap (0 unless a walk reached
+    /// `MAX_VERTICES`): a bound on what the albedo is missing.
+    pub dropped: f64,
+    /// Walks run.
+    pub walks: u64,
+    /// Mean vertices per walk.
+    pub mean_vertices: f64,
+}
+
+/// Checks a walk's inputs.
+pub fn check_inputs(model: Model, alpha: f64, mu: f64, orders: usize) -> Result<(), WalkError> {
+    if model.ndf != Ndf::Ggx || model.masking != Masking::HeightCorrelated {
+        return Err(WalkError::Model(model));
+    }
+    if !(0.0..=1000.0).contains(&alpha) {
+        return Err(WalkError::Alpha(alpha));
+    }
+    if !(0.0..=1.0).contains(&mu) {
+        return Err(WalkError::Mu(mu));
+    }
+    if orders > MAX_ORDER {
+        return Err(WalkError::Order(orders as u64));
+    }
+    Ok(())
+}
+
+/// Walks `settings.walks` times from the view `mu` on the microsurface of `model` at roughness
+/// `alpha` (GGX), tallying orders `1 ..= orders` one by one (at most [`MAX_ORDER`]) and, for a
+/// Fresnel model other than [`Fresnel::None`], the Fresnel-weighted albedo of every order.
+/// `progress` is told how many walks are done as chunks finish (in any order).
+pub fn walk_albedo(
+    model: Model,
+    alpha: f64,
+    mu: f64,
+    fresnel: &Fresnel,
+    orders: usize,
+    settings: &WalkSettings,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<WalkEstimate, WalkError> {
+    settings.validate()?;
+    check_inputs(model, alpha, mu, orders)?;
+    let ndf = Ggx { alpha };
+    let wi = Vec3::from_mu(mu);
+    let per_scramble = settings.walks / u64::from(settings.scrambles);
+    let chunks = per_scramble.div_ceil(u64::from(CHUNK));
+    let tasks: Vec<(u32, u64)> = (0..settings.scrambles)
+        .flat_map(|s| (0..chunks).map(move |c| (s, c)))
+        .collect();
+    let done = std::sync::atomic::AtomicU64::new(0);
+    let sums: Vec<Tallies> = tasks
+        .par_iter()
+        .map(|&(s, c)| {
+            let seed = mix_seed(&[settings.seed, 0x5741_4c4b, u64::from(s)]);
+            let sobol = OwenSobol::new(seed);
+            let mut tallies = Tallies::new(orders);
+            let start = c * u64::from(CHUNK);
+            let end = (start + u64::from(CHUNK)).min(per_scramble);
+            for index in start..end {
+                let mut random = random::WalkRandom::new(&sobol, seed, index as u32);
+                conductor::walk(
+                    &ndf,
+                    wi,
+                    fresnel,
+                    settings.heights,
+                    &mut random,
+                    &mut tallies,
+                );
+            }
+            let total = done.fetch_add(end - start, std::sync::atomic::Ordering::Relaxed);
+            progress(total + end - start);
+            tallies
+        })
+        .collect();
+    // Each scramble's sums, in chunk order: the same bits on any number of threads.
+    let mut replicates = vec![Tallies::new(orders); settings.scrambles as usize];
+    for (&(s, _), chunk) in tasks.iter().zip(&sums) {
+        replicates[s as usize].add(chunk);
+    }
+    let n = per_scramble as f64;
+    let measure = |get: &dyn Fn(&Tallies) -> f64| {
+        let means: Vec<f64> = replicates.iter().map(|t| get(t) / n).collect();
+        Measured::from_replicates(&means)
+    };
+    let with_fresnel = *fresnel != Fresnel::None;
+    let albedo = std::array::from_fn(|j| {
+        if with_fresnel {
+            measure(&|t| t.albedo[j])
+        } else {
+            Measured {
+                value: 1.0,
+                std_error: 0.0,
+            }
+        }
+    });
+    let dropped: Rgb = std::array::from_fn(|j| {
+        replicates.iter().map(|t| t.dropped[j]).sum::<f64>() / settings.walks as f64
+    });
+    Ok(WalkEstimate {
+        orders: (0..orders).map(|k| measure(&|t| t.orders[k])).collect(),
+        beyond: measure(&|t| t.beyond),
+        albedo,
+        dropped: dropped.into_iter().fold(0.0, f64::max),
+        walks: settings.walks,
+        mean_vertices: replicates.iter().map(|t| t.vertices).sum::<u64>() as f64
+            / settings.walks as f64,
+    })
+}

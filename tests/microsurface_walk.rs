@@ -1,0 +1,287 @@
+//! The microsurface random walk (`kiln::integrate::walk`) against what is known independently
+//! of it: GGX at `alpha = 1`, where the walk is a one-dimensional chain in (cosine, depth)
+//! written here from scratch (after a bounce the travel cosine is uniform on `(w_z, 1]`:
+//! `docs/multiple-scattering.md`), with its closed-form first order; kiln's deterministic
+//! reference `E` for the first order at other roughness; the visible-normal density below the
+//! horizon by quadrature; and the walk's own promises (height distributions, thread counts).
+
+#[path = "common/rng.rs"]
+mod rng;
+
+use kiln::integrate::reference::{ReferenceSettings, reference_albedo};
+use kiln::integrate::walk::{Heights, WalkEstimate, WalkSettings, walk_albedo};
+use kiln::model::{Ggx, Masking, MicrofacetDistribution, Model, Ndf, Vec3};
+use kiln::{Fresnel, model::fresnel::Rgb};
+use std::f64::consts::PI;
+
+const GGX: Model = Model {
+    ndf: Ndf::Ggx,
+    masking: Masking::HeightCorrelated,
+};
+
+fn walk(alpha: f64, mu: f64, fresnel: Fresnel, orders: usize, walks: u64) -> WalkEstimate {
+    let settings = WalkSettings {
+        walks,
+        ..WalkSettings::default()
+    };
+    walk_albedo(GGX, alpha, mu, &fresnel, orders, &settings, &|_| {}).unwrap()
+}
+
+fn schlick(f0: f64, f90: f64) -> Fresnel {
+    Fresnel::Schlick {
+        f0: [f0; 3],
+        f90: [f90; 3],
+    }
+}
+
+/// `E(mu) = 1 - mu ln(1 + 1 / mu)` at `alpha = 1` (`docs/physics.md`).
+fn e_alpha_one(mu: f64) -> f64 {
+    1.0 - mu * (1.0 + 1.0 / mu).ln()
+}
+
+/// One walk of the chain at `alpha = 1`, written without vectors, visible normals or
+/// reflections: `D = 1 / pi`, so the visible normal of `v` and the reflection about it send
+/// the ray to a direction uniform on the sphere's cap above the plane `z = w_z` (the half
+/// vector of `v` and a point `p` of that cap reflects `v` onto `p`). `Lambda(c) = (1 / c - 1) /
+/// 2`. State: the travel cosine and the optical depth `tau = -ln C1`. Schlick's `F` at the
+/// facet's cosine `v.m = sqrt((1 + v.p) / 2)`, with `p`'s azimuth uniform about `z`. Adds
+/// `e_k` to `orders` and the coloured albedo to `albedo`.
+fn chain(mu: f64, f0: f64, rng: &mut rng::Rng, orders: &mut [f64], albedo: &mut f64) {
+    let uniform = |rng: &mut rng::Rng| ((rng.next() >> 11) as f64 + 0.5) / (1u64 << 53) as f64;
+    let lambda = |c: f64| (1.0 / c - 1.0) / 2.0;
+    let mut c = -mu;
+    let mut tau = -uniform(rng).ln() / (1.0 + lambda(mu));
+    let (mut plain, mut coloured) = (1.0, 1.0);
+    for k in 0..10_000 {
+        let z = c + (1.0 - c) * uniform(rng);
+        let phi = 2.0 * PI * uniform(rng);
+        // v = -w: v_z = -c; v.p = v_z z + |v_xy| |p_xy| cos(phi).
+        let v_dot_p = -c * z + ((1.0 - c * c) * (1.0 - z * z)).max(0.0).sqrt() * phi.cos();
+        let cosine = ((1.0 + v_dot_p) / 2.0).max(0.0).sqrt();
+        coloured *= f0 + (1.0 - f0) * (1.0 - cosine).powi(5);
+        if z > 0.0 {
+            let l = lambda(z);
+            let escape = (-l * tau).exp();
+            if k < orders.len() {
+                orders[k] += plain * escape;
+            }
+            *albedo += coloured * escape;
+            plain *= 1.0 - escape;
+            coloured *= 1.0 - escape;
+            // The free path up, given that it stays below the top: truncated exponential.
+            tau += (1.0 - uniform(rng) * (1.0 - escape)).ln() / l;
+        } else {
+            tau += -uniform(rng).ln() / (1.0 + lambda(-z));
+        }
+        c = z;
+        if plain < 1e-14 {
+            return;
+        }
+    }
+}
+
+/// The chain's orders and albedo over `n` walks, with standard errors from 16 batches.
+fn chain_estimates(mu: f64, f0: f64, orders: usize, n: usize) -> (Vec<(f64, f64)>, (f64, f64)) {
+    let batches = 16;
+    let mut rng = rng::Rng(0x9e37_79b9_7f4a_7c15 ^ mu.to_bits());
+    let mut order_means = vec![Vec::new(); orders];
+    let mut albedo_means = Vec::new();
+    for _ in 0..batches {
+        let mut sums = vec![0.0; orders];
+        let mut albedo = 0.0;
+        for _ in 0..n / batches {
+            chain(mu, f0, &mut rng, &mut sums, &mut albedo);
+        }
+        for k in 0..orders {
+            order_means[k].push(sums[k] / (n / batches) as f64);
+        }
+        albedo_means.push(albedo / (n / batches) as f64);
+    }
+    let stats = |m: &[f64]| {
+        let r = m.len() as f64;
+        let mean = m.iter().sum::<f64>() / r;
+        let var = m.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (r * (r - 1.0));
+        (mean, var.sqrt())
+    };
+    (
+        order_means.iter().map(|m| stats(m)).collect(),
+        stats(&albedo_means),
+    )
+}
+
+/// The chain is right where it can be checked in closed form: its first order is `E` at
+/// `alpha = 1`.
+#[test]
+fn the_chain_first_order_is_the_closed_form() {
+    for mu in [0.1, 0.5, 1.0] {
+        let (orders, _) = chain_estimates(mu, 1.0, 1, 1 << 18);
+        let (value, se) = orders[0];
+        let truth = e_alpha_one(mu);
+        assert!(
+            (value - truth).abs() < 4.0 * se,
+            "mu {mu}: {value} +- {se} vs {truth}"
+        );
+    }
+}
+
+/// The walk at `alpha = 1` against the chain, order by order and with a coloured Fresnel (a
+/// throughput applied twice, or a Fresnel at the wrong cosine, moves the coloured albedo while
+/// the white furnace cannot see it), and its first order against the closed form with a
+/// standard error of at most `1e-4`.
+#[test]
+fn the_walk_at_alpha_one_is_the_chain() {
+    for mu in [0.05, 0.5, 1.0] {
+        let walked = walk(1.0, mu, schlick(0.3, 1.0), 6, 1 << 20);
+        let (orders, albedo) = chain_estimates(mu, 0.3, 6, 1 << 20);
+        let truth = e_alpha_one(mu);
+        let e1 = walked.orders[0];
+        assert!(e1.std_error <= 1e-4, "mu {mu}: {e1:?}");
+        assert!(
+            (e1.value - truth).abs() <= 3.0 * e1.std_error + 1e-7,
+            "mu {mu}: e_1 {e1:?} vs {truth}"
+        );
+        for (k, (walk_k, (chain_k, chain_se))) in walked.orders.iter().zip(&orders).enumerate() {
+            let allowed = 4.0 * (walk_k.std_error.powi(2) + chain_se.powi(2)).sqrt();
+            assert!(
+                (walk_k.value - chain_k).abs() <= allowed,
+                "mu {mu}, order {}: walk {walk_k:?}, chain {chain_k} +- {chain_se}",
+                k + 1
+            );
+        }
+        let a = walked.albedo[0];
+        let allowed = 4.0 * (a.std_error.powi(2) + albedo.1.powi(2)).sqrt();
+        assert!(
+            (a.value - albedo.0).abs() <= allowed,
+            "mu {mu}: albedo {a:?}, chain {albedo:?}"
+        );
+    }
+}
+
+/// The first order is the height-correlated Smith BRDF's albedo: kiln's deterministic
+/// reference `E` (an adaptive quadrature that shares only `D` and `Lambda` with the walk), from
+/// near a mirror to beyond `alpha = 1`, and at grazing.
+#[test]
+fn the_first_order_is_kilns_reference_e() {
+    let settings = ReferenceSettings::default();
+    for (alpha, mu) in [(0.05, 0.3), (0.3, 0.02), (0.5, 0.7), (2.0, 0.4)] {
+        let walked = walk(alpha, mu, Fresnel::None, 3, 1 << 18);
+        let e1 = walked.orders[0];
+        let truth = reference_albedo(GGX, alpha, mu, &settings).value;
+        assert!(e1.std_error <= 1e-4, "alpha {alpha}, mu {mu}: {e1:?}");
+        assert!(
+            (e1.value - truth).abs() <= 3.0 * e1.std_error + 1e-7,
+            "alpha {alpha}, mu {mu}: e_1 {e1:?} vs reference {truth}"
+        );
+    }
+}
+
+/// Visible normals from below the horizon (a ray travelling up meets a facet from below):
+/// the sampler's histogram over `cos(theta_m)` matches the density `<v, m>+ D(m) / A(v)`
+/// integrated by quadrature here, and that density's integral is `A(v) = |v_z| Lambda(-v)`.
+#[test]
+fn visible_normals_below_the_horizon_follow_their_density() {
+    let alpha: f64 = 0.6;
+    let ggx = Ggx { alpha };
+    let d = |m: Vec3| {
+        let t = (1.0 - m.z * m.z) + alpha * alpha * m.z * m.z;
+        alpha * alpha / (PI * t * t)
+    };
+    for vz in [-0.3f64, -0.8] {
+        let v = Vec3::new((1.0 - vz * vz).sqrt(), 0.0, vz);
+        // Quadrature of <v, m>+ D(m) over bins of m.z, midpoint in cos and phi.
+        let bins = 16;
+        let (nc, nphi) = (400, 400);
+        let mut expected = vec![0.0; bins];
+        for i in 0..bins * nc {
+            let z = (i as f64 + 0.5) / (bins * nc) as f64;
+            let s = (1.0 - z * z).sqrt();
+            for j in 0..nphi {
+                let phi = 2.0 * PI * (j as f64 + 0.5) / nphi as f64;
+                let m = Vec3::new(s * phi.cos(), s * phi.sin(), z);
+                let w = v.dot(m).max(0.0) * d(m) / (bins * nc * nphi) as f64 * 2.0 * PI;
+                expected[i / nc] += w;
+            }
+        }
+        let area: f64 = expected.iter().sum();
+        let lambda_up = ggx.lambda(Vec3::new(-v.x, -v.y, -v.z));
+        assert!(
+            (area - vz.abs() * lambda_up).abs() < 1e-4 * area,
+            "vz {vz}: {area} vs {}",
+            vz.abs() * lambda_up
+        );
+        let n = 1 << 20;
+        let mut counts = vec![0u64; bins];
+        let mut rng = rng::Rng(12345);
+        for _ in 0..n {
+            let u = [
+                ((rng.next() >> 11) as f64 + 0.5) / (1u64 << 53) as f64,
+                ((rng.next() >> 11) as f64 + 0.5) / (1u64 << 53) as f64,
+            ];
+            let m = ggx.sample_visible_normal(v, u);
+            assert!(v.dot(m) >= -1e-12, "vz {vz}: {m:?} is not visible");
+            counts[((m.z * bins as f64) as usize).min(bins - 1)] += 1;
+        }
+        for b in 0..bins {
+            let p = expected[b] / area;
+            let observed = counts[b] as f64 / n as f64;
+            let sigma = (p * (1.0 - p) / n as f64).sqrt();
+            assert!(
+                (observed - p).abs() <= 5.0 * sigma + 1e-5,
+                "vz {vz}, bin {b}: {observed} vs {p}"
+            );
+        }
+    }
+}
+
+/// Nothing depends on the height distribution: the same numbers walked on exponential,
+/// uniform and Gaussian heights give the same albedo (a slip in one distribution's `C1` or its
+/// inverse moves every hit below the first).
+#[test]
+fn the_height_distribution_does_not_matter() {
+    let run = |heights| {
+        let settings = WalkSettings {
+            walks: 1 << 14,
+            heights,
+            ..WalkSettings::default()
+        };
+        walk_albedo(GGX, 0.8, 0.3, &schlick(0.5, 1.0), 4, &settings, &|_| {}).unwrap()
+    };
+    let reference = run(Heights::Exponential);
+    for heights in [Heights::Uniform, Heights::Gaussian] {
+        let other = run(heights);
+        for k in 0..4 {
+            let (a, b) = (reference.orders[k].value, other.orders[k].value);
+            assert!(
+                (a - b).abs() < 1e-9,
+                "{heights:?}, order {}: {a} vs {b}",
+                k + 1
+            );
+        }
+        let (a, b) = (reference.albedo[0].value, other.albedo[0].value);
+        assert!((a - b).abs() < 1e-9, "{heights:?}: albedo {a} vs {b}");
+    }
+}
+
+/// The same settings give the same bits on one thread and on several.
+#[test]
+fn a_fixed_seed_reproduces_across_thread_counts() {
+    let run = |threads| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| walk(0.7, 0.4, schlick(0.2, 1.0), 8, 1 << 16))
+    };
+    let one = run(1);
+    let three = run(3);
+    let bits = |e: &WalkEstimate| -> Vec<u64> {
+        let albedo: Rgb = std::array::from_fn(|j| e.albedo[j].value);
+        e.orders
+            .iter()
+            .map(|m| m.value.to_bits())
+            .chain(albedo.iter().map(|v| v.to_bits()))
+            .chain([e.beyond.value.to_bits()])
+            .collect()
+    };
+    assert_eq!(bits(&one), bits(&three));
+}
