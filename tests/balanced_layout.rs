@@ -15,6 +15,8 @@ use std::fmt::Write as _;
 
 #[path = "common/cxx.rs"]
 mod cxx;
+#[path = "common/external.rs"]
+mod external;
 #[path = "common/lookup_audit.rs"]
 mod lookup_audit;
 #[path = "common/rng.rs"]
@@ -128,6 +130,11 @@ fn the_fitted_32x32_lookup_meets_2_5e_4_through_the_generated_code() {
         );
     }
     source += "}\n";
+    if cxx::compiler_or_skip("the_fitted_32x32_lookup_meets_2_5e_4_through_the_generated_code")
+        .is_none()
+    {
+        return;
+    }
     let from_hlsl = cxx::compile_and_run(dir.path(), "lookup_cpp", &source);
 
     // Rust, compiled by rustc.

@@ -14,6 +14,8 @@ use std::path::PathBuf;
 
 #[path = "common/cxx.rs"]
 mod cxx;
+#[path = "common/external.rs"]
+mod external;
 
 fn engine_file(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -218,8 +220,7 @@ fn kiln_s_shader_tables_compiles_as_cycles_includes_it() {
     }
     source.push_str("int main() { return 0; }\n");
     std::fs::write(dir.path().join("check.cpp"), source).unwrap();
-    let Some(compiler) = cxx::compiler() else {
-        eprintln!("no C++ compiler: the declarations were checked structurally only");
+    let Some(compiler) = cxx::compiler_or_skip("compiling Blender's declarations") else {
         return;
     };
     let out = std::process::Command::new(compiler)

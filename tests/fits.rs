@@ -10,6 +10,10 @@ use kiln::integrate::value::{Integral, Point};
 use kiln::verify::fit::{FitAuditSettings, FitReport, audit_fit};
 use std::path::Path;
 
+#[path = "common/cxx.rs"]
+mod cxx;
+#[path = "common/external.rs"]
+mod external;
 #[path = "common/rng.rs"]
 mod rng;
 use rng::Rng;
@@ -286,10 +290,7 @@ fn kiln_fits_state_a_maximum_no_random_point_beats() {
 /// Rust function's values, when the machine has a compiler.
 #[test]
 fn the_emitted_c_header_computes_the_fit() {
-    #[path = "common/cxx.rs"]
-    mod cxx;
-    let Some(compiler) = cxx::compiler() else {
-        eprintln!("no C++ compiler: the emitted C header is not compiled");
+    let Some(compiler) = cxx::compiler_or_skip("the_emitted_c_header_computes_the_fit") else {
         return;
     };
     for (name, rust) in COMMITTED {

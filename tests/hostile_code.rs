@@ -22,6 +22,8 @@ use kiln::{Quantity, Table, TableSpec};
 mod command;
 #[path = "common/cxx.rs"]
 mod cxx;
+#[path = "common/external.rs"]
+mod external;
 use command::kiln;
 
 /// Texts that try to leave a comment in each way a language allows, each carrying the word
@@ -204,7 +206,7 @@ fn blender_shader_tables() -> String {
 /// Runs the C++ preprocessor on `file` (comments removed, as the compiler sees it), if there
 /// is one.
 fn preprocessed(file: &Path) -> Option<String> {
-    let compiler = cxx::compiler()?;
+    let compiler = cxx::compiler_or_skip("the C++ preprocessor's reading of the emitted code")?;
     let out = std::process::Command::new(compiler)
         .args([
             "-x",

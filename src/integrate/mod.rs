@@ -2,6 +2,7 @@
 
 pub mod albedo;
 pub mod average_quadrature;
+pub mod compensation;
 pub mod dielectric;
 pub mod dielectric_average;
 pub mod estimate;

@@ -10,6 +10,20 @@ pub fn compiler() -> Option<&'static str> {
     })
 }
 
+/// The C++ compiler, or the skip reported for `test` (see `external.rs`).
+#[allow(dead_code)] // not every test that includes this file compiles
+pub fn compiler_or_skip(test: &str) -> Option<&'static str> {
+    if let Some(compiler) = compiler() {
+        return Some(compiler);
+    }
+    super::external::skipped(
+        test,
+        "a C++ compiler (c++, g++ or clang++)",
+        "Debian: apt-get install g++",
+    );
+    None
+}
+
 /// Compiles `source` as C++17 with every literal in single precision (`name.cpp` in `dir`),
 /// runs it, and returns the numbers it prints, one per line. Panics, with the compiler's
 /// message, if it does not compile.

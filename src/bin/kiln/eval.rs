@@ -1,5 +1,7 @@
 //! `kiln eval`.
 
+mod walk;
+
 use crate::args::{SEE_CONVENTIONS, parse_alpha, parse_mu, parse_roughness, parse_samples};
 use crate::fresnel_args::FresnelArgs;
 use clap::{Args, ValueEnum};
@@ -32,6 +34,17 @@ pub enum EvalQuantity {
     EDielectric,
     /// Its average 2 * integral of E mu dmu.
     EAvgDielectric,
+    /// e_k(mu): the energy (F = 1) that leaves a GGX microsurface after exactly --order k
+    /// scattering events, by the microsurface random walk (e_1 is E; the orders sum to 1).
+    EOrder,
+    /// The directional albedo of the whole GGX microsurface, every order, with the Fresnel
+    /// model (--f0/--f90, or --eta/--k) applied at every bounce, by the random walk: the truth
+    /// energy compensation stands for.
+    EMultiple,
+    /// The albedo of the single-scattering BRDF with the Fresnel model plus --compensation
+    /// (kulla-conty or turquin), from the reference's E, E_avg, E_F and F_avg: compare with
+    /// e-multiple.
+    ECompensated,
 }
 
 /// Evaluate E or E_avg at one point, or F_avg.
@@ -82,9 +95,23 @@ pub struct EvalArgs {
     /// e-avg, as `kiln bake` uses].
     #[arg(long, value_parser = parse_samples, allow_negative_numbers = true)]
     samples: Option<u64>,
-    /// Independent scrambles, for the standard error: a power of two, 2 to 1024.
-    #[arg(long, default_value_t = QmcSettings::DEFAULT_SCRAMBLES, allow_negative_numbers = true)]
-    scrambles: u32,
+    /// Independent scrambles, for the standard error: a power of two, 2 to 1024 [default: 8
+    /// for QMC, 16 for the walk].
+    #[arg(long, allow_negative_numbers = true)]
+    scrambles: Option<u32>,
+    /// For --quantity e-order: which order k, 1 to 64.
+    #[arg(long, allow_negative_numbers = true)]
+    order: Option<u64>,
+    /// For --quantity e-order|e-multiple: random walks, a power of two (split over the
+    /// scrambles) [default: 2^22, a standard error of about 1e-4 at alpha = 1].
+    #[arg(long, value_parser = parse_samples, allow_negative_numbers = true)]
+    walks: Option<u64>,
+    /// For --quantity e-compensated: the compensation whose albedo to compute.
+    #[arg(long, value_enum)]
+    compensation: Option<kiln::integrate::compensation::Compensation>,
+    /// Print nothing on stderr (no estimate, no progress).
+    #[arg(long, short)]
+    quiet: bool,
     /// Base seed of the scrambles.
     #[arg(long, default_value_t = 0)]
     seed: u64,
@@ -95,7 +122,17 @@ pub struct EvalArgs {
 
 pub fn run(args: EvalArgs) -> kiln::Result<()> {
     let fresnel = args.fresnel.model()?;
+    args.flags_of_their_quantities()?;
+    if matches!(
+        args.quantity,
+        EvalQuantity::EOrder | EvalQuantity::EMultiple | EvalQuantity::ECompensated
+    ) {
+        return multiple_scattering(&args, fresnel);
+    }
     let quantity = match args.quantity {
+        EvalQuantity::EOrder | EvalQuantity::EMultiple | EvalQuantity::ECompensated => {
+            unreachable!("handled above")
+        }
         EvalQuantity::FAvg => return fresnel_average(&args, fresnel),
         EvalQuantity::E => Quantity::E,
         EvalQuantity::EAvg => Quantity::EAvg,
@@ -171,7 +208,7 @@ pub fn run(args: EvalArgs) -> kiln::Result<()> {
             });
             let settings = QmcSettings {
                 samples,
-                scrambles: args.scrambles,
+                scrambles: args.scrambles.unwrap_or(QmcSettings::DEFAULT_SCRAMBLES),
                 seed: args.seed,
             };
             settings.validate().map_err(kiln::Error::InvalidInput)?;
@@ -316,7 +353,7 @@ fn fresnel_weighted(
             Method::Qmc => {
                 let settings = QmcSettings {
                     samples: args.samples.unwrap_or(QmcSettings::DEFAULT_SAMPLES),
-                    scrambles: args.scrambles,
+                    scrambles: args.scrambles.unwrap_or(QmcSettings::DEFAULT_SCRAMBLES),
                     seed: args.seed,
                 };
                 settings.validate().map_err(kiln::Error::InvalidInput)?;
@@ -420,7 +457,7 @@ fn dielectric(
                 } else {
                     16 * QmcSettings::DEFAULT_SAMPLES
                 }),
-                scrambles: args.scrambles,
+                scrambles: args.scrambles.unwrap_or(QmcSettings::DEFAULT_SCRAMBLES),
                 seed: args.seed,
             };
             settings.validate().map_err(kiln::Error::InvalidInput)?;
@@ -526,7 +563,10 @@ fn dielectric(
 fn print_json(args: &EvalArgs, mut object: serde_json::Value) {
     if args.method == Method::Qmc {
         object["estimator"] = "vndf-sobol-owen".into();
-        object["scrambles"] = args.scrambles.into();
+        object["scrambles"] = args
+            .scrambles
+            .unwrap_or(QmcSettings::DEFAULT_SCRAMBLES)
+            .into();
         object["seed"] = args.seed.into();
     }
     println!("{object}");
@@ -541,7 +581,102 @@ fn scalar_or_rgb(values: [f64; 3]) -> serde_json::Value {
     }
 }
 
+/// `kiln eval --quantity e-order|e-multiple|e-compensated`.
+fn multiple_scattering(args: &EvalArgs, fresnel: Fresnel) -> kiln::Result<()> {
+    let model = Model {
+        ndf: args.ndf,
+        masking: args.masking,
+    };
+    let (Some(alpha), Some(mu)) = (args.alpha_given()?, args.mu) else {
+        return Err(kiln::Error::InvalidInput(format!(
+            "--quantity {} needs --mu M and --alpha A (or --roughness R)",
+            args.quantity
+                .to_possible_value()
+                .expect("no skipped variants")
+                .get_name()
+        )));
+    };
+    if args.method != Method::Qmc || args.samples.is_some() {
+        return Err(kiln::Error::InvalidInput(
+            "--method and --samples choose the single-scattering integrator: the walk has              --walks, --scrambles and --seed"
+                .into(),
+        ));
+    }
+    match args.quantity {
+        EvalQuantity::EOrder => {
+            if fresnel != Fresnel::None {
+                return Err(kiln::Error::InvalidInput(
+                    "e_k is the energy of order k with F = 1: drop the Fresnel flags, or use \
+                     --quantity e-multiple for the albedo with a Fresnel"
+                        .into(),
+                ));
+            }
+            let Some(order) = args.order else {
+                return Err(kiln::Error::InvalidInput(
+                    "--quantity e-order needs --order K (1 to 64)".into(),
+                ));
+            };
+            walk::multiple_scattering(args, model, fresnel, alpha, mu, Some(order))
+        }
+        EvalQuantity::EMultiple => {
+            if matches!(fresnel, Fresnel::Dielectric { .. }) {
+                return Err(kiln::Error::InvalidInput(
+                    "the walk is a conductor's (every bounce reflects): a dielectric \
+                     interface, which also refracts, is not in this version; give Schlick's \
+                     --f0 (and --f90) or a conductor's --eta and --k"
+                        .into(),
+                ));
+            }
+            walk::multiple_scattering(args, model, fresnel, alpha, mu, None)
+        }
+        EvalQuantity::ECompensated => {
+            if matches!(fresnel, Fresnel::Dielectric { .. }) {
+                return Err(kiln::Error::InvalidInput(
+                    "e-compensated is a conductor's albedo: give Schlick's --f0 (and --f90) or \
+                     a conductor's --eta and --k"
+                        .into(),
+                ));
+            }
+            walk::compensated(args, model, fresnel, alpha, mu)
+        }
+        _ => unreachable!("called for the walk's quantities"),
+    }
+}
+
 impl EvalArgs {
+    /// `--alpha`, or `--roughness` as alpha; none given is `None`.
+    fn alpha_given(&self) -> kiln::Result<Option<f64>> {
+        Ok(match (self.alpha, self.roughness) {
+            (Some(alpha), _) => Some(alpha),
+            (None, Some(r)) => Some(RoughnessConvention::Perceptual.to_alpha(r)),
+            (None, None) => None,
+        })
+    }
+
+    /// `--order`, `--walks` and `--compensation` belong to the walk's quantities.
+    fn flags_of_their_quantities(&self) -> kiln::Result<()> {
+        let misplaced = |flag: &str, wanted: &str| {
+            Err(kiln::Error::InvalidInput(format!(
+                "{flag} applies to --quantity {wanted} only"
+            )))
+        };
+        if self.order.is_some() && self.quantity != EvalQuantity::EOrder {
+            return misplaced("--order", "e-order");
+        }
+        if self.walks.is_some()
+            && !matches!(
+                self.quantity,
+                EvalQuantity::EOrder | EvalQuantity::EMultiple
+            )
+        {
+            return misplaced("--walks", "e-order or e-multiple");
+        }
+        if self.compensation.is_some() && self.quantity != EvalQuantity::ECompensated {
+            return misplaced("--compensation", "e-compensated");
+        }
+        Ok(())
+    }
+
     /// `--samples` is QMC's: an error with `--method reference`.
     fn no_samples_for_reference(&self) -> kiln::Result<()> {
         if self.samples.is_some() {

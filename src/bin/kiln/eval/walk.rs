@@ -1,0 +1,213 @@
+//! `kiln eval --quantity e-order|e-multiple|e-compensated`: the microsurface walk's bounce
+//! spectrum and albedo, and the albedo a compensation gives (`kiln::integrate::walk`,
+//! `kiln::integrate::compensation`).
+
+use super::{EvalArgs, scalar_or_rgb};
+use kiln::integrate::compensation::compensated_albedo;
+use kiln::integrate::reference::ReferenceSettings;
+use kiln::integrate::walk::{WalkEstimate, WalkSettings, walk_albedo};
+use kiln::{Fresnel, Model};
+use std::time::Instant;
+
+/// Walks run to time the machine before a long request is announced.
+const PILOT_WALKS: u64 = 1 << 15;
+
+/// Announced on stderr (with a progress bar on a terminal) when longer than this.
+const ANNOUNCE_SECONDS: f64 = 2.0;
+
+/// `e-order` (`orders` = the order asked for, `fresnel` none) or `e-multiple`.
+pub fn multiple_scattering(
+    args: &EvalArgs,
+    model: Model,
+    fresnel: Fresnel,
+    alpha: f64,
+    mu: f64,
+    order: Option<u64>,
+) -> kiln::Result<()> {
+    let settings = WalkSettings {
+        walks: args.walks.unwrap_or(WalkSettings::DEFAULT_WALKS),
+        scrambles: args.scrambles.unwrap_or(WalkSettings::DEFAULT_SCRAMBLES),
+        seed: args.seed,
+        heights: Default::default(),
+    };
+    settings.validate()?;
+    let orders = match order {
+        Some(k) if (1..=kiln::integrate::walk::MAX_ORDER as u64).contains(&k) => k as usize,
+        Some(k) => return Err(kiln::integrate::walk::WalkError::Order(k).into()),
+        None => 1,
+    };
+    kiln::integrate::walk::check_inputs(model, alpha, mu, orders)?;
+    let start = Instant::now();
+    let bar = announce(args, model, &fresnel, alpha, mu, orders, &settings)?;
+    let estimate = walk_albedo(model, alpha, mu, &fresnel, orders, &settings, &|done| {
+        bar.set_position(done)
+    })?;
+    bar.finish_and_clear();
+    let seconds = start.elapsed().as_secs_f64();
+    print(args, model, fresnel, alpha, mu, order, &estimate, seconds);
+    Ok(())
+}
+
+/// Times a pilot run and, when the whole request would take more than [`ANNOUNCE_SECONDS`],
+/// says how long before it starts; returns the progress bar (hidden off a terminal).
+fn announce(
+    args: &EvalArgs,
+    model: Model,
+    fresnel: &Fresnel,
+    alpha: f64,
+    mu: f64,
+    orders: usize,
+    settings: &WalkSettings,
+) -> kiln::Result<indicatif::ProgressBar> {
+    let hidden = indicatif::ProgressBar::hidden;
+    if settings.walks <= 4 * PILOT_WALKS {
+        return Ok(hidden());
+    }
+    let pilot = WalkSettings {
+        walks: PILOT_WALKS.max(u64::from(settings.scrambles)),
+        ..*settings
+    };
+    let start = Instant::now();
+    walk_albedo(model, alpha, mu, fresnel, orders, &pilot, &|_| {})?;
+    let estimate = start.elapsed().as_secs_f64() * (settings.walks / pilot.walks) as f64;
+    if estimate < ANNOUNCE_SECONDS || args.quiet {
+        return Ok(hidden());
+    }
+    eprintln!(
+        "kiln: {} walks, about {} on this machine (fewer with --walks)",
+        settings.walks,
+        crate::human_seconds(estimate)
+    );
+    Ok(crate::progress_bar(false, settings.walks, "walking"))
+}
+
+#[allow(clippy::too_many_arguments)]
+fn print(
+    args: &EvalArgs,
+    model: Model,
+    fresnel: Fresnel,
+    alpha: f64,
+    mu: f64,
+    order: Option<u64>,
+    estimate: &WalkEstimate,
+    seconds: f64,
+) {
+    let (symbol, value, error) = match order {
+        Some(k) => {
+            let e = estimate.orders[k as usize - 1];
+            (format!("e_{k}"), [e.value; 3], e.std_error)
+        }
+        None => (
+            "E_multiple".to_string(),
+            estimate.albedo.map(|m| m.value),
+            kiln::stats::max_or_nan(estimate.albedo.iter().map(|m| m.std_error)),
+        ),
+    };
+    if args.json {
+        let mut object = serde_json::json!({
+            "quantity": symbol,
+            "ndf": model.ndf.name(),
+            "masking": model.masking.name(),
+            "fresnel": fresnel,
+            "alpha": alpha,
+            "roughness": args.roughness,
+            "mu": mu,
+            "value": scalar_or_rgb(value),
+            "value_rgb": value,
+            "std_error": error,
+            "method": "microsurface-walk",
+            "walks": estimate.walks,
+            "scrambles": args.scrambles.unwrap_or(WalkSettings::DEFAULT_SCRAMBLES),
+            "seed": args.seed,
+            "mean_vertices": estimate.mean_vertices,
+            "dropped_bound": estimate.dropped,
+            "seconds": seconds,
+            "kiln_version": kiln::format::metadata::KILN_VERSION,
+        });
+        if let Some(k) = order {
+            object["order"] = k.into();
+            object["orders"] = serde_json::json!(estimate.orders);
+            object["beyond"] = serde_json::json!(estimate.beyond);
+        }
+        println!("{object}");
+    } else {
+        let shown = if value[0] == value[1] && value[1] == value[2] {
+            format!("{:.8}", value[0])
+        } else {
+            format!("[{:.8}, {:.8}, {:.8}]", value[0], value[1], value[2])
+        };
+        println!(
+            "{symbol}(mu = {}, alpha = {}) = {shown} ± {error:.1e} (microsurface walk, {model}, \
+             {} Fresnel, {} walks, {:.2} vertices a walk, {seconds:.3} s)",
+            kiln::error::brief(mu),
+            kiln::error::brief(alpha),
+            fresnel.name(),
+            estimate.walks,
+            estimate.mean_vertices
+        );
+        if let Some(k) = order {
+            println!(
+                "  orders after {k}: {:.8} ± {:.1e}",
+                estimate.beyond.value, estimate.beyond.std_error
+            );
+        }
+    }
+}
+
+/// `e-compensated`: the albedo of single scattering plus `compensation`.
+pub fn compensated(
+    args: &EvalArgs,
+    model: Model,
+    fresnel: Fresnel,
+    alpha: f64,
+    mu: f64,
+) -> kiln::Result<()> {
+    let Some(compensation) = args.compensation else {
+        return Err(kiln::Error::InvalidInput(
+            "--quantity e-compensated needs --compensation kulla-conty|turquin".into(),
+        ));
+    };
+    let start = Instant::now();
+    let value = compensated_albedo(
+        model,
+        alpha,
+        mu,
+        &fresnel,
+        compensation,
+        &ReferenceSettings::default(),
+    );
+    let seconds = start.elapsed().as_secs_f64();
+    if args.json {
+        let object = serde_json::json!({
+            "quantity": "E_compensated",
+            "compensation": compensation.name(),
+            "ndf": model.ndf.name(),
+            "masking": model.masking.name(),
+            "fresnel": fresnel,
+            "alpha": alpha,
+            "roughness": args.roughness,
+            "mu": mu,
+            "value": scalar_or_rgb(value),
+            "value_rgb": value,
+            "method": "reference",
+            "seconds": seconds,
+            "kiln_version": kiln::format::metadata::KILN_VERSION,
+        });
+        println!("{object}");
+    } else {
+        let shown = if value[0] == value[1] && value[1] == value[2] {
+            format!("{:.10}", value[0])
+        } else {
+            format!("[{:.10}, {:.10}, {:.10}]", value[0], value[1], value[2])
+        };
+        println!(
+            "E_compensated(mu = {}, alpha = {}; {}, {} Fresnel) = {shown} ({model}, from the \
+             reference's E, E_avg, E_F and F_avg, {seconds:.3} s)",
+            kiln::error::brief(mu),
+            kiln::error::brief(alpha),
+            compensation.name(),
+            fresnel.name()
+        );
+    }
+    Ok(())
+}
