@@ -7,6 +7,7 @@ use std::path::Path;
 use std::process::Command;
 
 #[test]
+#[ignore = "long (about 140 s): .ci/run runs it with --ignored"]
 fn build_script_example_bakes_and_includes_the_tables() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let manifest = root.join("examples/build-script/Cargo.toml");

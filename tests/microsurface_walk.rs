@@ -9,7 +9,9 @@
 mod rng;
 
 use kiln::integrate::reference::{ReferenceSettings, reference_albedo};
-use kiln::integrate::walk::{Heights, WalkEstimate, WalkSettings, walk_albedo};
+use kiln::integrate::walk::{
+    Heights, WalkEstimate, WalkSettings, walk_albedo, walk_schlick_polynomial,
+};
 use kiln::model::{Ggx, Masking, MicrofacetDistribution, Model, Ndf, Vec3};
 use kiln::{Fresnel, model::fresnel::Rgb};
 use std::f64::consts::PI;
@@ -284,4 +286,32 @@ fn a_fixed_seed_reproduces_across_thread_counts() {
             .collect()
     };
     assert_eq!(bits(&one), bits(&three));
+}
+
+/// One set of walks for every `F0` (Schlick's Fresnel carried as a polynomial in `F0`): at
+/// `alpha = 1` its albedo at several `F0` is the chain's, written with `F` at each bounce
+/// directly; at `F0 = 1` (`F = 1`) it is 1, every walk leaving in the end.
+#[test]
+fn the_f0_polynomial_is_the_albedo_at_every_f0() {
+    let settings = WalkSettings {
+        walks: 1 << 20,
+        ..WalkSettings::default()
+    };
+    let mu = 0.4;
+    let polynomial = walk_schlick_polynomial(GGX, 1.0, mu, 1.0, &settings, &|_| {}).unwrap();
+    for f0 in [0.0, 0.3, 0.8] {
+        let (_, (chain, chain_se)) = chain_estimates(mu, f0, 1, 1 << 20);
+        let walked = polynomial.albedo(f0);
+        let allowed = 4.0 * (walked.std_error.powi(2) + chain_se.powi(2)).sqrt();
+        assert!(
+            (walked.value - chain).abs() <= allowed,
+            "F0 {f0}: polynomial {walked:?}, chain {chain} +- {chain_se}"
+        );
+    }
+    // Russian roulette keeps it unbiased, not exact: within its standard error.
+    let white = polynomial.albedo(1.0);
+    assert!(
+        (white.value - 1.0).abs() <= 4.0 * white.std_error + 1e-12,
+        "{white:?}"
+    );
 }

@@ -4,6 +4,10 @@
 //! the page shows the output under the command, the run must print the same lines, every number
 //! within one unit of the last digit the page prints; a picture a command draws into `docs/`
 //! must be the committed one.
+//!
+//! A block the page marks `<!-- long: ... -->` on the line before it (a command of a minute or
+//! more) runs in its own test, ignored by the README's test command and run by `.ci/run`
+//! (`cargo test --release -- --ignored`).
 
 #![cfg(feature = "cli")]
 
@@ -16,6 +20,8 @@ struct Example {
     line: usize,
     command: String,
     output: Vec<String>,
+    /// In a block marked `<!-- long: ... -->`.
+    long: bool,
 }
 
 fn examples(page: &Path) -> Vec<Example> {
@@ -23,11 +29,17 @@ fn examples(page: &Path) -> Vec<Example> {
     let mut examples: Vec<Example> = Vec::new();
     let mut in_block = false;
     let mut open: Option<usize> = None;
+    let mut long = false;
+    let mut previous = "";
     for (k, line) in text.lines().enumerate() {
         if line.starts_with("```") {
             in_block = !in_block;
+            long = in_block && previous.starts_with("<!-- long");
             open = None;
             continue;
+        }
+        if !line.trim().is_empty() {
+            previous = line;
         }
         if !in_block {
             continue;
@@ -39,6 +51,7 @@ fn examples(page: &Path) -> Vec<Example> {
                     line: k + 1,
                     command: command.to_string(),
                     output: Vec::new(),
+                    long,
                 });
                 examples.len() - 1
             });
@@ -181,11 +194,28 @@ fn pages() -> Vec<std::path::PathBuf> {
 
 #[test]
 fn every_documented_command_runs_and_prints_what_the_page_shows() {
+    // The README's quick start alone has three.
+    let ran = run_documented(false);
+    assert!(ran >= 3, "only {ran} documented commands found");
+}
+
+#[test]
+#[ignore = "long (about 110 s): .ci/run runs it with --ignored"]
+fn every_long_documented_command_runs_and_prints_what_the_page_shows() {
+    let ran = run_documented(true);
+    assert!(ran >= 2, "only {ran} long documented commands found");
+}
+
+/// Runs the documented commands that are `long` (or not), page by page; returns how many.
+fn run_documented(long: bool) -> usize {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let pages = pages();
     let mut ran = 0;
     for page in &pages {
-        let examples = examples(page);
+        let examples: Vec<Example> = examples(page)
+            .into_iter()
+            .filter(|e| e.long == long)
+            .collect();
         if examples.is_empty() {
             continue;
         }
@@ -213,8 +243,7 @@ fn every_documented_command_runs_and_prints_what_the_page_shows() {
             );
         }
     }
-    // The README's quick start alone has three.
-    assert!(ran >= 3, "only {ran} documented commands found");
+    ran
 }
 
 #[test]

@@ -101,6 +101,7 @@ fn the_default_bake_merges_byte_for_byte() {
 }
 
 #[test]
+#[ignore = "long (about 20 s): .ci/run runs it with --ignored"]
 fn a_beckmann_bake_merges_byte_for_byte() {
     merged_equals_unsharded(&[
         "--ndf",

@@ -19,8 +19,8 @@ use crate::model::kulla_conty::fresnel_colour;
 #[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum Compensation {
     /// Kulla and Conty 2017: the added lobe `(1 - E(mu_o)) (1 - E(mu_i)) / (pi (1 - E_avg))`
-    /// times `F_avg^2 E_avg / (1 - F_avg (1 - E_avg))` per channel
-    /// ([`crate::model::kulla_conty`]); its albedo is `E_F(mu) + colour (1 - E(mu))`.
+    /// times `F_avg^2 E_avg / (1 - F_avg (1 - E_avg))` per channel (kiln's
+    /// `model::kulla_conty`); its albedo is `E_F(mu) + colour (1 - E(mu))`.
     KullaConty,
     /// Turquin 2019, "Practical multiple scattering compensation for microfacet models"
     /// (Filament, Unreal 5, Bevy, three.js): the single-scattering BRDF scaled by

@@ -30,6 +30,10 @@ pub const ROULETTE: f64 = 1e-3;
 /// `alpha = 1000`, grazing, is a few hundred).
 pub const MAX_VERTICES: u32 = 1 << 20;
 
+/// The highest power of `F0` the walk's albedo polynomial keeps (see [`Tallies::polynomial`]);
+/// a walk with more vertices sets the higher powers aside as dropped (at `F0 = 1`).
+pub const MAX_DEGREE: usize = 64;
+
 /// What a set of walks leaves: sums over the walks.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Tallies {
@@ -39,20 +43,31 @@ pub struct Tallies {
     pub beyond: f64,
     /// The energy that left, every order, with the Fresnel factor of every vertex (per channel).
     pub albedo: Rgb,
-    /// The throughput set aside by [`MAX_VERTICES`] (per channel, with Fresnel).
+    /// With Schlick's Fresnel of unknown `F0` (and a given `F90`): the albedo of every order
+    /// as a polynomial in `F0`, `polynomial[j]` the coefficient of `F0^j` (Hill 2019, "A
+    /// Multi-Faceted Exploration (Part 4)": one throughput per power of `F0`); empty when not
+    /// asked for. All coefficients are non-negative.
+    pub polynomial: Vec<f64>,
+    /// The throughput set aside by [`MAX_VERTICES`] (per channel, with Fresnel), and by
+    /// [`MAX_DEGREE`] in the polynomial (at `F0 = 1`, in channel 0).
     pub dropped: Rgb,
     /// Vertices visited, over all walks.
     pub vertices: u64,
 }
 
 impl Tallies {
-    /// Empty tallies for `orders` orders.
+    /// Empty tallies for `orders` orders, with the `F0` polynomial or not.
     #[must_use]
-    pub fn new(orders: usize) -> Self {
+    pub fn new(orders: usize, polynomial: bool) -> Self {
         Self {
             orders: vec![0.0; orders],
             beyond: 0.0,
             albedo: [0.0; 3],
+            polynomial: if polynomial {
+                vec![0.0; MAX_DEGREE + 1]
+            } else {
+                Vec::new()
+            },
             dropped: [0.0; 3],
             vertices: 0,
         }
@@ -64,6 +79,9 @@ impl Tallies {
             *a += b;
         }
         self.beyond += other.beyond;
+        for (a, b) in self.polynomial.iter_mut().zip(&other.polynomial) {
+            *a += b;
+        }
         for j in 0..3 {
             self.albedo[j] += other.albedo[j];
             self.dropped[j] += other.dropped[j];
@@ -76,16 +94,24 @@ impl Tallies {
 /// `tallies`. With `fresnel` equal to [`Fresnel::None`] the walk stops after the last order
 /// tallied and puts what it still carries into `beyond` (with `F = 1` every walk leaves in the
 /// end, so that is exactly the expected energy of the later orders); otherwise it goes on to
-/// the end for the Fresnel-weighted albedo.
+/// the end for the Fresnel-weighted albedo. With `schlick_f90`, and `tallies` made with a
+/// polynomial, the walk also carries Schlick's Fresnel `F0 + (F90 - F0) (1 - c)^5` as a
+/// polynomial in `F0`.
 pub fn walk<N: MicrofacetDistribution>(
     ndf: &N,
     wi: Vec3,
     fresnel: &Fresnel,
+    schlick_f90: Option<f64>,
     heights: Heights,
     random: &mut WalkRandom<'_>,
     tallies: &mut Tallies,
 ) {
-    let to_the_end = *fresnel != Fresnel::None;
+    let polynomial = schlick_f90.filter(|_| !tallies.polynomial.is_empty());
+    let to_the_end = *fresnel != Fresnel::None || polynomial.is_some();
+    // The throughput's coefficients of F0^0 ..= F0^degree.
+    let mut coefficients = [0.0; MAX_DEGREE + 1];
+    coefficients[0] = 1.0;
+    let mut degree = 0;
     let tallied = tallies.orders.len() as u32;
     // Throughput with F = 1 (for the orders) and with the Fresnel factors (per channel).
     let mut plain = 1.0;
@@ -101,7 +127,22 @@ pub fn walk<N: MicrofacetDistribution>(
         let v = Vec3::new(-w.x, -w.y, -w.z);
         let m = ndf.sample_visible_normal(v, [random.uniform(), random.uniform()]);
         let cosine = v.dot(m);
-        if to_the_end {
+        if let Some(f90) = polynomial {
+            // Times F0 (1 - s) + F90 s, s = (1 - c)^5: every coefficient moves up a power.
+            let s = (1.0 - cosine.clamp(0.0, 1.0)).powi(5);
+            let (a, b) = (1.0 - s, f90 * s);
+            if degree == MAX_DEGREE {
+                tallies.dropped[0] += a * coefficients[MAX_DEGREE];
+            } else {
+                degree += 1;
+                coefficients[degree] = 0.0;
+            }
+            for j in (1..=degree).rev() {
+                coefficients[j] = a * coefficients[j - 1] + b * coefficients[j];
+            }
+            coefficients[0] *= b;
+        }
+        if *fresnel != Fresnel::None {
             let f = fresnel.reflectance(cosine);
             for (c, f) in coloured.iter_mut().zip(f) {
                 *c *= f;
@@ -125,11 +166,19 @@ pub fn walk<N: MicrofacetDistribution>(
             for (a, c) in tallies.albedo.iter_mut().zip(coloured) {
                 *a += c * escape;
             }
+            if polynomial.is_some() {
+                for (t, c) in tallies.polynomial.iter_mut().zip(&coefficients[..=degree]) {
+                    *t += c * escape;
+                }
+            }
             if escape >= 1.0 {
                 return;
             }
             plain *= 1.0 - escape;
             for c in &mut coloured {
+                *c *= 1.0 - escape;
+            }
+            for c in &mut coefficients[..=degree] {
                 *c *= 1.0 - escape;
             }
             // A hit below h given no escape: C1(h') = C1(h) / (1 - u (1 - P))^(1 / Lambda).
@@ -146,6 +195,9 @@ pub fn walk<N: MicrofacetDistribution>(
             for (d, c) in tallies.dropped.iter_mut().zip(coloured) {
                 *d += c;
             }
+            if polynomial.is_some() {
+                tallies.dropped[0] += coefficients[..=degree].iter().sum::<f64>();
+            }
             return;
         }
         if plain < ROULETTE {
@@ -155,6 +207,9 @@ pub fn walk<N: MicrofacetDistribution>(
             }
             plain = ROULETTE;
             for c in &mut coloured {
+                *c /= survive;
+            }
+            for c in &mut coefficients[..=degree] {
                 *c /= survive;
             }
         }

@@ -23,7 +23,7 @@ pub use conductor::Tallies;
 pub use heights::Heights;
 
 use crate::integrate::sobol::{OwenSobol, mix_seed};
-use crate::model::fresnel::{Fresnel, Rgb};
+use crate::model::fresnel::Fresnel;
 use crate::model::ndf::Ggx;
 use crate::model::vector::Vec3;
 use crate::model::{Masking, Model, Ndf};
@@ -99,6 +99,8 @@ pub enum WalkError {
     Alpha(f64),
     /// The walk is written for this model's distribution and masking only.
     Model(Model),
+    /// `F90` is not in `[0, 1]`.
+    F90(f64),
 }
 
 impl std::fmt::Display for WalkError {
@@ -119,6 +121,7 @@ impl std::fmt::Display for WalkError {
             ),
             WalkError::Mu(mu) => write!(f, "mu {} is out of range [0, 1]", shown(*mu)),
             WalkError::Alpha(a) => write!(f, "alpha {} is out of range [0, 1000]", shown(*a)),
+            WalkError::F90(v) => write!(f, "f90 {} is out of range [0, 1]", shown(*v)),
             WalkError::Model(model) => write!(
                 f,
                 "the microsurface walk is written for GGX (its masking is the walk's own, \
@@ -208,48 +211,10 @@ pub fn walk_albedo(
     settings: &WalkSettings,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Result<WalkEstimate, WalkError> {
-    settings.validate()?;
-    check_inputs(model, alpha, mu, orders)?;
-    let ndf = Ggx { alpha };
-    let wi = Vec3::from_mu(mu);
-    let per_scramble = settings.walks / u64::from(settings.scrambles);
-    let chunks = per_scramble.div_ceil(u64::from(CHUNK));
-    let tasks: Vec<(u32, u64)> = (0..settings.scrambles)
-        .flat_map(|s| (0..chunks).map(move |c| (s, c)))
-        .collect();
-    let done = std::sync::atomic::AtomicU64::new(0);
-    let sums: Vec<Tallies> = tasks
-        .par_iter()
-        .map(|&(s, c)| {
-            let seed = mix_seed(&[settings.seed, 0x5741_4c4b, u64::from(s)]);
-            let sobol = OwenSobol::new(seed);
-            let mut tallies = Tallies::new(orders);
-            let start = c * u64::from(CHUNK);
-            let end = (start + u64::from(CHUNK)).min(per_scramble);
-            for index in start..end {
-                let mut random = random::WalkRandom::new(&sobol, seed, index as u32);
-                conductor::walk(
-                    &ndf,
-                    wi,
-                    fresnel,
-                    settings.heights,
-                    &mut random,
-                    &mut tallies,
-                );
-            }
-            let total = done.fetch_add(end - start, std::sync::atomic::Ordering::Relaxed);
-            progress(total + end - start);
-            tallies
-        })
-        .collect();
-    // Each scramble's sums, in chunk order: the same bits on any number of threads.
-    let mut replicates = vec![Tallies::new(orders); settings.scrambles as usize];
-    for (&(s, _), chunk) in tasks.iter().zip(&sums) {
-        replicates[s as usize].add(chunk);
-    }
-    let n = per_scramble as f64;
+    let replicates = run(model, alpha, mu, fresnel, None, orders, settings, progress)?;
+    let per_scramble = (settings.walks / u64::from(settings.scrambles)) as f64;
     let measure = |get: &dyn Fn(&Tallies) -> f64| {
-        let means: Vec<f64> = replicates.iter().map(|t| get(t) / n).collect();
+        let means: Vec<f64> = replicates.iter().map(|t| get(t) / per_scramble).collect();
         Measured::from_replicates(&means)
     };
     let with_fresnel = *fresnel != Fresnel::None;
@@ -263,16 +228,140 @@ pub fn walk_albedo(
             }
         }
     });
-    let dropped: Rgb = std::array::from_fn(|j| {
-        replicates.iter().map(|t| t.dropped[j]).sum::<f64>() / settings.walks as f64
-    });
     Ok(WalkEstimate {
         orders: (0..orders).map(|k| measure(&|t| t.orders[k])).collect(),
         beyond: measure(&|t| t.beyond),
         albedo,
-        dropped: dropped.into_iter().fold(0.0, f64::max),
+        dropped: dropped(&replicates, settings),
         walks: settings.walks,
         mean_vertices: replicates.iter().map(|t| t.vertices).sum::<u64>() as f64
             / settings.walks as f64,
     })
+}
+
+/// The most any channel set aside, per walk.
+fn dropped(replicates: &[Tallies], settings: &WalkSettings) -> f64 {
+    (0..3)
+        .map(|j| replicates.iter().map(|t| t.dropped[j]).sum::<f64>() / settings.walks as f64)
+        .fold(0.0, f64::max)
+}
+
+/// The albedo of every order with Schlick's Fresnel `F0 + (F90 - F0) (1 - c)^5` at every
+/// vertex, as a polynomial in `F0` for one `F90`: one set of walks for every `F0`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SchlickPolynomial {
+    /// Each replicate's mean coefficients of `F0^0 ..= F0^MAX_DEGREE`.
+    pub replicates: Vec<Vec<f64>>,
+    /// `F90`.
+    pub f90: f64,
+    /// As [`WalkEstimate::dropped`].
+    pub dropped: f64,
+    /// Walks run.
+    pub walks: u64,
+}
+
+impl SchlickPolynomial {
+    /// The albedo at `f0` in `[0, 1]`, with its standard error.
+    #[must_use]
+    pub fn albedo(&self, f0: f64) -> Measured {
+        let means: Vec<f64> = self
+            .replicates
+            .iter()
+            .map(|c| c.iter().rev().fold(0.0, |sum, &c| sum * f0 + c))
+            .collect();
+        Measured::from_replicates(&means)
+    }
+}
+
+/// Walks as [`walk_albedo`] with Schlick's Fresnel of every `F0` at once (see
+/// [`SchlickPolynomial`]).
+pub fn walk_schlick_polynomial(
+    model: Model,
+    alpha: f64,
+    mu: f64,
+    f90: f64,
+    settings: &WalkSettings,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<SchlickPolynomial, WalkError> {
+    let replicates = run(
+        model,
+        alpha,
+        mu,
+        &Fresnel::None,
+        Some(f90),
+        0,
+        settings,
+        progress,
+    )?;
+    let per_scramble = (settings.walks / u64::from(settings.scrambles)) as f64;
+    Ok(SchlickPolynomial {
+        replicates: replicates
+            .iter()
+            .map(|t| t.polynomial.iter().map(|c| c / per_scramble).collect())
+            .collect(),
+        f90,
+        dropped: dropped(&replicates, settings),
+        walks: settings.walks,
+    })
+}
+
+/// Runs the walks and returns each scramble's sums.
+#[allow(clippy::too_many_arguments)]
+fn run(
+    model: Model,
+    alpha: f64,
+    mu: f64,
+    fresnel: &Fresnel,
+    schlick_f90: Option<f64>,
+    orders: usize,
+    settings: &WalkSettings,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<Vec<Tallies>, WalkError> {
+    settings.validate()?;
+    check_inputs(model, alpha, mu, orders)?;
+    if let Some(f90) = schlick_f90
+        && !(0.0..=1.0).contains(&f90)
+    {
+        return Err(WalkError::F90(f90));
+    }
+    let ndf = Ggx { alpha };
+    let wi = Vec3::from_mu(mu);
+    let per_scramble = settings.walks / u64::from(settings.scrambles);
+    let chunks = per_scramble.div_ceil(u64::from(CHUNK));
+    let tasks: Vec<(u32, u64)> = (0..settings.scrambles)
+        .flat_map(|s| (0..chunks).map(move |c| (s, c)))
+        .collect();
+    let done = std::sync::atomic::AtomicU64::new(0);
+    let sums: Vec<Tallies> = tasks
+        .par_iter()
+        .map(|&(s, c)| {
+            let seed = mix_seed(&[settings.seed, 0x5741_4c4b, u64::from(s)]);
+            let sobol = OwenSobol::new(seed);
+            let mut tallies = Tallies::new(orders, schlick_f90.is_some());
+            let start = c * u64::from(CHUNK);
+            let end = (start + u64::from(CHUNK)).min(per_scramble);
+            for index in start..end {
+                let mut random = random::WalkRandom::new(&sobol, seed, index as u32);
+                conductor::walk(
+                    &ndf,
+                    wi,
+                    fresnel,
+                    schlick_f90,
+                    settings.heights,
+                    &mut random,
+                    &mut tallies,
+                );
+            }
+            let total = done.fetch_add(end - start, std::sync::atomic::Ordering::Relaxed);
+            progress(total + end - start);
+            tallies
+        })
+        .collect();
+    // Each scramble's sums, in chunk order: the same bits on any number of threads.
+    let mut replicates =
+        vec![Tallies::new(orders, schlick_f90.is_some()); settings.scrambles as usize];
+    for (&(s, _), chunk) in tasks.iter().zip(&sums) {
+        replicates[s as usize].add(chunk);
+    }
+    Ok(replicates)
 }
