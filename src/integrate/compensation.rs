@@ -15,7 +15,8 @@ use crate::model::fresnel::{Fresnel, Rgb};
 use crate::model::kulla_conty::fresnel_colour;
 
 /// An energy compensation of the single-scattering BRDF.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
 #[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum Compensation {
     /// Kulla and Conty 2017: the added lobe `(1 - E(mu_o)) (1 - E(mu_i)) / (pi (1 - E_avg))`
@@ -30,12 +31,82 @@ pub enum Compensation {
 }
 
 impl Compensation {
+    /// Both forms, in a fixed order.
+    pub const ALL: [Compensation; 2] = [Compensation::KullaConty, Compensation::Turquin];
+
     /// The name on the command line and in reports.
     #[must_use]
     pub fn name(self) -> &'static str {
         match self {
             Compensation::KullaConty => "kulla-conty",
             Compensation::Turquin => "turquin",
+        }
+    }
+
+    /// The compensated albedo per channel from the single-scattering quantities `s`.
+    #[must_use]
+    pub fn albedo(self, s: &SingleScattering) -> Rgb {
+        match self {
+            Compensation::KullaConty => std::array::from_fn(|j| {
+                s.e_f[j] + fresnel_colour(s.f_avg[j], s.e_avg) * s.one_minus_e
+            }),
+            Compensation::Turquin => std::array::from_fn(|j| {
+                if s.e > 0.0 {
+                    s.e_f[j] * (1.0 + s.f0[j] * s.one_minus_e / s.e)
+                } else {
+                    0.0
+                }
+            }),
+        }
+    }
+}
+
+/// What the compensations are computed from at one view: the single-scattering albedos.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SingleScattering {
+    /// `E(mu)` (F = 1) and `1 - E(mu)`.
+    pub e: f64,
+    pub one_minus_e: f64,
+    /// `E_avg`.
+    pub e_avg: f64,
+    /// The Fresnel-weighted `E_F(mu)` per channel.
+    pub e_f: Rgb,
+    /// `F_avg` per channel.
+    pub f_avg: Rgb,
+    /// The reflectance at normal incidence per channel.
+    pub f0: Rgb,
+}
+
+impl SingleScattering {
+    /// The quantities at `(alpha, mu)` for `fresnel`, given `E_avg` at `alpha` (computed once
+    /// per roughness by the caller: [`reference_average_albedo`]).
+    #[must_use]
+    pub fn at(
+        model: Model,
+        alpha: f64,
+        mu: f64,
+        e_avg: f64,
+        fresnel: &Fresnel,
+        settings: &ReferenceSettings,
+    ) -> Self {
+        let e = reference_albedo(model, alpha, mu, settings);
+        let f = *fresnel;
+        let channel = |j: usize| {
+            reference_weighted_albedo(model, alpha, mu, move |c| f.reflectance(c)[j], settings)
+                .value
+        };
+        let e_f = if fresnel.is_grey() {
+            [channel(0); 3]
+        } else {
+            std::array::from_fn(channel)
+        };
+        Self {
+            e: e.value,
+            one_minus_e: e.one_minus_value,
+            e_avg,
+            e_f,
+            f_avg: fresnel.average(),
+            f0: fresnel.reflectance(1.0),
         }
     }
 }
@@ -51,35 +122,8 @@ pub fn compensated_albedo(
     compensation: Compensation,
     settings: &ReferenceSettings,
 ) -> Rgb {
-    let e = reference_albedo(model, alpha, mu, settings);
-    let single: Rgb = if fresnel.is_grey() {
-        let f = *fresnel;
-        let value =
-            reference_weighted_albedo(model, alpha, mu, move |c| f.reflectance(c)[0], settings)
-                .value;
-        [value; 3]
-    } else {
-        std::array::from_fn(|j| {
-            let f = *fresnel;
-            reference_weighted_albedo(model, alpha, mu, move |c| f.reflectance(c)[j], settings)
-                .value
-        })
-    };
-    match compensation {
-        Compensation::KullaConty => {
-            let e_avg = reference_average_albedo(model, alpha, settings).value;
-            let f_avg = fresnel.average();
-            std::array::from_fn(|j| single[j] + fresnel_colour(f_avg[j], e_avg) * e.one_minus_value)
-        }
-        Compensation::Turquin => {
-            let f0 = fresnel.reflectance(1.0);
-            std::array::from_fn(|j| {
-                if e.value > 0.0 {
-                    single[j] * (1.0 + f0[j] * e.one_minus_value / e.value)
-                } else {
-                    0.0
-                }
-            })
-        }
-    }
+    let e_avg = reference_average_albedo(model, alpha, settings).value;
+    compensation.albedo(&SingleScattering::at(
+        model, alpha, mu, e_avg, fresnel, settings,
+    ))
 }

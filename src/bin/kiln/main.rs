@@ -2,6 +2,7 @@
 
 mod args;
 mod bake;
+mod compensation;
 mod eval;
 mod fit;
 mod fresnel_args;
@@ -42,6 +43,7 @@ enum Command {
     Study(study::StudyArgs),
     Merge(merge::MergeArgs),
     Fit(fit::FitArgs),
+    Compensation(compensation::CompensationArgs),
 }
 
 /// A progress bar on stderr, drawn only when stderr is a terminal; hidden with `quiet`.
@@ -185,6 +187,7 @@ fn main() -> ExitCode {
         Command::Study(args) => study::run(args).map(|()| true),
         Command::Merge(args) => merge::run(args).map(|()| true),
         Command::Fit(args) => fit::run(args).map(|()| true),
+        Command::Compensation(args) => compensation::run(args).map(|()| true),
     };
     match result {
         Ok(true) => ExitCode::SUCCESS,

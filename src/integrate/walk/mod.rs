@@ -99,6 +99,8 @@ pub enum WalkError {
     Alpha(f64),
     /// The walk is written for this model's distribution and masking only.
     Model(Model),
+    /// `F0` is not in `[0, 1]`.
+    F0(f64),
     /// `F90` is not in `[0, 1]`.
     F90(f64),
 }
@@ -121,6 +123,7 @@ impl std::fmt::Display for WalkError {
             ),
             WalkError::Mu(mu) => write!(f, "mu {} is out of range [0, 1]", shown(*mu)),
             WalkError::Alpha(a) => write!(f, "alpha {} is out of range [0, 1000]", shown(*a)),
+            WalkError::F0(v) => write!(f, "f0 {} is out of range [0, 1]", shown(*v)),
             WalkError::F90(v) => write!(f, "f90 {} is out of range [0, 1]", shown(*v)),
             WalkError::Model(model) => write!(
                 f,
