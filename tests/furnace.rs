@@ -11,7 +11,7 @@ fn committed(name: &str) -> kiln::Table {
 }
 
 /// `1 - Ē`, the average of the `E` lookup, checked against an independent rule: midpoints in
-/// the texture coordinate `t` (where the lookup is piecewise linear), 2^16 cells, weights
+/// the texture coordinate `t` (where the lookup is piecewise linear), 2^12 cells, weights
 /// `mu(t_1)^2 - mu(t_0)^2`. And the deviation is `(1 - E(mu)) ((1 - Ē) / (1 - E_avg) - 1)`.
 #[test]
 fn furnace_integrates_the_lookup_and_reports_the_identity() {
@@ -23,7 +23,7 @@ fn furnace_integrates_the_lookup_and_reports_the_identity() {
         unreachable!()
     };
     for row in report.rows.iter().filter(|row| row.roughness >= 0.1) {
-        let cells = 1 << 16;
+        let cells = 1 << 12;
         let mut integral = 0.0;
         for k in 0..cells {
             let (t0, t1) = (k as f64 / cells as f64, (k + 1) as f64 / cells as f64);

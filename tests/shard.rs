@@ -96,6 +96,7 @@ fn merged_equals_unsharded(bake: &[&str]) {
 }
 
 #[test]
+#[ignore = "long (about 20 s): .ci/run runs it with --ignored (.ci/run's Slurm check merges the default bake too)"]
 fn the_default_bake_merges_byte_for_byte() {
     merged_equals_unsharded(&[]);
 }
