@@ -315,3 +315,165 @@ fn the_f0_polynomial_is_the_albedo_at_every_f0() {
         "{white:?}"
     );
 }
+
+/// `kiln` on the command line.
+#[cfg(feature = "cli")]
+fn kiln_json(args: &[&str]) -> serde_json::Value {
+    let output = std::process::Command::new(env!("CARGO_BIN_EXE_kiln"))
+        .args(args)
+        .arg("--json")
+        .output()
+        .unwrap();
+    assert!(
+        output.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    serde_json::from_slice(&output.stdout).unwrap()
+}
+
+/// The interface the checks use: `e-order` with its standard error, and
+/// `e-compensated` against the closed forms at `alpha = 1` with a constant `F = 1/2`
+/// (`--f0 0.5 --f90 0.5`): Kulla-Conty's albedo `F E + F^2 E_avg / (1 - F (1 - E_avg)) (1 - E)`,
+/// Turquin's `F E (1 + F (1 - E) / E)`, with `E(mu) = 1 - mu ln(1 + 1/mu)` and
+/// `E_avg = 4/3 (1 - ln 2)`.
+#[cfg(feature = "cli")]
+#[test]
+fn the_command_line_gives_the_walk_and_the_compensations() {
+    let mu = 0.3;
+    let e = e_alpha_one(mu);
+    let json = kiln_json(&[
+        "eval",
+        "--quantity",
+        "e-order",
+        "--order",
+        "1",
+        "--roughness",
+        "1",
+        "--mu",
+        "0.3",
+        "--walks",
+        "2^20",
+    ]);
+    let (value, se) = (
+        json["value"].as_f64().unwrap(),
+        json["std_error"].as_f64().unwrap(),
+    );
+    assert!(se <= 1e-4 && (value - e).abs() <= 3.0 * se + 1e-7, "{json}");
+    let e_avg = 4.0 / 3.0 * (1.0 - std::f64::consts::LN_2);
+    let f = 0.5;
+    for (name, expected) in [
+        (
+            "kulla-conty",
+            f * e + f * f * e_avg / (1.0 - f * (1.0 - e_avg)) * (1.0 - e),
+        ),
+        ("turquin", f * e * (1.0 + f * (1.0 - e) / e)),
+    ] {
+        let json = kiln_json(&[
+            "eval",
+            "--quantity",
+            "e-compensated",
+            "--compensation",
+            name,
+            "--f0",
+            "0.5",
+            "--f90",
+            "0.5",
+            "--alpha",
+            "1",
+            "--mu",
+            "0.3",
+        ]);
+        let value = json["value"].as_f64().unwrap();
+        assert!(
+            (value - expected).abs() < 1e-9,
+            "{name}: {value} vs {expected}"
+        );
+    }
+}
+
+/// Out of range: exit 2 with the range named, before any walk.
+#[cfg(feature = "cli")]
+#[test]
+fn the_command_line_refuses_what_the_walk_cannot_do() {
+    for (args, says) in [
+        (
+            &[
+                "--quantity",
+                "e-order",
+                "--order",
+                "65",
+                "--alpha",
+                "1",
+                "--mu",
+                "0.5",
+            ][..],
+            "1 to 64",
+        ),
+        (
+            &[
+                "--quantity",
+                "e-order",
+                "--order",
+                "0",
+                "--alpha",
+                "1",
+                "--mu",
+                "0.5",
+            ][..],
+            "1 to 64",
+        ),
+        (
+            &[
+                "--quantity",
+                "e-multiple",
+                "--f0",
+                "0.5",
+                "--ndf",
+                "beckmann",
+                "--alpha",
+                "1",
+                "--mu",
+                "0.5",
+            ][..],
+            "GGX",
+        ),
+        (
+            &[
+                "--quantity",
+                "e-multiple",
+                "--ior",
+                "1.5",
+                "--alpha",
+                "1",
+                "--mu",
+                "0.5",
+            ][..],
+            "dielectric",
+        ),
+        (
+            &[
+                "--quantity",
+                "e-multiple",
+                "--f0",
+                "0.5",
+                "--alpha",
+                "1",
+                "--mu",
+                "0.5",
+                "--walks",
+                "3",
+            ][..],
+            "power of two",
+        ),
+    ] {
+        let output = std::process::Command::new(env!("CARGO_BIN_EXE_kiln"))
+            .arg("eval")
+            .args(args)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(stderr.contains(says), "{args:?}: {stderr}");
+    }
+}
