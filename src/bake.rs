@@ -414,9 +414,14 @@ impl BakeOptions {
     /// ([`Texels::paired_with`]: fitted on the balanced axis) up to
     /// [`BakeOptions::LARGEST_FITTED_BY_DEFAULT`] texels a side, point samples beyond (named
     /// `-nodes`); point samples over the IOR unless named (a fit there costs about ten times
-    /// the bake: 108 s for the four glass tables at 16^3, docs/verify.md).
+    /// the bake: 108 s for the four glass tables at 16^3, docs/verify.md). `F_avg`, a closed
+    /// form over the IOR axis alone, is always point samples: there is no roughness to fit
+    /// over (`--texels lookup-fit` with `f-avg` among other quantities fits the others).
     #[must_use]
     pub fn texels_for(&self, quantity: Quantity) -> Texels {
+        if quantity == Quantity::FAvg {
+            return Texels::Nodes;
+        }
         if quantity.has_ior() {
             return self.texels.unwrap_or(Texels::Nodes);
         }

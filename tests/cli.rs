@@ -1156,3 +1156,29 @@ fn dielectric_and_container_outputs_are_byte_identical_for_any_thread_count() {
         );
     }
 }
+
+/// Issue 64, defect 1: `--texels lookup-fit` with `F_avg` (alone, beside `E`, in a shard) bakes
+/// instead of panicking (exit 101 at `roughness_axis`): `F_avg`, a closed form over the IOR
+/// alone, is point samples, and the others are fitted.
+#[test]
+fn f_avg_with_fitted_texels_bakes() {
+    for extra in [
+        &["--quantity", "f-avg"][..],
+        &["--quantity", "f-avg,e"][..],
+        &["--quantity", "f-avg,e", "--shard", "1/2"][..],
+    ] {
+        let dir = tempfile::tempdir().unwrap();
+        let output = Command::new(env!("CARGO_BIN_EXE_kiln"))
+            .args(["bake", "--texels", "lookup-fit", "--size", "6", "-q", "--out"])
+            .arg(dir.path())
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(
+            output.status.success(),
+            "{extra:?}: exit {:?}: {}",
+            output.status.code(),
+            String::from_utf8_lossy(&output.stderr)
+        );
+    }
+}
