@@ -43,6 +43,11 @@ pub fn smooth_point(alpha: f64, mu: f64) -> (f64, f64) {
         (alpha, mu)
     } else if mu == 0.0 {
         (SMOOTH_ALPHA, 0.0)
+    } else if alpha < f64::MIN_POSITIVE {
+        // A subnormal alpha: SMOOTH_ALPHA / alpha overflows below 5.6e-316 (and then every
+        // mu went to the mirror's 1: issue 64, defect 8); the ratio mu / alpha does not, and
+        // overflows only where the view is a mirror's anyway.
+        (SMOOTH_ALPHA, ((mu / alpha) * SMOOTH_ALPHA).min(1.0))
     } else {
         (SMOOTH_ALPHA, (mu * (SMOOTH_ALPHA / alpha)).min(1.0))
     }
@@ -199,6 +204,28 @@ mod tests {
         assert_eq!(smooth_point(1e-9, 0.5), (1e-7, 1.0));
         assert_eq!(smooth_point(0.0, 0.3), (1e-7, 1.0));
         assert_eq!(smooth_point(0.0, 0.0), (1e-7, 0.0));
+        // Subnormal alpha (issue 64, defect 8: from 1e-316 down every mu went to the mirror).
+        for a in [1e-316, 5e-324] {
+            assert_eq!(smooth_point(a, a), (1e-7, 1e-7), "{a}");
+            assert_eq!(smooth_point(a, 0.5), (1e-7, 1.0), "{a}");
+        }
+    }
+
+    /// `E(mu = a, alpha = a)` is the grazing layer's `0.892075...` for every small `a` down to
+    /// the smallest subnormal, by the reference and by QMC: the similarity, not the mirror.
+    #[test]
+    fn subnormal_roughness_is_the_limit_it_stands_for() {
+        use crate::integrate::reference::{ReferenceSettings, reference_albedo};
+        let correlated = model(Ndf::Ggx, Masking::HeightCorrelated);
+        let settings = ReferenceSettings::default();
+        let layer = reference_albedo(correlated, 1e-6, 1e-6, &settings).value;
+        assert!((layer - 0.892_075_491_49).abs() < 1e-9, "{layer}");
+        for a in [1e-300, 1e-316, 5e-324] {
+            let e = reference_albedo(correlated, a, a, &settings).value;
+            assert!((e - layer).abs() < 1e-9, "alpha = mu = {a}: {e}");
+            let qmc = crate::integrate::albedo(correlated, a, a, &Default::default());
+            assert!((qmc.value - layer).abs() < 1e-4, "alpha = mu = {a}: QMC {qmc:?}");
+        }
     }
 
     /// `E = 1` exactly: the mirror off the horizon for every masking, and the grazing limit of
