@@ -101,6 +101,25 @@ pub fn quoted(text: &str) -> String {
     format!("'{out}'")
 }
 
+/// A path as a message shows it, whole: control characters and bidirectional overrides
+/// escaped as in [`quoted`] (a scene's `output.dir` is a file's text: issue 64, defect 9).
+#[must_use]
+pub fn escaped_path(path: &std::path::Path) -> String {
+    path.display()
+        .to_string()
+        .chars()
+        .flat_map(|c| {
+            let escape = c.is_control() || is_bidi_control(c);
+            let (plain, escaped) = if escape {
+                (None, Some(c.escape_default()))
+            } else {
+                (Some(c), None)
+            };
+            plain.into_iter().chain(escaped.into_iter().flatten())
+        })
+        .collect()
+}
+
 /// The Unicode bidirectional formatting characters (embeddings, overrides, isolates, marks),
 /// which change how the text around them is displayed.
 #[must_use]

@@ -1169,7 +1169,15 @@ fn f_avg_with_fitted_texels_bakes() {
     ] {
         let dir = tempfile::tempdir().unwrap();
         let output = Command::new(env!("CARGO_BIN_EXE_kiln"))
-            .args(["bake", "--texels", "lookup-fit", "--size", "6", "-q", "--out"])
+            .args([
+                "bake",
+                "--texels",
+                "lookup-fit",
+                "--size",
+                "6",
+                "-q",
+                "--out",
+            ])
             .arg(dir.path())
             .args(extra)
             .output()

@@ -314,3 +314,35 @@ fn every_effect_combination_the_plan_accepts_bakes() {
     // kiln's layout alone has 8 distinct sets (every subset of its three effects).
     assert!(baked >= 8, "{baked}");
 }
+
+/// Issue 64, defect 9: `kiln plan` printed the scene's `output.dir` raw, terminal escape
+/// sequences (a retitle, a clear screen) and bidirectional overrides included; now escaped.
+#[cfg(feature = "cli")]
+#[test]
+fn kiln_plan_prints_no_control_characters_from_the_scene() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("scene.toml");
+    std::fs::write(
+        &file,
+        "[output]\ndir = \"t\\u001b]0;owned\\u0007\\u001b[2J\\u202eables\"\n\n[[material]]\nname \
+         = \"m\"\nndf = \"ggx\"\nroughness = 0.5\nfresnel = \"none\"\n",
+    )
+    .unwrap();
+    let output = std::process::Command::new(env!("CARGO_BIN_EXE_kiln"))
+        .args(["plan", "--scene"])
+        .arg(&file)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "{stderr}");
+    for text in [&stdout, &stderr] {
+        assert!(
+            !text
+                .chars()
+                .any(|c| c == '\u{1b}' || c == '\u{7}' || c == '\u{202e}'),
+            "{text:?}"
+        );
+    }
+    assert!(stdout.contains("\\u{1b}]0;owned"), "{stdout}");
+}

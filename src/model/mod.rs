@@ -224,7 +224,10 @@ mod tests {
             let e = reference_albedo(correlated, a, a, &settings).value;
             assert!((e - layer).abs() < 1e-9, "alpha = mu = {a}: {e}");
             let qmc = crate::integrate::albedo(correlated, a, a, &Default::default());
-            assert!((qmc.value - layer).abs() < 1e-4, "alpha = mu = {a}: QMC {qmc:?}");
+            assert!(
+                (qmc.value - layer).abs() < 1e-4,
+                "alpha = mu = {a}: QMC {qmc:?}"
+            );
         }
     }
 

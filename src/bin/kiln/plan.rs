@@ -76,7 +76,7 @@ pub fn run(args: PlanArgs) -> kiln::Result<()> {
         eprintln!(
             "kiln: warning: {} names no materials, so it needs no tables; add [[material]] \
              entries (name, ndf, roughness, fresnel; kiln plan --help shows the format)",
-            args.scene.display()
+            kiln::error::escaped_path(&args.scene)
         );
     }
     let threads = rayon::current_num_threads();
@@ -86,7 +86,7 @@ pub fn run(args: PlanArgs) -> kiln::Result<()> {
         .fold(0.0, |sum, t| sum + t.estimated_core_seconds);
     println!(
         "{}: {} {} {} (estimated {} on {threads} threads, less what the cache in {} holds)",
-        args.scene.display(),
+        kiln::error::escaped_path(&args.scene),
         kiln::error::count(plan.materials.len(), "material"),
         if plan.materials.len() == 1 {
             "needs"
@@ -95,7 +95,7 @@ pub fn run(args: PlanArgs) -> kiln::Result<()> {
         },
         kiln::error::count(plan.tables.len(), "table"),
         crate::human_seconds(total / threads as f64),
-        scene.output_dir().join(".kiln-cache").display()
+        kiln::error::escaped_path(&scene.output_dir().join(".kiln-cache"))
     );
     let effects = |effects: &[kiln::scene::Effect]| -> String {
         let names: Vec<&str> = effects.iter().map(|e| e.name()).collect();
