@@ -477,3 +477,55 @@ fn the_command_line_refuses_what_the_walk_cannot_do() {
         assert!(stderr.contains(says), "{args:?}: {stderr}");
     }
 }
+
+/// kiln's compensation: the fit recovers coefficients it is given (a synthetic walk made of
+/// its own basis, so that only the least squares and the pinned white furnace are tested),
+/// and at a view its albedo is within 0.5 % of walks independent of those it was fitted to.
+#[test]
+fn kilns_compensation_fits_its_basis_and_matches_independent_walks() {
+    use kiln::integrate::compensation::{KILN_FIT_SEED, KilnCompensation};
+    let (e_scale, e_bias) = (0.4, 0.05);
+    let given = [0.01, 0.08, 0.2, 0.3];
+    let truth = KilnCompensation {
+        coefficients: given,
+    };
+    let walk = |f: f64| f * e_scale + e_bias + truth.multiple(f);
+    let fitted = KilnCompensation::fit(walk, e_scale, e_bias);
+    for (a, b) in fitted.coefficients.iter().zip(given) {
+        assert!(
+            (a - b).abs() < 1e-9,
+            "{:?} vs {given:?}",
+            fitted.coefficients
+        );
+    }
+    let settings = WalkSettings {
+        walks: 1 << 16,
+        seed: KILN_FIT_SEED,
+        ..WalkSettings::default()
+    };
+    let reference = ReferenceSettings::default();
+    let (alpha, mu) = (1.0, 0.35);
+    let kiln = KilnCompensation::at(GGX, alpha, mu, &settings, &reference).unwrap();
+    let audit = WalkSettings {
+        walks: 1 << 16,
+        ..WalkSettings::default()
+    };
+    let independent = walk_schlick_polynomial(GGX, alpha, mu, 1.0, &audit, &|_| {}).unwrap();
+    for f0 in [0.04, 0.5, 0.9] {
+        let fresnel = schlick(f0, 1.0);
+        let e_f = kiln::integrate::reference::reference_weighted_albedo(
+            GGX,
+            alpha,
+            mu,
+            move |c| fresnel.reflectance(c)[0],
+            &reference,
+        )
+        .value;
+        let truth = independent.albedo(f0).value;
+        let ours = e_f + kiln.multiple(f0);
+        assert!(
+            (ours / truth - 1.0).abs() < 5e-3,
+            "F0 {f0}: kiln {ours}, walk {truth}"
+        );
+    }
+}

@@ -10,6 +10,7 @@
 use crate::integrate::reference::{
     ReferenceSettings, reference_albedo, reference_average_albedo, reference_weighted_albedo,
 };
+use crate::integrate::walk::{WalkError, WalkSettings, walk_schlick_polynomial};
 use crate::model::Model;
 use crate::model::fresnel::{Fresnel, Rgb};
 use crate::model::kulla_conty::fresnel_colour;
@@ -28,11 +29,20 @@ pub enum Compensation {
     /// `1 + F0 (1 / E(mu) - 1)`, `F0` the reflectance at normal incidence; its albedo is
     /// `E_F(mu) (1 + F0 (1 - E) / E)`.
     Turquin,
+    /// kiln's (issue 60, in progress): the reciprocal lobe `M(mu_o) M(mu_i) / (pi M_avg)` per
+    /// channel, `M(mu, F0)` the walk's albedo less single scattering's, held as four
+    /// coefficients in `F0` ([`KilnCompensation`]); its albedo is `E_F(mu) + M(mu, F0)`.
+    /// Schlick's Fresnel with `F90 = 1` only, at points (no table yet).
+    Kiln,
 }
 
 impl Compensation {
     /// Both forms, in a fixed order.
-    pub const ALL: [Compensation; 2] = [Compensation::KullaConty, Compensation::Turquin];
+    pub const ALL: [Compensation; 3] = [
+        Compensation::KullaConty,
+        Compensation::Turquin,
+        Compensation::Kiln,
+    ];
 
     /// The name on the command line and in reports.
     #[must_use]
@@ -40,10 +50,12 @@ impl Compensation {
         match self {
             Compensation::KullaConty => "kulla-conty",
             Compensation::Turquin => "turquin",
+            Compensation::Kiln => "kiln",
         }
     }
 
-    /// The compensated albedo per channel from the single-scattering quantities `s`.
+    /// The compensated albedo per channel from the single-scattering quantities `s` (for
+    /// [`Compensation::Kiln`], with `s.kiln` set: NaN without it).
     #[must_use]
     pub fn albedo(self, s: &SingleScattering) -> Rgb {
         match self {
@@ -57,8 +69,123 @@ impl Compensation {
                     0.0
                 }
             }),
+            Compensation::Kiln => std::array::from_fn(|j| match &s.kiln {
+                Some(kiln) => s.e_f[j] + kiln.multiple(s.f0[j]),
+                None => f64::NAN,
+            }),
         }
     }
+}
+
+/// The pole of kiln's basis in `F0`: each Bernstein polynomial over `1 - KILN_POLE F0`, the
+/// shape of the bounces' geometric series (`e_2 F^2 / (1 - q F)`). Chosen over 0.2 to 0.5 with
+/// `examples/compensation_basis` (degree 3: 0.54 % at 0.2, 0.13 % at 0.35, 0.58 % at 0.5;
+/// 1.1 % without a pole).
+pub const KILN_POLE: f64 = 0.35;
+
+/// kiln's compensation at one view: the multiple-scattering albedo
+/// `M(F0) = Σ_j c_j B_j(F0) / (1 - KILN_POLE F0)` with the cubic Bernstein polynomials `B_j`,
+/// fitted to the walk's albedo less single scattering's (Schlick, `F90 = 1`) by least squares
+/// relative to the walk's albedo over `F0` in [0.02, 1], with `c_3` pinned so that `F0 = 1` is
+/// the white furnace exactly (`M(1) = 1 - E`). Four coefficients: one RGBA texel.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct KilnCompensation {
+    pub coefficients: [f64; 4],
+}
+
+impl KilnCompensation {
+    /// The basis at `f0`.
+    #[must_use]
+    pub fn basis(f0: f64) -> [f64; 4] {
+        let g = 1.0 - f0;
+        let pole = 1.0 - KILN_POLE * f0;
+        [
+            g * g * g / pole,
+            3.0 * f0 * g * g / pole,
+            3.0 * f0 * f0 * g / pole,
+            f0 * f0 * f0 / pole,
+        ]
+    }
+
+    /// `M(f0)`.
+    #[must_use]
+    pub fn multiple(&self, f0: f64) -> f64 {
+        Self::basis(f0)
+            .iter()
+            .zip(&self.coefficients)
+            .map(|(b, c)| b * c)
+            .sum()
+    }
+
+    /// The fit (see the type) to `walk(F0)`, the walk's albedo, given single scattering's
+    /// split-sum parts: `E_F(F0) = F0 E_scale + E_bias` (`F90 = 1`).
+    #[must_use]
+    pub fn fit(walk: impl Fn(f64) -> f64, e_scale: f64, e_bias: f64) -> Self {
+        let f0s: Vec<f64> = (0..=49)
+            .map(|k| 0.02 + 0.98 * f64::from(k) / 49.0)
+            .collect();
+        let single = |f: f64| f * e_scale + e_bias;
+        // B_3(1) = 1 and the others vanish there: c_3 = M(1) (1 - KILN_POLE).
+        let pinned = (walk(1.0) - single(1.0)) * (1.0 - KILN_POLE);
+        let mut normal = [[0.0; 3]; 3];
+        let mut right = [0.0; 3];
+        for &f in &f0s {
+            let w = walk(f);
+            let weight = 1.0 / (w * w);
+            let b = Self::basis(f);
+            let target = w - single(f) - pinned * b[3];
+            for i in 0..3 {
+                right[i] += weight * b[i] * target;
+                for j in 0..3 {
+                    normal[i][j] += weight * b[i] * b[j];
+                }
+            }
+        }
+        let [c0, c1, c2] = solve3(normal, right);
+        Self {
+            coefficients: [c0, c1, c2, pinned],
+        }
+    }
+}
+
+/// The seed of the walks kiln's compensation is fitted to: other than the audit's (seed 0 by
+/// default), so that the audit measures it against independent walks.
+pub const KILN_FIT_SEED: u64 = 0x6b69_6c6e;
+
+impl KilnCompensation {
+    /// Fitted at `(alpha, mu)` to the walk with `settings` (Schlick, `F90 = 1`; give
+    /// [`KILN_FIT_SEED`] as the seed to stay independent of an audit's walks).
+    pub fn at(
+        model: Model,
+        alpha: f64,
+        mu: f64,
+        settings: &WalkSettings,
+        reference: &ReferenceSettings,
+    ) -> Result<Self, WalkError> {
+        let polynomial = walk_schlick_polynomial(model, alpha, mu, 1.0, settings, &|_| {})?;
+        let schlick = |c: f64| (1.0 - c.clamp(0.0, 1.0)).powi(5);
+        let e_scale =
+            reference_weighted_albedo(model, alpha, mu, |c| 1.0 - schlick(c), reference).value;
+        let e_bias = reference_weighted_albedo(model, alpha, mu, schlick, reference).value;
+        Ok(Self::fit(|f| polynomial.albedo(f).value, e_scale, e_bias))
+    }
+}
+
+/// `A x = b` for a symmetric positive definite 3 x 3 `A` (Cramer's rule).
+fn solve3(a: [[f64; 3]; 3], b: [f64; 3]) -> [f64; 3] {
+    let det = |m: [[f64; 3]; 3]| {
+        m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
+    };
+    let d = det(a);
+    std::array::from_fn(|k| {
+        let mut m = a;
+        for (row, value) in m.iter_mut().zip(b) {
+            row[k] = value;
+        }
+        det(m) / d
+    })
 }
 
 /// What the compensations are computed from at one view: the single-scattering albedos.
@@ -75,6 +202,8 @@ pub struct SingleScattering {
     pub f_avg: Rgb,
     /// The reflectance at normal incidence per channel.
     pub f0: Rgb,
+    /// kiln's compensation at this view, where it was fitted ([`Compensation::Kiln`]).
+    pub kiln: Option<KilnCompensation>,
 }
 
 impl SingleScattering {
@@ -107,13 +236,14 @@ impl SingleScattering {
             e_f,
             f_avg: fresnel.average(),
             f0: fresnel.reflectance(1.0),
+            kiln: None,
         }
     }
 }
 
 /// The directional albedo, per channel, of the single-scattering BRDF of `model` at `alpha`
-/// with `fresnel` plus `compensation`, viewed at `mu` (see the module docs).
-#[must_use]
+/// with `fresnel` plus `compensation`, viewed at `mu` (see the module docs); kiln's is fitted
+/// to the default walks seeded [`KILN_FIT_SEED`] and needs Schlick's Fresnel with `F90 = 1`.
 pub fn compensated_albedo(
     model: Model,
     alpha: f64,
@@ -121,9 +251,21 @@ pub fn compensated_albedo(
     fresnel: &Fresnel,
     compensation: Compensation,
     settings: &ReferenceSettings,
-) -> Rgb {
+) -> Result<Rgb, WalkError> {
     let e_avg = reference_average_albedo(model, alpha, settings).value;
-    compensation.albedo(&SingleScattering::at(
-        model, alpha, mu, e_avg, fresnel, settings,
-    ))
+    let mut single = SingleScattering::at(model, alpha, mu, e_avg, fresnel, settings);
+    if compensation == Compensation::Kiln {
+        if !matches!(fresnel, Fresnel::Schlick { f90, .. } if *f90 == [1.0; 3]) {
+            return Err(WalkError::KilnFresnel(format!(
+                "{} Fresnel",
+                fresnel.flags()
+            )));
+        }
+        let walks = WalkSettings {
+            seed: KILN_FIT_SEED,
+            ..WalkSettings::default()
+        };
+        single.kiln = Some(KilnCompensation::at(model, alpha, mu, &walks, settings)?);
+    }
+    Ok(compensation.albedo(&single))
 }

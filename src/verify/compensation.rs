@@ -3,11 +3,16 @@
 //! ([`crate::integrate::compensation`]) beside the albedo of every order of scattering on the
 //! microsurface ([`crate::integrate::walk`], one set of walks per view for every `F0`).
 //!
+//! kiln's own compensation ([`Compensation::Kiln`]) is fitted at each view to walks of another
+//! seed ([`KILN_FIT_SEED`]) than the audit's, so that it is measured against independent walks.
+//!
 //! Each figure is the relative deviation `compensated / walk - 1` with its 95 % confidence
 //! half-width `1.96 (compensated / walk) (sigma_walk / walk)` (the compensations come from the
 //! reference to 1e-10, so the walk's standard error is all the uncertainty there is).
 
-use crate::integrate::compensation::{Compensation, SingleScattering};
+use crate::integrate::compensation::{
+    Compensation, KILN_FIT_SEED, KilnCompensation, SingleScattering,
+};
 use crate::integrate::reference::{ReferenceSettings, reference_average_albedo};
 use crate::integrate::walk::{Measured, WalkError, WalkSettings, walk_schlick_polynomial};
 use crate::model::{Fresnel, Model};
@@ -105,12 +110,29 @@ pub fn audit_compensations(
         for &mu in &grid.mus {
             let polynomial =
                 walk_schlick_polynomial(model, alpha, mu, grid.f90, settings, &|_| {})?;
+            let kiln = if compensations.contains(&Compensation::Kiln) {
+                if grid.f90 != 1.0 {
+                    return Err(WalkError::KilnFresnel(format!("F90 {}", grid.f90)));
+                }
+                let fit_walks = WalkSettings {
+                    seed: KILN_FIT_SEED,
+                    ..*settings
+                };
+                Some(KilnCompensation::at(
+                    model, alpha, mu, &fit_walks, &reference,
+                )?)
+            } else {
+                None
+            };
             for &f0 in &grid.f0s {
                 let fresnel = Fresnel::Schlick {
                     f0: [f0; 3],
                     f90: [grid.f90; 3],
                 };
-                let single = SingleScattering::at(model, alpha, mu, e_avg, &fresnel, &reference);
+                let single = SingleScattering {
+                    kiln,
+                    ..SingleScattering::at(model, alpha, mu, e_avg, &fresnel, &reference)
+                };
                 points.push(CompensationPoint {
                     alpha,
                     mu,

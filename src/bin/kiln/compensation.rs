@@ -12,7 +12,8 @@ use kiln::{Masking, Model, Ndf, RoughnessConvention};
 #[derive(Args, Debug)]
 #[command(
     long_about = "Measure how far the albedo of single scattering plus an energy compensation \
-                  (Kulla-Conty's lobe with its colour term, Turquin's scaling) is from the albedo \
+                  (Kulla-Conty's lobe with its colour term, Turquin's scaling, kiln's own fitted \
+                  to walks of another seed) is from the albedo \
                   of every order of scattering on the microsurface, by the random walk (GGX, \
                   height-correlated, Schlick's Fresnel at every bounce). Prints, per \
                   compensation, the largest deviation of each sign with its 95 % confidence \
@@ -22,7 +23,7 @@ use kiln::{Masking, Model, Ndf, RoughnessConvention};
     after_help = SEE_CONVENTIONS
 )]
 pub struct CompensationArgs {
-    /// The compensations to measure [default: both].
+    /// The compensations to measure [default: all three].
     #[arg(long, value_enum, value_delimiter = ',')]
     compensation: Vec<Compensation>,
     /// Perceptual roughness values r (alpha = r^2), comma-separated, in [0, 1].
@@ -82,8 +83,14 @@ pub fn run(args: CompensationArgs) -> kiln::Result<()> {
     };
     let views = (grid.alphas.len() * grid.mus.len()) as u64;
     if !args.quiet {
-        // About 0.25 s per 2^20 walks on two cores at alpha = 1 (the longest walks).
-        let seconds = views as f64 * 0.25 * args.walks as f64 / f64::from(1 << 20);
+        // About 0.5 s a view per 2^20 walks on two cores, walks and references (measured
+        // 2026-12-07: 16 s for the default 32 views), twice that with kiln's own fit.
+        let fits = if compensations.contains(&Compensation::Kiln) {
+            2.0
+        } else {
+            1.0
+        };
+        let seconds = views as f64 * 0.5 * fits * args.walks as f64 / f64::from(1 << 20);
         if seconds > 5.0 {
             eprintln!(
                 "kiln: {views} views of {} walks, about {} (fewer with --walks)",

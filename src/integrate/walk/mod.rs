@@ -103,6 +103,8 @@ pub enum WalkError {
     F0(f64),
     /// `F90` is not in `[0, 1]`.
     F90(f64),
+    /// kiln's compensation is fitted for Schlick's Fresnel with `F90 = 1`; this is another.
+    KilnFresnel(String),
 }
 
 impl std::fmt::Display for WalkError {
@@ -124,6 +126,11 @@ impl std::fmt::Display for WalkError {
             WalkError::Mu(mu) => write!(f, "mu {} is out of range [0, 1]", shown(*mu)),
             WalkError::Alpha(a) => write!(f, "alpha {} is out of range [0, 1000]", shown(*a)),
             WalkError::F0(v) => write!(f, "f0 {} is out of range [0, 1]", shown(*v)),
+            WalkError::KilnFresnel(what) => write!(
+                f,
+                "kiln's compensation is fitted for Schlick's Fresnel with F90 = 1 (got {what}): \
+                 give --f0 (and --f90 1), or measure kulla-conty and turquin only"
+            ),
             WalkError::F90(v) => write!(f, "f90 {} is out of range [0, 1]", shown(*v)),
             WalkError::Model(model) => write!(
                 f,

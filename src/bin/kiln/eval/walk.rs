@@ -164,7 +164,7 @@ pub fn compensated(
 ) -> kiln::Result<()> {
     let Some(compensation) = args.compensation else {
         return Err(kiln::Error::InvalidInput(
-            "--quantity e-compensated needs --compensation kulla-conty|turquin".into(),
+            "--quantity e-compensated needs --compensation kulla-conty|turquin|kiln".into(),
         ));
     };
     let start = Instant::now();
@@ -175,7 +175,7 @@ pub fn compensated(
         &fresnel,
         compensation,
         &ReferenceSettings::default(),
-    );
+    )?;
     let seconds = start.elapsed().as_secs_f64();
     if args.json {
         let object = serde_json::json!({
@@ -202,11 +202,16 @@ pub fn compensated(
         };
         println!(
             "E_compensated(mu = {}, alpha = {}; {}, {} Fresnel) = {shown} ({model}, from the \
-             reference's E, E_avg, E_F and F_avg, {seconds:.3} s)",
+             reference's E, E_avg, E_F and F_avg{}, {seconds:.3} s)",
             kiln::error::brief(mu),
             kiln::error::brief(alpha),
             compensation.name(),
-            fresnel.name()
+            fresnel.name(),
+            if compensation == kiln::integrate::compensation::Compensation::Kiln {
+                ", kiln's coefficients fitted to 2^22 walks"
+            } else {
+                ""
+            }
         );
     }
     Ok(())
