@@ -370,7 +370,15 @@ fn help_texts_are_true() {
     assert!(verify.contains("[default: linear, as engines' tables are]"));
     assert!(!verify.contains("The default."), "verify --help: --mu-axis");
     assert!(!verify.contains("Store and use"), "verify --help: --dtype");
-    for command in ["bake", "eval", "plan", "verify", "study", "merge"] {
+    for command in [
+        "bake",
+        "eval",
+        "plan",
+        "verify",
+        "study",
+        "merge",
+        "compensation",
+    ] {
         let text = help(command);
         assert!(!text.contains("[`"), "{command} --help shows rustdoc links");
         assert!(

@@ -31,7 +31,7 @@ pub enum Compensation {
     Turquin,
     /// kiln's (issue 60, in progress): the reciprocal lobe `M(mu_o) M(mu_i) / (pi M_avg)` per
     /// channel, `M(mu, F0)` the walk's albedo less single scattering's, held as four
-    /// coefficients in `F0` ([`KilnCompensation`]); its albedo is `E_F(mu) + M(mu, F0)`.
+    /// coefficients in `F0` (`KilnCompensation`); its albedo is `E_F(mu) + M(mu, F0)`.
     /// Schlick's Fresnel with `F90 = 1` only, at points (no table yet).
     Kiln,
 }
