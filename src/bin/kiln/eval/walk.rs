@@ -104,26 +104,17 @@ fn print(
         ),
     };
     if args.json {
-        let mut object = serde_json::json!({
-            "quantity": symbol,
-            "ndf": model.ndf.name(),
-            "masking": model.masking.name(),
-            "fresnel": fresnel,
-            "alpha": alpha,
-            "roughness": args.roughness,
-            "mu": mu,
-            "value": scalar_or_rgb(value),
-            "value_rgb": value,
-            "std_error": error,
-            "method": "microsurface-walk",
-            "walks": estimate.walks,
-            "scrambles": args.scrambles.unwrap_or(WalkSettings::DEFAULT_SCRAMBLES),
-            "seed": args.seed,
-            "mean_vertices": estimate.mean_vertices,
-            "dropped_bound": estimate.dropped,
-            "seconds": seconds,
-            "kiln_version": kiln::format::metadata::KILN_VERSION,
-        });
+        let mut object = point_json(args, &symbol, model, fresnel, (alpha, mu), value, seconds);
+        object["std_error"] = error.into();
+        object["method"] = "microsurface-walk".into();
+        object["walks"] = estimate.walks.into();
+        object["scrambles"] = args
+            .scrambles
+            .unwrap_or(WalkSettings::DEFAULT_SCRAMBLES)
+            .into();
+        object["seed"] = args.seed.into();
+        object["mean_vertices"] = estimate.mean_vertices.into();
+        object["dropped_bound"] = estimate.dropped.into();
         if let Some(k) = order {
             object["order"] = k.into();
             object["orders"] = serde_json::json!(estimate.orders);
@@ -131,11 +122,7 @@ fn print(
         }
         println!("{object}");
     } else {
-        let shown = if value[0] == value[1] && value[1] == value[2] {
-            format!("{:.8}", value[0])
-        } else {
-            format!("[{:.8}, {:.8}, {:.8}]", value[0], value[1], value[2])
-        };
+        let shown = shown_rgb(value, 8);
         println!(
             "{symbol}(mu = {}, alpha = {}) = {shown} ± {error:.1e} (microsurface walk, {model}, \
              {} Fresnel, {} walks, {:.2} vertices a walk, {seconds:.3} s)",
@@ -178,28 +165,20 @@ pub fn compensated(
     )?;
     let seconds = start.elapsed().as_secs_f64();
     if args.json {
-        let object = serde_json::json!({
-            "quantity": "E_compensated",
-            "compensation": compensation.name(),
-            "ndf": model.ndf.name(),
-            "masking": model.masking.name(),
-            "fresnel": fresnel,
-            "alpha": alpha,
-            "roughness": args.roughness,
-            "mu": mu,
-            "value": scalar_or_rgb(value),
-            "value_rgb": value,
-            "method": "reference",
-            "seconds": seconds,
-            "kiln_version": kiln::format::metadata::KILN_VERSION,
-        });
+        let mut object = point_json(
+            args,
+            "E_compensated",
+            model,
+            fresnel,
+            (alpha, mu),
+            value,
+            seconds,
+        );
+        object["compensation"] = compensation.name().into();
+        object["method"] = "reference".into();
         println!("{object}");
     } else {
-        let shown = if value[0] == value[1] && value[1] == value[2] {
-            format!("{:.10}", value[0])
-        } else {
-            format!("[{:.10}, {:.10}, {:.10}]", value[0], value[1], value[2])
-        };
+        let shown = shown_rgb(value, 10);
         println!(
             "E_compensated(mu = {}, alpha = {}; {}, {} Fresnel) = {shown} ({model}, from the \
              reference's E, E_avg, E_F and F_avg{}, {seconds:.3} s)",
@@ -215,4 +194,41 @@ pub fn compensated(
         );
     }
     Ok(())
+}
+
+/// The JSON fields every walk quantity prints: what, where, the value.
+fn point_json(
+    args: &EvalArgs,
+    quantity: &str,
+    model: Model,
+    fresnel: Fresnel,
+    (alpha, mu): (f64, f64),
+    value: [f64; 3],
+    seconds: f64,
+) -> serde_json::Value {
+    serde_json::json!({
+        "quantity": quantity,
+        "ndf": model.ndf.name(),
+        "masking": model.masking.name(),
+        "fresnel": fresnel,
+        "alpha": alpha,
+        "roughness": args.roughness,
+        "mu": mu,
+        "value": scalar_or_rgb(value),
+        "value_rgb": value,
+        "seconds": seconds,
+        "kiln_version": kiln::format::metadata::KILN_VERSION,
+    })
+}
+
+/// One number when the channels agree, `[R, G, B]` otherwise, to `decimals` places.
+fn shown_rgb(value: [f64; 3], decimals: usize) -> String {
+    if value[0] == value[1] && value[1] == value[2] {
+        format!("{:.decimals$}", value[0])
+    } else {
+        format!(
+            "[{:.decimals$}, {:.decimals$}, {:.decimals$}]",
+            value[0], value[1], value[2]
+        )
+    }
 }
