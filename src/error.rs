@@ -105,9 +105,15 @@ pub fn quoted(text: &str) -> String {
 /// escaped as in [`quoted`] (a scene's `output.dir` is a file's text: issue 64, defect 9).
 #[must_use]
 pub fn escaped_path(path: &std::path::Path) -> String {
-    path.display()
-        .to_string()
-        .chars()
+    escaped(&path.display().to_string())
+}
+
+/// Text from a file shown whole where it names something (a formula file's `name` and
+/// `source`): control characters and bidirectional overrides escaped as in [`quoted`], no
+/// quotes, no cut (issue 64, defect 7).
+#[must_use]
+pub fn escaped(text: &str) -> String {
+    text.chars()
         .flat_map(|c| {
             let escape = c.is_control() || is_bidi_control(c);
             let (plain, escaped) = if escape {

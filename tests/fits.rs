@@ -553,3 +553,51 @@ mod command_line {
         assert!(e["worst"]["mu"].is_number() && e["worst"]["r"].is_number());
     }
 }
+
+/// Issue 64, defect 7: a formula file's text reaches the terminal escaped and bounded: `name`
+/// and `source` with escape sequences and a bidi override, an unknown 4000-character name, a
+/// `define` line holding ESC; and "at character N" counts characters after non-ASCII text.
+#[cfg(feature = "cli")]
+#[test]
+fn formula_file_text_reaches_the_terminal_escaped_and_bounded() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |text: &str| {
+        let file = dir.path().join("f.toml");
+        std::fs::write(&file, text).unwrap();
+        let output = std::process::Command::new(env!("CARGO_BIN_EXE_kiln"))
+            .args(["verify", "--fit"])
+            .arg(&file)
+            .output()
+            .unwrap();
+        let all = format!(
+            "{}{}",
+            String::from_utf8_lossy(&output.stdout),
+            String::from_utf8_lossy(&output.stderr)
+        );
+        assert!(
+            !all.chars().any(|c| c == '\u{1b}' || c == '\u{7}' || c == '\u{202e}'),
+            "{all:?}"
+        );
+        (output.status.code(), all)
+    };
+    // A valid file whose name and source carry control text: audited, shown escaped.
+    let (code, all) = run(
+        "name = \"k\\u001b]0;owned\\u0007\"\nsource = \"s\\u202etxt\\u001b[2J\"\nE = \"1 - 0.5 * r\"\n",
+    );
+    assert_eq!(code, Some(0), "{all}");
+    assert!(all.contains("k\\u{1b}]0;owned"), "{all}");
+    // An unknown name of 4000 characters: quoted, at most 60 of them.
+    let long = "x".repeat(4000);
+    let (code, all) = run(&format!("name = \"k\"\nE = \"1 - {long}\"\n"));
+    assert_eq!(code, Some(2), "{all}");
+    assert!(all.len() < 600 && all.contains("unknown name 'xxx"), "{all}");
+    // A define line with ESC and no '='.
+    let (code, all) = run("name = \"k\"\ndefine = [\"a\\u001b[2J\"]\nE = \"1\"\n");
+    assert_eq!(code, Some(2), "{all}");
+    assert!(all.contains("a\\u{1b}[2J"), "{all}");
+    // Characters, not bytes: "1 +<no-break space>nu" fails at character 5, the n (bytes
+    // would say 6: the space is two).
+    let (code, all) = run("name = \"k\"\nE = \"1 +\\u00a0nu\"\n");
+    assert_eq!(code, Some(2), "{all}");
+    assert!(all.contains("at character 5"), "{all}");
+}

@@ -8,6 +8,7 @@
 //! names the formula and the character where it went wrong. Evaluation never panics; a value
 //! outside a function's domain is NaN, which the audit reports as such.
 
+use crate::error::{escaped, quoted};
 use std::fmt;
 
 /// The longest formula accepted, in bytes.
@@ -110,7 +111,8 @@ impl Function {
 /// Where and why a formula failed to parse.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct FormulaError {
-    /// The byte offset in the formula.
+    /// Where in the formula, in characters from its start (not bytes: "at character N" after
+    /// non-ASCII text counted bytes, issue 64).
     pub at: usize,
     pub message: String,
 }
@@ -132,6 +134,18 @@ impl Expr {
     /// A formula too long, too deep, with an unknown name or function, a wrong number of
     /// arguments, or bad syntax.
     pub fn parse(text: &str, names: &[String]) -> Result<Expr, FormulaError> {
+        Self::parse_bytes(text, names).map_err(|mut e| {
+            let mut end = e.at.min(text.len());
+            while !text.is_char_boundary(end) {
+                end -= 1;
+            }
+            e.at = text[..end].chars().count();
+            e
+        })
+    }
+
+    /// [`Expr::parse`] with the error's position in bytes.
+    fn parse_bytes(text: &str, names: &[String]) -> Result<Expr, FormulaError> {
         if text.len() > MAX_FORMULA_BYTES {
             return Err(FormulaError {
                 at: MAX_FORMULA_BYTES,
@@ -151,8 +165,8 @@ impl Expr {
         parser.skip_space();
         if parser.at < text.len() {
             return Err(parser.error(format!(
-                "unexpected '{}' after a complete expression",
-                parser.rest().chars().next().unwrap_or(' ')
+                "unexpected {} after a complete expression",
+                quoted(&parser.rest().chars().next().unwrap_or(' ').to_string())
             )));
         }
         Ok(expr)
@@ -317,13 +331,17 @@ impl Parser<'_> {
                 None => Err(FormulaError {
                     at: start,
                     message: format!(
-                        "unknown name '{name}': the variables are {}",
+                        "unknown name {}: the variables are {}",
+                        quoted(name),
                         self.names.join(", ")
                     ),
                 }),
             };
         }
-        Err(self.error(format!("unexpected '{c}' where a value was expected")))
+        Err(self.error(format!(
+            "unexpected {} where a value was expected",
+            quoted(&c.to_string())
+        )))
     }
 
     fn number(&mut self, start: usize) -> Result<Expr, FormulaError> {
@@ -359,7 +377,7 @@ impl Parser<'_> {
             Ok(x) if x.is_finite() => Ok(Expr::Number(x)),
             _ => Err(FormulaError {
                 at: start,
-                message: format!("'{text}' is not a finite number"),
+                message: format!("{} is not a finite number", quoted(text)),
             }),
         }
     }
@@ -369,7 +387,8 @@ impl Parser<'_> {
             return Err(FormulaError {
                 at: start,
                 message: format!(
-                    "unknown function '{name}': the functions are {}",
+                    "unknown function {}: the functions are {}",
+                    quoted(name),
                     Function::names()
                 ),
             });
@@ -382,7 +401,9 @@ impl Parser<'_> {
                     break;
                 }
                 if !self.eat(',') {
-                    return Err(self.error(format!("expected ',' or ')' in {name}(...)")));
+                    return Err(
+                        self.error(format!("expected ',' or ')' in {}(...)", escaped(name)))
+                    );
                 }
             }
         }

@@ -148,7 +148,8 @@ impl FormulaFit {
         for (k, line) in file.define.iter().enumerate() {
             let Some((name, formula)) = line.split_once('=') else {
                 return Err(format!(
-                    "define[{k}] is '{line}': write it as name = formula"
+                    "define[{k}] is {}: write it as name = formula",
+                    crate::error::quoted(line)
                 ));
             };
             let name = name.trim();
@@ -156,11 +157,15 @@ impl FormulaFit {
                 && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
             if !valid || name.len() > 64 {
                 return Err(format!(
-                    "define[{k}]: '{name}' is not a name (letters, digits and _, at most 64)"
+                    "define[{k}]: {} is not a name (letters, digits and _, at most 64)",
+                    crate::error::quoted(name)
                 ));
             }
             if names.iter().any(|n| n == name) {
-                return Err(format!("define[{k}]: '{name}' is already defined"));
+                return Err(format!(
+                    "define[{k}]: {} is already defined",
+                    crate::error::quoted(name)
+                ));
             }
             let expr =
                 Expr::parse(formula, &names).map_err(|e| format!("define[{k}] ({name}): {e}"))?;

@@ -52,7 +52,8 @@ pub fn run(args: &VerifyArgs, name: &str) -> kiln::Result<bool> {
         let maps: Vec<_> = report.quantities.iter().map(|q| q.map.clone()).collect();
         let title = format!(
             "{}: |fit - reference| for {} (ringed: the worst point)",
-            report.fit, report.model
+            kiln::error::escaped(&report.fit),
+            report.model
         );
         write_plot(path, svg, crate::plot::error_map_plot(&title, &maps))?;
     }
@@ -69,7 +70,7 @@ pub fn run(args: &VerifyArgs, name: &str) -> kiln::Result<bool> {
         if let (false, Some(bound)) = (passed, args.max_error) {
             eprintln!(
                 "kiln: --fit {}: max error {worst:.2e} exceeds --max-error {bound:e}",
-                report.fit
+                kiln::error::escaped(&report.fit)
             );
         }
     } else {
@@ -90,8 +91,8 @@ fn text(report: &FitReport) -> String {
     let mut out = format!(
         "{} ({})\nagainst the reference for {} (tolerance {:e}) at {} points: {} x {} over mu \
          = t^2 and r in [0, 1] (alpha = r^2), then around each worst point\n",
-        report.fit,
-        report.source,
+        kiln::error::escaped(&report.fit),
+        kiln::error::escaped(&report.source),
         report.model,
         report.reference_tolerance,
         report.points_compared,
