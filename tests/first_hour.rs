@@ -406,6 +406,47 @@ fn a_games202_file_gets_a_verdict_that_names_its_mistake() {
         verdict(&path).starts_with("as good as 16-bit storage allows"),
         "{text}"
     );
+    // Issue 64, defect 6: an 8-bit LUT saved as a 16-bit PNG (levels times 257) is the truth
+    // rounded to 8 bits, not noise; so is a 4-bit PNG of the truth at 4 bits. The storage is
+    // read from the data, not the header's bit depth alone.
+    let grey_png = |name: &str, depth: png::BitDepth, data: Vec<u8>| {
+        let folder = dir.path().join(name);
+        std::fs::create_dir_all(&folder).unwrap();
+        let path = folder.join("GGX_E_LUT.png");
+        let mut bytes = Vec::new();
+        {
+            let mut encoder = png::Encoder::new(&mut bytes, n as u32, n as u32);
+            encoder.set_color(png::ColorType::Grayscale);
+            encoder.set_depth(depth);
+            let mut writer = encoder.write_header().unwrap();
+            writer.write_image_data(&data).unwrap();
+        }
+        std::fs::write(&path, bytes).unwrap();
+        path
+    };
+    // Rows as the homework's file has them, roughest on top.
+    let top_down = |k: usize| v[(n - 1 - k / n) * n + k % n];
+    let widened: Vec<u8> = (0..n * n)
+        .flat_map(|k| (u16::from((top_down(k) * 255.0).round() as u8) * 257).to_be_bytes())
+        .collect();
+    let path = grey_png("eight-as-sixteen", png::BitDepth::Sixteen, widened);
+    let found = verdict(&path);
+    assert!(
+        found.starts_with("as good as 8-bit storage allows"),
+        "{found}"
+    );
+    let nibbles: Vec<u8> = (0..n * n / 2)
+        .map(|k| {
+            let level = |k: usize| (top_down(k) * 15.0).round() as u8;
+            level(2 * k) << 4 | level(2 * k + 1)
+        })
+        .collect();
+    let path = grey_png("four", png::BitDepth::Four, nibbles);
+    let found = verdict(&path);
+    assert!(
+        found.starts_with("as good as 4-bit storage allows"),
+        "{found}"
+    );
 }
 
 /// Item 8: Blender's whole `shader.tables` took 157 s with a bar per table ("eta 14s" with two

@@ -575,7 +575,8 @@ fn formula_file_text_reaches_the_terminal_escaped_and_bounded() {
             String::from_utf8_lossy(&output.stderr)
         );
         assert!(
-            !all.chars().any(|c| c == '\u{1b}' || c == '\u{7}' || c == '\u{202e}'),
+            !all.chars()
+                .any(|c| c == '\u{1b}' || c == '\u{7}' || c == '\u{202e}'),
             "{all:?}"
         );
         (output.status.code(), all)
@@ -590,7 +591,10 @@ fn formula_file_text_reaches_the_terminal_escaped_and_bounded() {
     let long = "x".repeat(4000);
     let (code, all) = run(&format!("name = \"k\"\nE = \"1 - {long}\"\n"));
     assert_eq!(code, Some(2), "{all}");
-    assert!(all.len() < 600 && all.contains("unknown name 'xxx"), "{all}");
+    assert!(
+        all.len() < 600 && all.contains("unknown name 'xxx"),
+        "{all}"
+    );
     // A define line with ESC and no '='.
     let (code, all) = run("name = \"k\"\ndefine = [\"a\\u001b[2J\"]\nE = \"1\"\n");
     assert_eq!(code, Some(2), "{all}");

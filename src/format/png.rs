@@ -154,3 +154,37 @@ pub fn decode_grey(
     }
     Ok(values)
 }
+
+/// How many bits a grey (or first-channel) PNG really holds: its bit depth, less where the
+/// data says otherwise: an `sBIT` chunk's significant bits, or a 16-bit image whose every sample
+/// is a multiple of 257 (8-bit levels widened, `v * 257`), which holds 8 bits. `None` for what
+/// is not a PNG. (Read from the header alone, an 8-bit LUT saved as 16 bits was judged against
+/// 16-bit storage and told it was noisy: issue 64, defect 6.)
+#[must_use]
+pub fn effective_bits(bytes: &[u8]) -> Option<u8> {
+    let decoder = png::Decoder::new(bytes);
+    let mut reader = decoder.read_info().ok()?;
+    let info = reader.info();
+    let depth = info.bit_depth as u8;
+    let significant = info
+        .sbit
+        .as_ref()
+        .and_then(|s| s.first().copied())
+        .filter(|&b| b > 0 && b < depth);
+    if let Some(bits) = significant {
+        return Some(bits);
+    }
+    if depth != 16 {
+        return Some(depth);
+    }
+    let samples = info.color_type.samples();
+    let (width, height) = (info.width as usize, info.height as usize);
+    let mut buffer = vec![0; reader.output_buffer_size()];
+    let frame = reader.next_frame(&mut buffer).ok()?;
+    let widened = buffer[..frame.buffer_size()]
+        .chunks_exact(frame.line_size)
+        .take(height)
+        .flat_map(|row| row.chunks_exact(2 * samples).take(width))
+        .all(|pixel| u16::from_be_bytes([pixel[0], pixel[1]]) % 257 == 0);
+    Some(if widened { 8 } else { 16 })
+}

@@ -128,6 +128,9 @@ pub enum Stored {
     /// 16-bit unsigned normalised, `round(65535 v) / 65535` (a 16-bit PNG given where the
     /// engine's is 8-bit: [`crate::preset::Preset::storage_of`]).
     Unorm16,
+    /// 4-bit unsigned normalised, `round(15 v) / 15` (a 4-bit PNG given where the engine's is
+    /// 8-bit).
+    Unorm4,
 }
 
 impl Stored {
@@ -145,6 +148,7 @@ impl Stored {
             Stored::F16 => crate::format::f16::stored,
             Stored::Unorm8 => |v| f64::from(crate::format::png::unorm8(v)) / 255.0,
             Stored::Unorm16 => |v| (v.clamp(0.0, 1.0) * 65535.0).round() / 65535.0,
+            Stored::Unorm4 => |v| (v.clamp(0.0, 1.0) * 15.0).round() / 15.0,
         }
     }
 
@@ -155,6 +159,7 @@ impl Stored {
             Stored::F32 | Stored::F16 => 0.0,
             Stored::Unorm8 => 1.0 / 255.0,
             Stored::Unorm16 => 1.0 / 65535.0,
+            Stored::Unorm4 => 1.0 / 15.0,
         }
     }
 
@@ -166,6 +171,7 @@ impl Stored {
             Stored::F16 => "f16",
             Stored::Unorm8 => "8-bit",
             Stored::Unorm16 => "16-bit",
+            Stored::Unorm4 => "4-bit",
         }
     }
 }

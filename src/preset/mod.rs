@@ -141,18 +141,21 @@ impl Preset {
         })
     }
 
-    /// [`Preset::storage`] of the engine's file `bytes` as it is: a 16-bit PNG given where the
-    /// engine writes 8 bits is audited against 16-bit storage (its floor is 7.6e-6, not 1.96e-3).
+    /// [`Preset::storage`] of the engine's file `bytes` as it is: a PNG given where the engine
+    /// writes 8 bits is audited against the precision it really holds
+    /// ([`crate::format::png::effective_bits`]): 16 bits (floor 7.6e-6, not 1.96e-3), 8 bits
+    /// saved as 16 (levels times 257, or an `sBIT` of 8), 4 bits.
     #[must_use]
     pub fn storage_of(self, bytes: &[u8]) -> Option<crate::verify::Storage> {
         let stored = self.layout().stored;
-        // A PNG's bit depth is byte 24, in its IHDR chunk after the 8-byte signature.
-        let sixteen_bit_png = bytes.starts_with(b"\x89PNG\r\n\x1a\n") && bytes.get(24) == Some(&16);
-        if stored == layout::Stored::Unorm8 && sixteen_bit_png {
-            Self::storage_as(layout::Stored::Unorm16)
-        } else {
-            Self::storage_as(stored)
+        if stored != layout::Stored::Unorm8 || !bytes.starts_with(b"\x89PNG\r\n\x1a\n") {
+            return Self::storage_as(stored);
         }
+        Self::storage_as(match crate::format::png::effective_bits(bytes) {
+            Some(16) => layout::Stored::Unorm16,
+            Some(bits) if bits <= 4 => layout::Stored::Unorm4,
+            _ => layout::Stored::Unorm8,
+        })
     }
 
     /// The name on the command line.
