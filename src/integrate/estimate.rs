@@ -33,16 +33,11 @@ impl Estimate {
     /// never the spread inside one sequence, which QMC makes meaningless.
     #[must_use]
     pub fn from_replicates(one_minus_means: &[f64], samples: u64) -> Self {
-        let r = one_minus_means.len() as f64;
         assert!(
             one_minus_means.len() >= 2,
             "need at least two replicates for an error estimate"
         );
-        let mean = one_minus_means.iter().sum::<f64>() / r;
-        let var = one_minus_means
-            .iter()
-            .map(|&x| (x - mean) * (x - mean))
-            .sum::<f64>();
+        let (mean, std_error) = mean_and_std_error(one_minus_means);
         // A mean outside [0, 1] (possible only for an estimator with negative or > 1 weights)
         // is brought into the range, and the standard error widened by the distance: never a
         // clamp that hides a bias.
@@ -50,10 +45,20 @@ impl Estimate {
         Self {
             value: 1.0 - one_minus_value,
             one_minus_value,
-            std_error: (var / (r * (r - 1.0))).sqrt() + (mean - one_minus_value).abs(),
+            std_error: std_error + (mean - one_minus_value).abs(),
             samples,
         }
     }
+}
+
+/// The mean of `R >= 2` independent replicate means and its standard error,
+/// `sqrt(Σ (I_r - Ī)^2 / (R (R - 1)))`.
+#[must_use]
+pub fn mean_and_std_error(means: &[f64]) -> (f64, f64) {
+    let r = means.len() as f64;
+    let mean = means.iter().sum::<f64>() / r;
+    let var = means.iter().map(|&x| (x - mean) * (x - mean)).sum::<f64>();
+    (mean, (var / (r * (r - 1.0))).sqrt())
 }
 
 #[cfg(test)]

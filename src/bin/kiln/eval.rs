@@ -602,6 +602,12 @@ fn multiple_scattering(args: &EvalArgs, fresnel: Fresnel) -> kiln::Result<()> {
                 .into(),
         ));
     }
+    let view = walk::View {
+        model,
+        fresnel,
+        alpha,
+        mu,
+    };
     match args.quantity {
         EvalQuantity::EOrder => {
             if fresnel != Fresnel::None {
@@ -616,7 +622,7 @@ fn multiple_scattering(args: &EvalArgs, fresnel: Fresnel) -> kiln::Result<()> {
                     "--quantity e-order needs --order K (1 to 64)".into(),
                 ));
             };
-            walk::multiple_scattering(args, model, fresnel, alpha, mu, Some(order))
+            walk::multiple_scattering(args, view, Some(order))
         }
         EvalQuantity::EMultiple => {
             if matches!(fresnel, Fresnel::Dielectric { .. }) {
@@ -627,7 +633,7 @@ fn multiple_scattering(args: &EvalArgs, fresnel: Fresnel) -> kiln::Result<()> {
                         .into(),
                 ));
             }
-            walk::multiple_scattering(args, model, fresnel, alpha, mu, None)
+            walk::multiple_scattering(args, view, None)
         }
         EvalQuantity::ECompensated => {
             if matches!(fresnel, Fresnel::Dielectric { .. }) {
@@ -637,7 +643,7 @@ fn multiple_scattering(args: &EvalArgs, fresnel: Fresnel) -> kiln::Result<()> {
                         .into(),
                 ));
             }
-            walk::compensated(args, model, fresnel, alpha, mu)
+            walk::compensated(args, view)
         }
         _ => unreachable!("called for the walk's quantities"),
     }

@@ -158,16 +158,12 @@ pub struct Measured {
 }
 
 impl Measured {
-    /// The mean and standard error of independent replicate means (`R >= 2`).
+    /// The mean and standard error of independent replicate means (`R >= 2`), as kiln's QMC
+    /// ([`crate::integrate::estimate::mean_and_std_error`]) but without its clamp to [0, 1].
     #[must_use]
     pub fn from_replicates(means: &[f64]) -> Self {
-        let r = means.len() as f64;
-        let mean = means.iter().sum::<f64>() / r;
-        let var = means.iter().map(|&x| (x - mean) * (x - mean)).sum::<f64>();
-        Self {
-            value: mean,
-            std_error: (var / (r * (r - 1.0))).sqrt(),
-        }
+        let (value, std_error) = crate::integrate::estimate::mean_and_std_error(means);
+        Self { value, std_error }
     }
 }
 

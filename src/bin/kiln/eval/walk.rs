@@ -15,15 +15,23 @@ const PILOT_WALKS: u64 = 1 << 15;
 /// Announced on stderr (with a progress bar on a terminal) when longer than this.
 const ANNOUNCE_SECONDS: f64 = 2.0;
 
-/// `e-order` (`orders` = the order asked for, `fresnel` none) or `e-multiple`.
-pub fn multiple_scattering(
-    args: &EvalArgs,
-    model: Model,
-    fresnel: Fresnel,
-    alpha: f64,
-    mu: f64,
-    order: Option<u64>,
-) -> kiln::Result<()> {
+/// Where and for what a walk quantity is evaluated.
+#[derive(Clone, Copy, Debug)]
+pub struct View {
+    pub model: Model,
+    pub fresnel: Fresnel,
+    pub alpha: f64,
+    pub mu: f64,
+}
+
+/// `e-order` (`order` given, `fresnel` none) or `e-multiple`.
+pub fn multiple_scattering(args: &EvalArgs, view: View, order: Option<u64>) -> kiln::Result<()> {
+    let View {
+        model,
+        fresnel,
+        alpha,
+        mu,
+    } = view;
     let settings = WalkSettings {
         walks: args.walks.unwrap_or(WalkSettings::DEFAULT_WALKS),
         scrambles: args.scrambles.unwrap_or(WalkSettings::DEFAULT_SCRAMBLES),
@@ -38,13 +46,13 @@ pub fn multiple_scattering(
     };
     kiln::integrate::walk::check_inputs(model, alpha, mu, orders)?;
     let start = Instant::now();
-    let bar = announce(args, model, &fresnel, alpha, mu, orders, &settings)?;
+    let bar = announce(args, view, orders, &settings)?;
     let estimate = walk_albedo(model, alpha, mu, &fresnel, orders, &settings, &|done| {
         bar.set_position(done)
     })?;
     bar.finish_and_clear();
     let seconds = start.elapsed().as_secs_f64();
-    print(args, model, fresnel, alpha, mu, order, &estimate, seconds);
+    print(args, view, order, &estimate, seconds);
     Ok(())
 }
 
@@ -52,10 +60,7 @@ pub fn multiple_scattering(
 /// says how long before it starts; returns the progress bar (hidden off a terminal).
 fn announce(
     args: &EvalArgs,
-    model: Model,
-    fresnel: &Fresnel,
-    alpha: f64,
-    mu: f64,
+    view: View,
     orders: usize,
     settings: &WalkSettings,
 ) -> kiln::Result<indicatif::ProgressBar> {
@@ -68,7 +73,15 @@ fn announce(
         ..*settings
     };
     let start = Instant::now();
-    walk_albedo(model, alpha, mu, fresnel, orders, &pilot, &|_| {})?;
+    walk_albedo(
+        view.model,
+        view.alpha,
+        view.mu,
+        &view.fresnel,
+        orders,
+        &pilot,
+        &|_| {},
+    )?;
     let estimate = start.elapsed().as_secs_f64() * (settings.walks / pilot.walks) as f64;
     if estimate < ANNOUNCE_SECONDS || args.quiet {
         return Ok(hidden());
@@ -81,17 +94,13 @@ fn announce(
     Ok(crate::progress_bar(false, settings.walks, "walking"))
 }
 
-#[allow(clippy::too_many_arguments)]
-fn print(
-    args: &EvalArgs,
-    model: Model,
-    fresnel: Fresnel,
-    alpha: f64,
-    mu: f64,
-    order: Option<u64>,
-    estimate: &WalkEstimate,
-    seconds: f64,
-) {
+fn print(args: &EvalArgs, view: View, order: Option<u64>, estimate: &WalkEstimate, seconds: f64) {
+    let View {
+        model,
+        fresnel,
+        alpha,
+        mu,
+    } = view;
     let (symbol, value, error) = match order {
         Some(k) => {
             let e = estimate.orders[k as usize - 1];
@@ -104,7 +113,7 @@ fn print(
         ),
     };
     if args.json {
-        let mut object = point_json(args, &symbol, model, fresnel, (alpha, mu), value, seconds);
+        let mut object = point_json(args, &symbol, view, value, seconds);
         object["std_error"] = error.into();
         object["method"] = "microsurface-walk".into();
         object["walks"] = estimate.walks.into();
@@ -142,13 +151,13 @@ fn print(
 }
 
 /// `e-compensated`: the albedo of single scattering plus `compensation`.
-pub fn compensated(
-    args: &EvalArgs,
-    model: Model,
-    fresnel: Fresnel,
-    alpha: f64,
-    mu: f64,
-) -> kiln::Result<()> {
+pub fn compensated(args: &EvalArgs, view: View) -> kiln::Result<()> {
+    let View {
+        model,
+        fresnel,
+        alpha,
+        mu,
+    } = view;
     let Some(compensation) = args.compensation else {
         return Err(kiln::Error::InvalidInput(
             "--quantity e-compensated needs --compensation kulla-conty|turquin|kiln".into(),
@@ -165,15 +174,7 @@ pub fn compensated(
     )?;
     let seconds = start.elapsed().as_secs_f64();
     if args.json {
-        let mut object = point_json(
-            args,
-            "E_compensated",
-            model,
-            fresnel,
-            (alpha, mu),
-            value,
-            seconds,
-        );
+        let mut object = point_json(args, "E_compensated", view, value, seconds);
         object["compensation"] = compensation.name().into();
         object["method"] = "reference".into();
         println!("{object}");
@@ -200,20 +201,18 @@ pub fn compensated(
 fn point_json(
     args: &EvalArgs,
     quantity: &str,
-    model: Model,
-    fresnel: Fresnel,
-    (alpha, mu): (f64, f64),
+    view: View,
     value: [f64; 3],
     seconds: f64,
 ) -> serde_json::Value {
     serde_json::json!({
         "quantity": quantity,
-        "ndf": model.ndf.name(),
-        "masking": model.masking.name(),
-        "fresnel": fresnel,
-        "alpha": alpha,
+        "ndf": view.model.ndf.name(),
+        "masking": view.model.masking.name(),
+        "fresnel": view.fresnel,
+        "alpha": view.alpha,
         "roughness": args.roughness,
-        "mu": mu,
+        "mu": view.mu,
         "value": scalar_or_rgb(value),
         "value_rgb": value,
         "seconds": seconds,
