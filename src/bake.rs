@@ -301,6 +301,7 @@ impl BakeOptions {
         };
         let mut stored: u64 = 0;
         let mut largest: u64 = 0;
+        let mut largest_fit: u64 = 0;
         for spec in &specs {
             let texels = spec
                 .shape()
@@ -322,9 +323,27 @@ impl BakeOptions {
             }
             stored = stored.saturating_add(texels.saturating_mul(24));
             largest = largest.max(texels);
+            let fit = lookup_fit_bytes(spec);
+            if fit > Self::MAX_BAKE_BYTES {
+                return Err(Error::InvalidInput(format!(
+                    "{}: fitting the {} table's texels for its lookup (--texels lookup-fit) \
+                     would hold {:.1} GiB (its normal equations: {texels} texels by a band of \
+                     {}), more than the {} GiB kiln allows a bake; nothing was written: bake \
+                     point samples (--texels points) at this size, or fit a smaller table",
+                    spec.id(),
+                    shape(spec),
+                    fit as f64 / f64::from(1 << 30),
+                    crate::table::lookup_fit::band(spec) + 1,
+                    Self::MAX_BAKE_BYTES >> 30
+                )));
+            }
+            largest_fit = largest_fit.max(fit);
         }
         let estimate = std::mem::size_of::<Estimate>() as u64;
-        let bytes = stored.saturating_add(largest.saturating_mul(estimate));
+        // The fit runs after the integration, table by table: its memory beside the tables.
+        let bytes = stored
+            .saturating_add(largest.saturating_mul(estimate))
+            .max(stored.saturating_add(largest_fit));
         if bytes > Self::MAX_BAKE_BYTES {
             return Err(Error::InvalidInput(format!(
                 "the bake's {} tables ({}) would hold {:.1} GiB, more than the {} GiB kiln \
@@ -959,14 +978,34 @@ fn lookup_fit_settings(spec: &TableSpec) -> crate::table::lookup_fit::LookupFitS
 }
 
 /// The reference evaluations [`fit_texels`] makes for a table of `spec`: 0 for point samples.
+/// Counted, not built.
 #[must_use]
 pub fn lookup_fit_evaluations(spec: &TableSpec) -> u64 {
     if spec.texels != Texels::LookupFit {
         return 0;
     }
-    let audit = crate::verify::lookup_coordinates(spec, &crate::verify::AuditSettings::default());
-    crate::table::lookup_fit::planned_evaluations(spec, &lookup_fit_settings(spec), audit.len())
-        as u64
+    crate::table::lookup_fit::planned_evaluations(
+        spec,
+        &lookup_fit_settings(spec),
+        audit_count(spec),
+    ) as u64
+}
+
+/// `kiln verify`'s default audit points for `spec`, which a lookup fit adds to its own.
+fn audit_count(spec: &TableSpec) -> usize {
+    let audit =
+        crate::verify::lookup_coordinate_count(spec, &crate::verify::AuditSettings::default());
+    usize::try_from(audit).unwrap_or(usize::MAX)
+}
+
+/// The memory [`fit_texels`] holds for a table of `spec`, in bytes: 0 for point samples
+/// ([`crate::table::lookup_fit::memory_bytes`]).
+#[must_use]
+pub fn lookup_fit_bytes(spec: &TableSpec) -> u64 {
+    if spec.texels != Texels::LookupFit {
+        return 0;
+    }
+    crate::table::lookup_fit::memory_bytes(spec, &lookup_fit_settings(spec), audit_count(spec))
 }
 
 /// Bakes one table, texels in parallel (deterministic for any thread count).
@@ -1132,12 +1171,7 @@ pub fn lookup_fit_core_seconds(spec: &TableSpec) -> f64 {
     if evaluations == 0 {
         return 0.0;
     }
-    // A lookup blends texels up to one step along every axis: the band is the sum of the
-    // row-major strides (`mu + 1` for rows of `mu` texels, `n^2 + n + 1` for an `n^3` table).
-    let shape = spec.shape();
-    let band = (0..shape.len())
-        .map(|d| shape[d + 1..].iter().product::<usize>())
-        .sum::<usize>() as f64;
+    let band = crate::table::lookup_fit::band(spec) as f64;
     let settings = lookup_fit_settings(spec);
     let solve = settings.iterations as f64 * spec.len() as f64 * band * band * 1.2e-9;
     let digits = (-settings.tolerance.log10()).round().max(1.0) as u32;
@@ -1147,18 +1181,8 @@ pub fn lookup_fit_core_seconds(spec: &TableSpec) -> f64 {
 /// [`estimated_core_seconds`] of the texels' integration alone.
 fn integration_core_seconds(spec: &TableSpec) -> f64 {
     let texels = spec.len() as f64;
-    let beckmann = spec.model.ndf == crate::model::Ndf::Beckmann;
     match spec.method {
-        Method::Qmc => {
-            let rate = match (spec.quantity, beckmann) {
-                (Quantity::E, false) => 75e6,
-                (Quantity::EAvg, false) => 50e6,
-                (Quantity::E, true) => 3.5e6,
-                (Quantity::EAvg, true) => 1.7e6,
-                _ => 20e6,
-            };
-            texels * spec.qmc.samples as f64 / rate
-        }
+        Method::Qmc => texels * qmc_seconds_per_point(spec.quantity, spec.model, spec.qmc.samples),
         Method::Reference => {
             let digits = spec.reference_digits.unwrap_or(10);
             texels * reference_seconds_per_point(spec, digits)
@@ -1166,13 +1190,36 @@ fn integration_core_seconds(spec: &TableSpec) -> f64 {
     }
 }
 
+/// The estimated cost of one QMC estimate of `quantity` for `model` with `samples` samples, in
+/// seconds of one core, at the kernel rates measured for [`estimated_core_seconds`]: for `kiln
+/// eval` to say how long a point will take.
+#[must_use]
+pub fn qmc_seconds_per_point(quantity: Quantity, model: crate::model::Model, samples: u64) -> f64 {
+    let beckmann = model.ndf == crate::model::Ndf::Beckmann;
+    let rate = match (quantity, beckmann) {
+        (Quantity::E, false) => 75e6,
+        (Quantity::EAvg, false) => 50e6,
+        (Quantity::E, true) => 3.5e6,
+        (Quantity::EAvg, true) => 1.7e6,
+        _ => 20e6,
+    };
+    samples as f64 / rate
+}
+
 /// The estimated cost of one reference value of `spec`'s quantity and model at tolerance
 /// `10^-digits`, in seconds of one core (the per-texel figures of [`estimated_core_seconds`]):
 /// for `kiln verify` to say how long an audit will take.
 #[must_use]
 pub fn reference_seconds_per_point(spec: &TableSpec, digits: u32) -> f64 {
-    let beckmann = spec.model.ndf == crate::model::Ndf::Beckmann;
-    let per_texel = match (spec.quantity, beckmann) {
+    reference_seconds(spec.quantity, spec.model, digits)
+}
+
+/// [`reference_seconds_per_point`] of `quantity` for `model`, without a table: for `kiln
+/// verify --fit`.
+#[must_use]
+pub fn reference_seconds(quantity: Quantity, model: crate::model::Model, digits: u32) -> f64 {
+    let beckmann = model.ndf == crate::model::Ndf::Beckmann;
+    let per_texel = match (quantity, beckmann) {
         (Quantity::E, false) => 0.3e-3,
         (Quantity::E, true) => 0.6e-3,
         (Quantity::EAvg, false) => 4e-3,

@@ -374,12 +374,30 @@ impl Scene {
                 m.name
             )));
         }
+        if self
+            .output
+            .as_ref()
+            .and_then(|o| o.formats.as_ref())
+            .is_some_and(Vec::is_empty)
+        {
+            // An empty list baked every table and wrote none of them (exit 0).
+            return Err(bad(format!(
+                "output.formats is empty, so nothing would be written: list at least one of {}, \
+                 or remove the line for every format",
+                Format::ALL
+                    .iter()
+                    .map(|f| format!("\"{}\"", f.name()))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )));
+        }
         if let Some(x) = self.output.as_ref().and_then(|o| o.max_error)
             && !(crate::BakeOptions::MIN_MAX_ERROR..=0.5).contains(&x)
         {
             return Err(bad(format!(
-                "output.max_error must be between {:e} and 0.5 (got {x})",
-                crate::BakeOptions::MIN_MAX_ERROR
+                "output.max_error must be between {:e} and 0.5 (got {})",
+                crate::BakeOptions::MIN_MAX_ERROR,
+                crate::error::shown(x)
             )));
         }
         // What the plan lists, the bake bakes: each of its bakes passes every check `kiln bake`
@@ -1264,7 +1282,7 @@ fresnel = { schlick = { f0 = 0.04 } }
 
     #[test]
     fn bad_scenes_say_where_and_what() {
-        let cases: [(&str, &str); 9] = [
+        let cases: [(&str, &str); 10] = [
             (
                 "[[material]]\nname = \"a\"\nndf = \"ggx\"\nroughness = 0.1\ntransmission = true\n",
                 "needs a dielectric fresnel",
@@ -1297,6 +1315,11 @@ fresnel = { schlick = { f0 = 0.04 } }
             (
                 "[[material]]\nname = \"a\"\nndf = \"ggx\"\nroughness = 0.1\nfresnel = { metal = {} }\n",
                 "metal",
+            ),
+            // Issue 64: an empty list baked every table for 13 s and wrote none (exit 0).
+            (
+                "[output]\nformats = []\n[[material]]\nname = \"a\"\nndf = \"ggx\"\nroughness = 0.1\n",
+                "output.formats is empty, so nothing would be written",
             ),
         ];
         for (text, needle) in cases {

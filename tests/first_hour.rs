@@ -9,26 +9,7 @@ use std::process::{Command, Output, Stdio};
 
 #[path = "common/command.rs"]
 mod command;
-use command::kiln;
-
-fn stderr(output: &Output) -> String {
-    String::from_utf8_lossy(&output.stderr).into_owned()
-}
-
-/// Runs kiln and expects a usage error (exit 2) whose message names each of `words`.
-fn refused(args: &[&str], words: &[&str]) -> String {
-    let output = kiln(args);
-    let message = stderr(&output);
-    assert_eq!(output.status.code(), Some(2), "{args:?}: {message}");
-    assert!(!message.contains("panicked"), "{message}");
-    for word in words {
-        assert!(
-            message.contains(word),
-            "{args:?}: '{message}' lacks '{word}'"
-        );
-    }
-    message
-}
+use command::{kiln, refused, stderr};
 
 fn ok(args: &[&str]) -> Output {
     let output = kiln(args);

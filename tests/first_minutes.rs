@@ -10,28 +10,10 @@ use std::process::Output;
 
 #[path = "common/command.rs"]
 mod command;
-use command::kiln;
-
-fn stderr(output: &Output) -> String {
-    String::from_utf8_lossy(&output.stderr).into_owned()
-}
+use command::{kiln, refused, stderr};
 
 fn stdout(output: &Output) -> String {
     String::from_utf8_lossy(&output.stdout).into_owned()
-}
-
-/// Runs kiln and expects a usage error (exit 2) whose message names each of `words`.
-fn refused(args: &[&str], words: &[&str]) -> String {
-    let output = kiln(args);
-    let message = stderr(&output);
-    assert_eq!(output.status.code(), Some(2), "{args:?}: {message}");
-    for word in words {
-        assert!(
-            message.contains(word),
-            "{args:?}: '{message}' lacks '{word}'"
-        );
-    }
-    message
 }
 
 fn files_in(dir: &Path) -> Vec<String> {

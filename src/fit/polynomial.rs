@@ -127,6 +127,13 @@ pub fn fit(model: Model, degrees: Degrees, progress: &(dyn Fn() + Sync)) -> Poly
     fit_to(model, degrees, &truth)
 }
 
+/// How many points [`truth_points`] computes the reference at (97 x 97 and the grazing probes
+/// on each of the 97 rows): what a cost estimate counts.
+#[must_use]
+pub fn truth_point_count() -> usize {
+    fit_points(96).len()
+}
+
 /// The reference at the fit's points, `((t, r), value)`: computed once for every shape a
 /// sweep tries.
 #[must_use]

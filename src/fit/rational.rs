@@ -36,6 +36,18 @@ const ADDED_PER_ROUND: usize = 500;
 /// Differential-correction steps at most (each a linear program).
 const MAX_STEPS: usize = 40;
 
+/// The estimated time of [`fit_to`] for `shape`, in seconds (its linear programs run on one
+/// thread): `44 s (n / 33)^4.5` for `n` unknowns (the coefficients and `z`), fitted to whole
+/// `kiln fit --degrees` runs on a 2-core AMD EPYC, one each (2026-12-07: 2,2/2,2 in 4.1 s,
+/// 3,3/3,3 in 44 s of CPU, 4,4/4,4 in 261 s). The cost grows with the programs' size and the
+/// steps they take, so the figure is a rough one: 6,6/6,6 about 2 hours, 12,12/12,12 about 3
+/// weeks.
+#[must_use]
+pub fn estimated_seconds(shape: RationalShape) -> f64 {
+    let unknowns = (shape.coefficients() + 2) as f64;
+    44.0 * (unknowns / 33.0).powf(4.5)
+}
+
 /// The shape of a rational fit: the degrees of `P` and of `Q`, and whether `P` is additive.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct RationalShape {

@@ -11,6 +11,7 @@ pub mod comment;
 pub mod dds;
 pub mod exr;
 pub mod f16;
+pub mod folder_lock;
 pub mod json;
 pub mod ktx2;
 pub mod metadata;
@@ -332,8 +333,15 @@ fn create_output_dir(dir: &Path) -> Result<()> {
 
 /// Writes `(file name, bytes)` pairs into `dir` all-or-nothing (as far as a file system allows):
 /// each goes to a temporary file first; only when all were written are they renamed into place.
+/// Under the folder's lock ([`folder_lock`]), so that two writers' sets are never interleaved.
 pub fn write_files(dir: &Path, files: &[(String, Vec<u8>)]) -> Result<Vec<PathBuf>> {
     create_output_dir(dir)?;
+    let _lock = folder_lock::FolderLock::acquire(dir)?;
+    write_files_locked(dir, files)
+}
+
+/// [`write_files`] for a caller that holds the folder's lock.
+fn write_files_locked(dir: &Path, files: &[(String, Vec<u8>)]) -> Result<Vec<PathBuf>> {
     remove_stale_temporaries(dir);
     let mut staged = Vec::with_capacity(files.len());
     for (name, bytes) in files {
@@ -419,7 +427,9 @@ pub fn write_tables(
 }
 
 /// Writes files holding `tables` (and perhaps others, an engine's own file) after checking the
-/// replacement rule ([`replace::check`]) for the tables' names.
+/// replacement rule ([`replace::check`]) for the tables' names: the check and the writes under
+/// one hold of the folder's lock ([`folder_lock`]), so that of two bakes of different specs
+/// into one folder the second to get there is refused, naming the first one's files.
 pub fn write_table_files(
     dir: &Path,
     tables: &[Table],
@@ -428,8 +438,10 @@ pub fn write_table_files(
 ) -> Result<Vec<PathBuf>> {
     let names: Vec<String> = files.iter().map(|(name, _)| name.clone()).collect();
     let specs: Vec<crate::table::TableSpec> = tables.iter().map(|t| t.spec.clone()).collect();
+    create_output_dir(dir)?;
+    let _lock = folder_lock::FolderLock::acquire(dir)?;
     let stale = replace::check(dir, &specs, &names, replace)?;
-    let written = write_files(dir, files)?;
+    let written = write_files_locked(dir, files)?;
     for path in stale {
         std::fs::remove_file(&path).map_err(|source| Error::Io {
             path: path.clone(),

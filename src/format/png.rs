@@ -127,6 +127,9 @@ pub fn decode_grey(
             expected.0, expected.1
         ));
     }
+    if reader.info().color_type == png::ColorType::Indexed {
+        check_palette_indices(bytes)?;
+    }
     let mut buffer = vec![0; reader.output_buffer_size()];
     let frame = reader
         .next_frame(&mut buffer)
@@ -153,6 +156,46 @@ pub fn decode_grey(
         ));
     }
     Ok(values)
+}
+
+/// Refuses a palette image with a pixel whose index is past its palette (the PNG
+/// specification calls that an error; expanded, such a pixel read as black, a silent 0).
+fn check_palette_indices(bytes: &[u8]) -> std::result::Result<(), String> {
+    let mut reader = png::Decoder::new(bytes)
+        .read_info()
+        .map_err(|e| format!("not a PNG file ({e})"))?;
+    let (colours, width, height, bits) = {
+        let info = reader.info();
+        let colours = info.palette.as_ref().map_or(0, |p| p.len() / 3);
+        (
+            colours,
+            info.width as usize,
+            info.height as usize,
+            info.bit_depth as usize,
+        )
+    };
+    let mut buffer = vec![0; reader.output_buffer_size()];
+    let frame = reader
+        .next_frame(&mut buffer)
+        .map_err(|e| format!("a damaged PNG file ({e})"))?;
+    let mask = (1_usize << bits) - 1;
+    for (y, row) in buffer[..frame.buffer_size()]
+        .chunks_exact(frame.line_size)
+        .take(height)
+        .enumerate()
+    {
+        for x in 0..width {
+            let bit = x * bits;
+            let index = (usize::from(row[bit / 8]) >> (8 - bits - bit % 8)) & mask;
+            if index >= colours {
+                return Err(format!(
+                    "pixel ({x}, {y}) holds palette index {index}, past its palette of \
+                     {colours} colours (a damaged or hand-made file)"
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// How many bits a grey (or first-channel) PNG really holds: its bit depth, less where the
@@ -187,4 +230,49 @@ pub fn effective_bits(bytes: &[u8]) -> Option<u8> {
         .flat_map(|row| row.chunks_exact(2 * samples).take(width))
         .all(|pixel| u16::from_be_bytes([pixel[0], pixel[1]]) % 257 == 0);
     Some(if widened { 8 } else { 16 })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 4 x 1 palette image of `colours` grey entries (entry k is grey `k * 85`) whose pixels
+    /// hold `indices`, at `depth` bits an index.
+    fn palette_png(colours: usize, indices: [u8; 4], depth: png::BitDepth) -> Vec<u8> {
+        let mut bytes = Vec::new();
+        let mut encoder = png::Encoder::new(&mut bytes, 4, 1);
+        encoder.set_color(png::ColorType::Indexed);
+        encoder.set_depth(depth);
+        encoder.set_palette(
+            (0..colours)
+                .flat_map(|k| [(k * 85) as u8; 3])
+                .collect::<Vec<u8>>(),
+        );
+        let row = match depth {
+            png::BitDepth::Eight => indices.to_vec(),
+            // Four 2-bit indices in one byte, the first in the high bits.
+            _ => vec![indices[0] << 6 | indices[1] << 4 | indices[2] << 2 | indices[3]],
+        };
+        let mut writer = encoder.write_header().expect("header");
+        writer.write_image_data(&row).expect("data");
+        writer.finish().expect("finished");
+        bytes
+    }
+
+    /// Issue 64: a palette image whose indices run past its palette decoded those pixels as
+    /// black (0) instead of being refused. In range, the palette's greys are what is read.
+    #[test]
+    fn palette_indices_past_the_palette_are_refused() {
+        for depth in [png::BitDepth::Eight, png::BitDepth::Two] {
+            let fine = palette_png(4, [0, 1, 2, 3], depth);
+            let values = decode_grey(&fine, (4, 1)).expect("in range");
+            assert_eq!(values, [0.0, 85.0 / 255.0, 170.0 / 255.0, 1.0]);
+            let past = palette_png(2, [0, 1, 3, 0], depth);
+            let message = decode_grey(&past, (4, 1)).unwrap_err();
+            assert!(
+                message.contains("pixel (2, 0) holds palette index 3, past its palette of 2"),
+                "{message}"
+            );
+        }
+    }
 }

@@ -120,7 +120,10 @@ impl Fresnel {
                 finite("f90", &f90)?;
                 for (what, v) in [("f0", f0), ("f90", f90)] {
                     if let Some(x) = v.iter().find(|x| !(0.0..=1.0).contains(*x)) {
-                        return Err(format!("{what} must be in [0, 1] (got {x})"));
+                        return Err(format!(
+                            "{what} must be in [0, 1] (got {})",
+                            crate::error::shown(*x)
+                        ));
                     }
                 }
                 Ok(())

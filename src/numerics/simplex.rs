@@ -317,7 +317,7 @@ impl Simplex {
             let theta = self.values[r].max(0.0) / w[r];
             degenerate = if theta > TOLERANCE { 0 } else { degenerate + 1 };
             self.pivot(r, q, &w);
-            if self.pivots % REFACTOR_EVERY == 0 {
+            if self.pivots.is_multiple_of(REFACTOR_EVERY) {
                 let _ = self.refactor(column, rhs);
             }
         }

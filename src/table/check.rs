@@ -172,21 +172,30 @@ impl Table {
         for k in 0..n {
             let (v, w, e) = (self.value[k], self.one_minus_value[k], self.std_error[k]);
             if !range.contains(&v) {
-                return Err(format!("{symbol} at texel {k} is {v}, outside [0, 1]"));
+                return Err(format!(
+                    "{symbol} at texel {k} is {}, outside [0, 1]",
+                    crate::error::shown(v)
+                ));
             }
             if !range.contains(&w) {
                 return Err(format!(
-                    "one_minus_{symbol} at texel {k} is {w}, outside [0, 1]"
+                    "one_minus_{symbol} at texel {k} is {}, outside [0, 1]",
+                    crate::error::shown(w)
                 ));
             }
             if (v + w - 1.0).abs() > 2.0 * RANGE_TOLERANCE {
                 return Err(format!(
-                    "at texel {k}, {symbol} = {v} and one_minus_{symbol} = {w} do not add up \
-                     to 1"
+                    "at texel {k}, {symbol} = {} and one_minus_{symbol} = {} do not add up \
+                     to 1",
+                    crate::error::shown(v),
+                    crate::error::shown(w)
                 ));
             }
             if !(e.is_finite() && e >= 0.0) {
-                return Err(format!("std_error at texel {k} is {e}"));
+                return Err(format!(
+                    "std_error at texel {k} is {}",
+                    crate::error::shown(e)
+                ));
             }
         }
         Ok(())

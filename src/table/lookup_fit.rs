@@ -211,7 +211,57 @@ pub fn planned_evaluations(
     settings: &LookupFitSettings,
     extra: usize,
 ) -> usize {
-    fit_points(spec, settings.per_cell).len() + extra
+    fit_point_count(spec, settings.per_cell).saturating_add(extra)
+}
+
+/// The band of the fit's normal equations: a lookup blends texels up to one step along every
+/// axis, so the band is the sum of the row-major strides (`mu + 1` for rows of `mu` texels,
+/// `n^2 + n + 1` for an `n^3` table).
+#[must_use]
+pub fn band(spec: &super::TableSpec) -> usize {
+    let shape = spec.shape();
+    (0..shape.len())
+        .map(|d| shape[d + 1..].iter().product::<usize>())
+        .sum()
+}
+
+/// The memory [`fit_for_lookup`] holds for a table of `spec` with `extra` points of the
+/// caller's, in bytes, counted without allocating (saturating): the banded normal equations
+/// (`texels x (band + 1)` numbers, [`crate::numerics::minimax`]) and, per point, its
+/// coordinates, its lookup weights twice (all texels and the free ones), the truth, the
+/// residual, the error and Lawson's weight.
+#[must_use]
+pub fn memory_bytes(spec: &super::TableSpec, settings: &LookupFitSettings, extra: usize) -> u64 {
+    let matrix = (spec.len() as u64)
+        .saturating_mul(band(spec) as u64 + 1)
+        .saturating_mul(8);
+    let per_point = (std::mem::size_of::<FitPoint>()
+        + 2 * std::mem::size_of::<super::LookupWeights>()
+        + 4 * 8) as u64;
+    let points = planned_evaluations(spec, settings, extra) as u64;
+    matrix.saturating_add(points.saturating_mul(per_point))
+}
+
+/// How many points [`fit_points`] makes, counted without making them (saturating).
+fn fit_point_count(spec: &super::TableSpec, per_cell: usize) -> usize {
+    let ts = |axis: Option<super::Axis>| -> usize {
+        axis.map_or(1, |axis| {
+            let cells = match axis.grid() {
+                super::Grid::Nodes => axis.size().saturating_sub(1).max(1),
+                super::Grid::Centers => axis.size(),
+            };
+            cells.saturating_mul(per_cell).saturating_add(1)
+        })
+    };
+    let mus = match spec.mu {
+        Some(_) if spec.ior.is_none() => {
+            ts(spec.mu).saturating_add(super::axis::grazing_probes().len())
+        }
+        _ => ts(spec.mu),
+    };
+    ts(spec.ior)
+        .saturating_mul(ts(spec.roughness))
+        .saturating_mul(mus)
 }
 
 /// Fits `table`'s texels for its lookup (see the module docs), in place: `value` and
@@ -357,4 +407,54 @@ fn blend_capped(
         }
     }
     vec![0.0; unknowns]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::integrate::quantity::Quantity;
+    use crate::table::axis::{Axis, IorBound, IorMapping, MuMapping};
+    use crate::table::{Grid, TableSpec, test_e_spec};
+
+    /// `spec` over an IOR axis of 2 nodes: a 2 x rows x columns glass table.
+    fn glass_of(spec: TableSpec) -> TableSpec {
+        TableSpec {
+            quantity: Quantity::EDielectric,
+            ior: Some(Axis::Ior {
+                size: 2,
+                mapping: IorMapping::Linear,
+                max: IorBound(3.0),
+                grid: Grid::Nodes,
+            }),
+            ..spec
+        }
+    }
+
+    /// What a cost estimate and the bake's memory bound read is counted from the axes, not
+    /// made: the count must be what the fit then makes, for every kind of axis.
+    #[test]
+    fn the_fit_points_are_counted_without_being_made() {
+        let glass = glass_of(test_e_spec(3, 4, Grid::Nodes, MuMapping::Linear));
+        for spec in [
+            test_e_spec(3, 4, Grid::Nodes, MuMapping::Linear),
+            test_e_spec(5, 2, Grid::Centers, MuMapping::Sqrt),
+            test_e_spec(1, 7, Grid::Nodes, MuMapping::Adaptive),
+            glass.clone(),
+        ] {
+            for per_cell in [1, 2, 3, 6] {
+                assert_eq!(
+                    fit_point_count(&spec, per_cell),
+                    fit_points(&spec, per_cell).len(),
+                    "{} per cell {per_cell}",
+                    spec.id()
+                );
+            }
+        }
+        // By hand: 3 x 4 nodes at 2 a cell: 5 roughness rungs of 7 mu points and 27 probes.
+        let spec = test_e_spec(3, 4, Grid::Nodes, MuMapping::Linear);
+        assert_eq!(fit_point_count(&spec, 2), 5 * (7 + 27));
+        // The band of a 3 x 4 table is a row and one; of a 2 x 3 x 4 one, 12 + 4 + 1.
+        assert_eq!(band(&spec), 5);
+        assert_eq!(band(&glass), 17);
+    }
 }

@@ -536,12 +536,65 @@ pub fn lookup_coordinates(spec: &TableSpec, settings: &AuditSettings) -> Vec<Coo
     points
 }
 
+/// How many points [`lookup_coordinates`] makes, counted without making them (saturating): what
+/// a cost estimate and [`check_audit_size`] read before anything is allocated.
+#[must_use]
+pub fn lookup_coordinate_count(spec: &TableSpec, settings: &AuditSettings) -> u64 {
+    let ladder = |n: usize| (settings.density.max(1) as u64).saturating_mul(n as u64) + 1;
+    let etas = spec.ior.map_or(1, |axis| ladder(axis.size()));
+    let Some(roughness) = spec.roughness else {
+        return etas;
+    };
+    let per_rung = spec.mu.map_or(1, |axis| {
+        ladder(axis.size()).saturating_add(grazing_probes().len() as u64)
+    });
+    etas.saturating_mul(ladder(roughness.size()))
+        .saturating_mul(per_rung)
+}
+
 /// How many points one pass of [`audit`] compares: every node and every [`lookup_coordinates`]
 /// point (against the reference, the scouts and any refining pass come on top:
-/// [`Progress::Planned`] announces each).
+/// [`Progress::Planned`] announces each). Counted, not built.
 #[must_use]
 pub fn audit_points(spec: &TableSpec, settings: &AuditSettings) -> u64 {
-    (spec.len() + lookup_coordinates(spec, settings).len()) as u64
+    (spec.len() as u64).saturating_add(lookup_coordinate_count(spec, settings))
+}
+
+/// The most points (nodes and lookups) one [`audit`] compares. The audit holds every point in
+/// memory for its figures, its 99th percentile and its error maps, about 220 bytes each (the
+/// point, its coordinates and its measurement, and the report's copy): 2^22 points are about
+/// 0.9 GB. A 128 x 128 table at `--density 8` is 1.1 M points, a 1024 x 1024 one at density 1
+/// 2.1 M.
+pub const MAX_AUDIT_POINTS: u64 = 1 << 22;
+
+/// Refuses, by name and before anything is allocated, an audit of more than
+/// [`MAX_AUDIT_POINTS`] points, saying which density would fit.
+pub fn check_audit_size(spec: &TableSpec, settings: &AuditSettings) -> crate::Result<()> {
+    let points = audit_points(spec, settings);
+    if points <= MAX_AUDIT_POINTS {
+        return Ok(());
+    }
+    let shape: Vec<String> = spec.shape().iter().map(ToString::to_string).collect();
+    let fits = (1..settings.density.max(1)).rev().find(|&density| {
+        let smaller = AuditSettings {
+            density,
+            ..*settings
+        };
+        audit_points(spec, &smaller) <= MAX_AUDIT_POINTS
+    });
+    let advice = match fits {
+        Some(density) => format!("take --density {density} or less"),
+        None => "no density fits: audit a table baked at a smaller --size (the lookups between \
+                 its texels stay as close as its nodes' errors allow)"
+            .to_string(),
+    };
+    Err(crate::Error::InvalidInput(format!(
+        "auditing the {} table ({} texels) at --density {} compares {points} points, more than \
+         the {MAX_AUDIT_POINTS} (2^22, about 0.9 GB) an audit holds in memory: {advice}",
+        shape.join(" x "),
+        spec.len(),
+        settings.density.max(1),
+    )))
 }
 
 /// The largest number of `E_avg` entries [`node_errors`] checks: each costs the reference a
@@ -797,6 +850,52 @@ mod tests {
         }
         assert!((probes[3] / 10f64.powf(-5.75) - 1.0).abs() < 1e-14);
         assert!(probes.windows(2).all(|w| w[0] < w[1]));
+    }
+
+    /// The audit's size is counted from the axes (what `kiln verify` and a fitted bake read
+    /// before anything is allocated) and is what the audit then makes; past
+    /// [`MAX_AUDIT_POINTS`] it is refused, naming the largest density that fits.
+    #[test]
+    fn the_audit_is_counted_without_being_made_and_bounded() {
+        for density in [0, 1, 2, 3, 7] {
+            let settings = AuditSettings {
+                density,
+                ..AuditSettings::default()
+            };
+            for spec in [
+                test_e_spec(3, 4, Grid::Nodes, MuMapping::Linear),
+                test_e_spec(6, 2, Grid::Centers, MuMapping::Sqrt),
+                e_avg_spec(6),
+                glass_spec(Quantity::EDielectric, 3, 3, 4),
+            ] {
+                assert_eq!(
+                    lookup_coordinate_count(&spec, &settings),
+                    lookup_coordinates(&spec, &settings).len() as u64,
+                    "{} at density {density}",
+                    spec.id()
+                );
+            }
+        }
+        // A 128 x 128 table at density 64: 8193 rungs of 8193 mu points and 27 probes, and
+        // its 16384 nodes; 2^22 points hold density 15 (1921 x 1948 + 16384 = 3758492), not
+        // 16 (2049 x 2076 + 16384 = 4270108).
+        let big = test_e_spec(128, 128, Grid::Centers, MuMapping::Linear);
+        let at = |density| AuditSettings {
+            density,
+            ..AuditSettings::default()
+        };
+        assert_eq!(audit_points(&big, &at(64)), 16384 + 8193 * (8193 + 27));
+        let message = check_audit_size(&big, &at(64)).unwrap_err().to_string();
+        assert!(
+            message.contains("--density 64") && message.contains("take --density 15 or less"),
+            "{message}"
+        );
+        check_audit_size(&big, &at(15)).expect("density 15 fits");
+        assert!(check_audit_size(&big, &at(16)).is_err());
+        // A table whose nodes alone are past the bound: no density fits, and it says so.
+        let huge = test_e_spec(4096, 4096, Grid::Centers, MuMapping::Linear);
+        let message = check_audit_size(&huge, &at(1)).unwrap_err().to_string();
+        assert!(message.contains("no density fits"), "{message}");
     }
 
     #[test]

@@ -2,6 +2,29 @@
 
 use std::process::{Command, Output};
 
+/// What `kiln` printed on stderr.
+#[allow(dead_code)] // not every test that includes this file reads stderr
+pub fn stderr(output: &Output) -> String {
+    String::from_utf8_lossy(&output.stderr).into_owned()
+}
+
+/// Runs `kiln` and expects a usage error (exit 2, no panic) whose message names each of
+/// `words`; the message.
+#[allow(dead_code)] // not every test that includes this file expects refusals
+pub fn refused(args: &[&str], words: &[&str]) -> String {
+    let output = kiln(args);
+    let message = stderr(&output);
+    assert_eq!(output.status.code(), Some(2), "{args:?}: {message}");
+    assert!(!message.contains("panicked"), "{message}");
+    for word in words {
+        assert!(
+            message.contains(word),
+            "{args:?}: '{message}' lacks '{word}'"
+        );
+    }
+    message
+}
+
 /// Runs `kiln` with `args` and returns what it printed and its status.
 pub fn kiln(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_kiln"))

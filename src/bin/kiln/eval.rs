@@ -212,10 +212,12 @@ pub fn run(args: EvalArgs) -> kiln::Result<()> {
                 seed: args.seed,
             };
             settings.validate().map_err(kiln::Error::InvalidInput)?;
+            let waiting = args.announce_qmc(quantity, model, samples);
             let e = match mu {
                 Some(mu) => kiln::albedo(model, alpha, mu, &settings),
                 None => kiln::average_albedo(model, alpha, &settings),
             };
+            waiting.finish_and_clear();
             (e.value, e.one_minus_value, e.std_error, e.samples, true)
         }
         Method::Reference => {
@@ -357,7 +359,10 @@ fn fresnel_weighted(
                     seed: args.seed,
                 };
                 settings.validate().map_err(kiln::Error::InvalidInput)?;
+                // Fresnel-weighted integrals run at the split-sum channels' rate.
+                let waiting = args.announce_qmc(Quantity::EScale, model, settings.samples);
                 let e = weighted_albedo(model, alpha, mu, channel(j), &settings);
+                waiting.finish_and_clear();
                 (e.value, e.std_error, e.samples, true)
             }
             Method::Reference => {
@@ -461,10 +466,12 @@ fn dielectric(
                 seed: args.seed,
             };
             settings.validate().map_err(kiln::Error::InvalidInput)?;
+            let waiting = args.announce_qmc(Quantity::EDielectric, model, settings.samples);
             let e = match mu {
                 Some(mu) => dielectric_albedo_with(model, alpha, mu, eta, convention, &settings),
                 None => dielectric_average_albedo_with(model, alpha, eta, convention, &settings),
             };
+            waiting.finish_and_clear();
             (
                 e.value,
                 e.one_minus_value,
@@ -681,6 +688,23 @@ impl EvalArgs {
             return misplaced("--compensation", "e-compensated");
         }
         Ok(())
+    }
+
+    /// Announces a QMC estimate of `samples` samples that will take more than a few seconds
+    /// ([`crate::announce_cost`], at [`kiln::bake::qmc_seconds_per_point`]'s kernel rates) and
+    /// returns a spinner with the time spent, cleared when the estimate is in (hidden with
+    /// --quiet or --json, or when the estimate is short).
+    fn announce_qmc(
+        &self,
+        quantity: Quantity,
+        model: kiln::Model,
+        samples: u64,
+    ) -> indicatif::ProgressBar {
+        let quiet = self.quiet || self.json;
+        let seconds = kiln::bake::qmc_seconds_per_point(quantity, model, samples);
+        crate::announce_cost(seconds, quiet);
+        let threads = rayon::current_num_threads() as f64;
+        crate::spinner(quiet || seconds / threads <= 2.0, "integrating")
     }
 
     /// `--samples` is QMC's: an error with `--method reference`.

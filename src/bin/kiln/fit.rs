@@ -130,6 +130,28 @@ const RATIONAL_SWEEP: [RationalShape; 6] = [
     rational((3, 3), (3, 3), false),
 ];
 
+/// The estimated wall time of `kiln fit` making and auditing `shapes`, in seconds: the
+/// reference at the fit's points (1e-8) and at each audit's (1e-7) on every thread, and each
+/// rational fit's linear programs on one ([`kiln::fit::rational::estimated_seconds`]); a
+/// polynomial fit's least squares take no time to speak of.
+fn estimated_seconds(model: Model, shapes: &[Shape]) -> f64 {
+    let threads = rayon::current_num_threads() as f64;
+    let e = |digits| kiln::bake::reference_seconds(kiln::Quantity::E, model, digits);
+    let truth = kiln::fit::polynomial::truth_point_count() as f64 * e(8);
+    let audit_points = FitAuditSettings::default().points.pow(2) as f64;
+    let fits: f64 = shapes
+        .iter()
+        .map(|shape| {
+            let audit = audit_points * e(7) / threads;
+            match shape {
+                Shape::Polynomial(_) => audit,
+                Shape::Rational(shape) => audit + kiln::fit::rational::estimated_seconds(*shape),
+            }
+        })
+        .sum();
+    truth / threads + fits
+}
+
 /// A fit and its audit: the formula file's text and the audited maximum.
 struct Audited {
     fit: MadeFit,
@@ -188,14 +210,24 @@ pub fn run(args: FitArgs) -> kiln::Result<()> {
         kiln::format::check_output_dir(&out)?;
     }
     let quiet = args.quiet || args.json;
-    let bar = crate::progress_bar(quiet, 0, "reference");
+    let shapes: Vec<Shape> = if args.sweep {
+        SWEEP
+            .iter()
+            .map(|&(t, r)| Shape::Polynomial(Degrees { t, r }))
+            .chain(RATIONAL_SWEEP.iter().copied().map(Shape::Rational))
+            .collect()
+    } else {
+        vec![args.degrees]
+    };
+    crate::announce_seconds(estimated_seconds(model, &shapes), quiet);
+    let bar = crate::progress_bar(
+        quiet,
+        kiln::fit::polynomial::truth_point_count() as u64,
+        "reference",
+    );
     let truth = truth_points(model, &|| bar.inc(1));
     bar.finish_and_clear();
     if args.sweep {
-        let shapes = SWEEP
-            .iter()
-            .map(|&(t, r)| Shape::Polynomial(Degrees { t, r }))
-            .chain(RATIONAL_SWEEP.iter().copied().map(Shape::Rational));
         let mut fits = Vec::new();
         for shape in shapes {
             let a = audited(make(model, shape, &truth, quiet)?, model);

@@ -62,6 +62,21 @@ pub fn progress_bar(quiet: bool, total: u64, what: &str) -> indicatif::ProgressB
     bar
 }
 
+/// A spinner with the time spent, for work whose progress cannot be counted (one QMC
+/// estimate); hidden if `quiet`.
+pub fn spinner(quiet: bool, what: &str) -> indicatif::ProgressBar {
+    if quiet {
+        return indicatif::ProgressBar::hidden();
+    }
+    let bar = indicatif::ProgressBar::new_spinner();
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(&format!("{{spinner}} {what} {{elapsed}}"))
+            .expect("valid template"),
+    );
+    bar.enable_steady_tick(std::time::Duration::from_millis(200));
+    bar
+}
+
 /// A `.toml` file given where no positional argument is taken (`kiln plan scene.toml`).
 fn stray_scene_file(e: &clap::Error) -> Option<String> {
     use clap::error::{ContextKind, ContextValue};
@@ -112,8 +127,12 @@ pub fn human_seconds(seconds: f64) -> String {
 /// Says on stderr, before a bake of more than a few seconds starts, how long it should take
 /// (on any stderr: a log or CI output needs it as much as a terminal); nothing with `quiet`.
 pub fn announce_cost(core_seconds: f64, quiet: bool) {
+    announce_seconds(core_seconds / rayon::current_num_threads() as f64, quiet);
+}
+
+/// [`announce_cost`] of work estimated in seconds of wall time (some of it on one thread).
+pub fn announce_seconds(seconds: f64, quiet: bool) {
     let threads = rayon::current_num_threads();
-    let seconds = core_seconds / threads as f64;
     if !quiet && seconds > 5.0 {
         eprintln!(
             "kiln: estimated {} on {threads} threads (a rough figure; interrupting writes \

@@ -318,29 +318,30 @@ impl VerifyArgs {
     }
 
     fn load(&self, path: &Path) -> kiln::Result<Table> {
-        if self.channel.is_none() && self.dtype.is_none() {
-            if let Some(table) = read_kiln(path)? {
-                let given = self.layout_flags_given();
-                if !given.is_empty() {
-                    return Err(kiln::Error::InvalidInput(format!(
-                        "{} is a kiln table and carries its own layout ({} {}, {}); {} describe \
-                         external tables and would be ignored: drop {}",
-                        path.display(),
-                        table.spec.model,
-                        table.spec.quantity.symbol(),
-                        table
-                            .spec
-                            .shape()
-                            .iter()
-                            .map(ToString::to_string)
-                            .collect::<Vec<_>>()
-                            .join("x"),
-                        given.join(", "),
-                        if given.len() == 1 { "it" } else { "them" }
-                    )));
-                }
-                return Ok(table);
+        if self.channel.is_none()
+            && self.dtype.is_none()
+            && let Some(table) = read_kiln(path)?
+        {
+            let given = self.layout_flags_given();
+            if !given.is_empty() {
+                return Err(kiln::Error::InvalidInput(format!(
+                    "{} is a kiln table and carries its own layout ({} {}, {}); {} describe \
+                     external tables and would be ignored: drop {}",
+                    path.display(),
+                    table.spec.model,
+                    table.spec.quantity.symbol(),
+                    table
+                        .spec
+                        .shape()
+                        .iter()
+                        .map(ToString::to_string)
+                        .collect::<Vec<_>>()
+                        .join("x"),
+                    given.join(", "),
+                    if given.len() == 1 { "it" } else { "them" }
+                )));
             }
+            return Ok(table);
         }
         let is_exr = path
             .extension()
@@ -474,7 +475,7 @@ fn run_furnace(args: &VerifyArgs, table: &Table) -> kiln::Result<bool> {
     let turquin_report = match forms.contains(&Form::Turquin) {
         true => {
             let settings = args.audit_settings(None);
-            let points = kiln::verify::lookup_coordinates(&table.spec, &settings).len() as u64;
+            let points = kiln::verify::lookup_coordinate_count(&table.spec, &settings);
             // The furnace's truth is the reference at 1e-9 (TURQUIN_TRUTH_TOLERANCE); a glass
             // table's points cost four times what the bake's figures say (measured at 1e-10:
             // the 16 x 16 x 16 E_dielectric's 65340 points took 137 s on 2 threads, 2026-12-03,
@@ -742,6 +743,9 @@ pub fn run(args: VerifyArgs) -> kiln::Result<bool> {
         let quiet = args.quiet || args.json;
         let audited = |t: &&Table| t.spec.quantity != Quantity::FMsNorm;
         let settings = args.audit_settings(None);
+        for table in tables.iter().filter(audited) {
+            check_audit_size(args, table)?;
+        }
         let seconds: f64 = tables
             .iter()
             .filter(audited)
@@ -783,6 +787,7 @@ pub fn run(args: VerifyArgs) -> kiln::Result<bool> {
     }
     plot_kind(&args)?;
     let table = args.load(args.file())?;
+    check_audit_size(&args, &table)?;
     if args.furnace {
         return run_furnace(&args, &table);
     }
@@ -790,6 +795,17 @@ pub fn run(args: VerifyArgs) -> kiln::Result<bool> {
         return run_normalisation_audit(&args, &table);
     }
     audit_one(&args, &table, None, None)
+}
+
+/// [`kiln::verify::check_audit_size`] for `table` at the command's density, naming the file:
+/// refused before any point is made.
+fn check_audit_size(args: &VerifyArgs, table: &Table) -> kiln::Result<()> {
+    kiln::verify::check_audit_size(&table.spec, &args.audit_settings(None)).map_err(|e| match e {
+        kiln::Error::InvalidInput(m) => {
+            kiln::Error::InvalidInput(format!("{}: {m}", kiln::error::escaped_path(args.file())))
+        }
+        other => other,
+    })
 }
 
 /// Audits an `f_ms_norm` table against the average of its E table's lookup (the E table beside
@@ -1003,7 +1019,7 @@ fn point_micros(table: &Table) -> u64 {
 /// The estimated cost of auditing `table` (its nodes and its lookup points), in seconds of one
 /// core, for [`crate::announce_cost`] and the progress bar.
 fn audit_core_seconds(table: &Table, settings: &AuditSettings) -> f64 {
-    let points = table.spec.len() + kiln::verify::lookup_coordinates(&table.spec, settings).len();
+    let points = kiln::verify::audit_points(&table.spec, settings);
     points as f64 * point_micros(table) as f64 * 1e-6
 }
 

@@ -45,7 +45,16 @@ pub fn run(args: &VerifyArgs, name: &str) -> kiln::Result<bool> {
         ..FitAuditSettings::default()
     };
     let quiet = args.quiet || args.json;
-    let bar = crate::progress_bar(quiet, fit_audit_points(&fit, &settings), "verifying");
+    // Every point costs the reference of each quantity the fit gives, at the audit's tolerance.
+    let digits = (-settings.tolerance.log10()).round().max(1.0) as u32;
+    let per_point: f64 = fit
+        .quantities()
+        .into_iter()
+        .map(|q| kiln::bake::reference_seconds(q, model, digits))
+        .sum();
+    let points = fit_audit_points(&fit, &settings);
+    crate::announce_cost(points as f64 * per_point, quiet);
+    let bar = crate::progress_bar(quiet, points, "verifying");
     let report = audit_fit(&fit, &settings, &|| bar.inc(1));
     bar.finish_and_clear();
     if let (Some(svg), Some(path)) = (svg, &args.plot) {
