@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Fuzzes every reader kiln has with cargo-fuzz (libFuzzer): kiln's own files, engine files,
-# external tables, scenes, cache entries and sets of shards for `kiln merge`
-# (fuzz/fuzz_targets/). Needs a nightly toolchain and `cargo install cargo-fuzz`. Seeds each
+# external tables, scenes, cache entries, sets of shards for `kiln merge`, formula files and
+# games202 PNG LUTs as their verdict reads them (fuzz/fuzz_targets/). Needs a nightly toolchain and `cargo install cargo-fuzz`. Seeds each
 # target's corpus with valid files (a small bake, the vendored engine files, every preset as
 # kiln writes it, the example scene, a shard and edit lists), then runs each
 # target for SECONDS (default 600) under a 1 GiB allocation limit, a 2 GiB RSS limit and a 5 s
@@ -19,7 +19,8 @@ seconds=${1:-600}
 shift || true
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
-    targets=(kiln_file preset_file external_table scene cache_entry shard_merge)
+    targets=(kiln_file preset_file external_table scene cache_entry shard_merge formula_file
+        png_verdict)
 fi
 corpus=fuzz/corpus
 seeds=$(mktemp -d)
@@ -29,6 +30,16 @@ kiln=target/release/kiln
 "$kiln" bake --quantity e,e-avg --size 6 --max-error 1e-3 \
     --format json,exr,bin,ktx2,dds,h,rs -q --out "$seeds/kiln"
 mkdir -p "$corpus"/{kiln_file,preset_file,external_table,scene,cache_entry,shard_merge}
+mkdir -p "$corpus"/{formula_file,png_verdict}
+# The formula language: the example file, and the corpus kept in the repository
+# (fuzz/seeds/formula_file: every function, operator and define form the language has).
+cp examples/fits/karis-mobile.toml "$corpus/formula_file/"
+cp fuzz/seeds/formula_file/* "$corpus/formula_file/"
+# PNG verdicts: games202's LUT as kiln writes it, and the kept seeds (fuzz/seeds/png_verdict:
+# 16-bit widened, sBIT 8, 4-bit grey, palette).
+"$kiln" bake --preset games202 -q --out "$seeds/games202"
+cp "$seeds"/games202/*.png "$corpus/png_verdict/"
+cp fuzz/seeds/png_verdict/* "$corpus/png_verdict/"
 # kiln_file: a selector byte (json 0, exr 1, bin 2, ktx2 3, dds 4, h 5, rs 6), then the file.
 i=0
 for ext in json exr bin ktx2 dds h rs; do

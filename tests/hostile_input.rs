@@ -1,6 +1,7 @@
 //! Hostile input, deterministically: for every reader (kiln's JSON, binary, EXR, KTX2, DDS, C
 //! and Rust files; every preset's engine file; external text and raw tables; scenes; cache
-//! entries), a few hundred seeded mutants of a valid file: bit flips, truncations at every
+//! entries; formula files, whose error messages may quote no raw control character; a games202
+//! PNG as its verdict reads it), a few hundred seeded mutants of a valid file: bit flips, truncations at every
 //! header word and at random, huge or zero length fields, NaN and infinity written over
 //! values, numbers in text replaced by `NaN`, `1e999` or `-1`, lines dropped or doubled. Each
 //! must read as an error or as a table whose every number is finite, never panic, never ask
@@ -413,6 +414,63 @@ fn targets(dir: &Path) -> Vec<Target> {
                         .collect()
                 })
                 .map_err(|e| e.to_string())
+        }),
+    });
+
+    // A formula file (`kiln verify --fit FILE`): the formula language. A message about a bad
+    // file quotes its text escaped and bounded (issue 64, defect 7): no control character may
+    // reach the terminal, however the text was mutated.
+    let formula = std::fs::read(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/fits/karis-mobile.toml"),
+    )
+    .unwrap();
+    targets.push(Target {
+        name: "formula file".into(),
+        seed: formula,
+        text: true,
+        read: Box::new(|bytes| {
+            let text = String::from_utf8(bytes.to_vec()).map_err(|e| e.to_string())?;
+            match kiln::fit::FormulaFit::parse(&text) {
+                Ok(fit) => {
+                    let fit = kiln::fit::Fit::Formula(fit);
+                    for shown in [fit.name(), fit.source()] {
+                        let printed = kiln::error::escaped(shown);
+                        assert!(!printed.chars().any(char::is_control), "{printed:?}");
+                    }
+                    // A formula may divide by zero: a NaN there is the fit's, which the audit
+                    // reports; evaluating it must not panic.
+                    let mut values = Vec::new();
+                    for quantity in fit.quantities() {
+                        for (mu, r) in [(0.0, 0.0), (0.5, 0.5), (1.0, 1.0), (1e-9, 1e-9)] {
+                            values.push(fit.value(quantity, mu, r));
+                        }
+                    }
+                    Ok(values.into_iter().filter(|v| v.is_finite()).collect())
+                }
+                Err(message) => {
+                    assert!(
+                        !message.chars().any(|c| c.is_control() && c != '\n'),
+                        "raw control characters in {message:?}"
+                    );
+                    Err(message)
+                }
+            }
+        }),
+    });
+
+    // A games202 PNG LUT as `kiln verify --preset games202` reads it for its verdict: the
+    // tables, and the precision its data holds (sBIT, levels widened from 8 bits, palettes).
+    targets.push(Target {
+        name: "games202 png verdict".into(),
+        seed: engine_file(Preset::Games202),
+        text: false,
+        read: Box::new(|bytes| {
+            let tables = Preset::Games202
+                .read_tables(bytes, "mutant")
+                .map_err(|e| e.to_string())?;
+            let _ = Preset::Games202.storage_of(bytes);
+            let _ = kiln::format::png::effective_bits(bytes);
+            Ok(numbers(&tables))
         }),
     });
 

@@ -466,6 +466,21 @@ fn the_command_line_refuses_what_the_walk_cannot_do() {
             ][..],
             "power of two",
         ),
+        // A ray skimming a near-mirror: every bounce leaves it nearly tangent, and each walk
+        // ran to the vertex cap (2^20: minutes of silence); now the first such walk refuses.
+        (
+            &[
+                "--quantity",
+                "e-multiple",
+                "--f0",
+                "0.5",
+                "--alpha",
+                "1e-300",
+                "--mu",
+                "0",
+            ][..],
+            "did not end within 65536 vertices",
+        ),
     ] {
         let output = std::process::Command::new(env!("CARGO_BIN_EXE_kiln"))
             .arg("eval")
@@ -475,6 +490,23 @@ fn the_command_line_refuses_what_the_walk_cannot_do() {
         let stderr = String::from_utf8_lossy(&output.stderr);
         assert_eq!(output.status.code(), Some(2), "{args:?}: {stderr}");
         assert!(stderr.contains(says), "{args:?}: {stderr}");
+    }
+}
+
+/// A mirror (`alpha = 0`) reflects once: the walk's albedo is Schlick's Fresnel at the view,
+/// in closed form, and at `mu = 0` (a tangent view, which has no visible normal to sample and
+/// whose reflection runs along the surface) its grazing value `F90`.
+#[test]
+fn a_mirror_walk_is_one_reflection() {
+    for (mu, f0, expected) in [
+        (0.3, 0.5, 0.5 + 0.5 * 0.7_f64.powi(5)),
+        (1.0, 0.04, 0.04),
+        (0.0, 0.5, 1.0),
+    ] {
+        let estimate = walk(0.0, mu, schlick(f0, 1.0), 1, 1 << 10);
+        let value = estimate.albedo[0].value;
+        assert!((value - expected).abs() < 1e-14, "mu {mu}: {value}");
+        assert_eq!(estimate.mean_vertices, 1.0);
     }
 }
 
@@ -528,4 +560,77 @@ fn kilns_compensation_fits_its_basis_and_matches_independent_walks() {
             "F0 {f0}: kiln {ours}, walk {truth}"
         );
     }
+}
+
+/// kiln's compensation as a table: `kiln compensation --bake` writes one JSON document that
+/// reads back checked, `--table` measures its lookup against independent walks, and a damaged
+/// document is refused by name before anything is walked.
+#[test]
+fn the_compensation_table_bakes_reads_back_and_is_audited() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("tables");
+    let run = |args: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_kiln"))
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    let baked = run(&[
+        "compensation",
+        "--bake",
+        out.to_str().unwrap(),
+        "--size",
+        "6",
+        "--walks",
+        "2^12",
+        "-q",
+    ]);
+    assert!(
+        baked.status.success(),
+        "{}",
+        String::from_utf8_lossy(&baked.stderr)
+    );
+    let file = out.join("ggx-height-correlated-kiln-compensation.json");
+    let bytes = std::fs::read(&file).unwrap();
+    let table = kiln::format::compensation::decode(&bytes, "baked").unwrap();
+    assert_eq!(table.spec.shape(), vec![6, 6]);
+    assert_eq!(table.walks, 1 << 12);
+    let audit = run(&[
+        "compensation",
+        "--table",
+        file.to_str().unwrap(),
+        "--compensation",
+        "kiln",
+        "--roughness",
+        "0.6",
+        "--mu",
+        "0.4",
+        "--f0",
+        "0.5",
+        "--walks",
+        "2^14",
+        "-q",
+    ]);
+    let text = String::from_utf8_lossy(&audit.stdout);
+    assert!(
+        audit.status.success(),
+        "{}",
+        String::from_utf8_lossy(&audit.stderr)
+    );
+    assert!(text.contains("  kiln "), "{text}");
+    // A coefficient of the wrong length: refused, naming it.
+    let damaged = String::from_utf8(bytes).unwrap().replacen(
+        "\"coefficients\": [\n      [",
+        "\"coefficients\": [\n      [0.5, ",
+        1,
+    );
+    let bad = dir.path().join("bad.json");
+    std::fs::write(&bad, damaged).unwrap();
+    let refused = run(&["compensation", "--table", bad.to_str().unwrap(), "-q"]);
+    let message = String::from_utf8_lossy(&refused.stderr);
+    assert_eq!(refused.status.code(), Some(2), "{message}");
+    assert!(
+        message.contains("coefficient 0 holds 37 numbers for 36 texels"),
+        "{message}"
+    );
 }

@@ -7,6 +7,7 @@
 pub mod binary;
 pub mod c_header;
 pub mod comment;
+pub mod compensation;
 #[cfg(feature = "containers")]
 pub mod dds;
 pub mod exr;

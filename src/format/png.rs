@@ -222,6 +222,11 @@ pub fn effective_bits(bytes: &[u8]) -> Option<u8> {
     }
     let samples = info.color_type.samples();
     let (width, height) = (info.width as usize, info.height as usize);
+    // The header's size is the file's word: no image larger than a table may be (a forged
+    // height of 4e9 asked for a terabyte; found by the png_verdict fuzz target).
+    if width.saturating_mul(height) > crate::table::MAX_TEXELS {
+        return None;
+    }
     let mut buffer = vec![0; reader.output_buffer_size()];
     let frame = reader.next_frame(&mut buffer).ok()?;
     let widened = buffer[..frame.buffer_size()]
@@ -257,6 +262,41 @@ mod tests {
         writer.write_image_data(&row).expect("data");
         writer.finish().expect("finished");
         bytes
+    }
+
+    /// The CRC-32 of PNG chunks (ISO 3309), bit by bit.
+    fn crc32(bytes: &[u8]) -> u32 {
+        let mut crc = !0_u32;
+        for &b in bytes {
+            crc ^= u32::from(b);
+            for _ in 0..8 {
+                crc = if crc & 1 == 1 {
+                    (crc >> 1) ^ 0xedb8_8320
+                } else {
+                    crc >> 1
+                };
+            }
+        }
+        !crc
+    }
+
+    /// A 16-bit grey PNG whose header claims 128 x 4,294,965,120 pixels (with a valid CRC)
+    /// over the data of a 128 x 1 image: `effective_bits` sized its buffer from the header and
+    /// asked for a terabyte (the png_verdict fuzz target's find). Now it declines to judge.
+    #[test]
+    fn a_forged_image_size_is_not_allocated() {
+        let mut bytes = Vec::new();
+        let mut encoder = png::Encoder::new(&mut bytes, 128, 1);
+        encoder.set_color(png::ColorType::Grayscale);
+        encoder.set_depth(png::BitDepth::Sixteen);
+        let mut writer = encoder.write_header().expect("header");
+        writer.write_image_data(&[0x01; 256]).expect("data");
+        writer.finish().expect("finished");
+        // IHDR's data is bytes 16..29 (width at 16, height at 20), its CRC at 29.
+        bytes[20..24].copy_from_slice(&0xffff_f780_u32.to_be_bytes());
+        let crc = crc32(&bytes[12..29]);
+        bytes[29..33].copy_from_slice(&crc.to_be_bytes());
+        assert_eq!(effective_bits(&bytes), None);
     }
 
     /// Issue 64: a palette image whose indices run past its palette decoded those pixels as

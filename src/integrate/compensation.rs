@@ -10,7 +10,7 @@
 use crate::integrate::reference::{
     ReferenceSettings, reference_albedo, reference_average_albedo, reference_weighted_albedo,
 };
-use crate::integrate::walk::{WalkError, WalkSettings, walk_schlick_polynomial};
+use crate::integrate::walk::{SchlickPolynomial, WalkError, WalkSettings, walk_schlick_polynomial};
 use crate::model::Model;
 use crate::model::fresnel::{Fresnel, Rgb};
 use crate::model::kulla_conty::fresnel_colour;
@@ -162,12 +162,24 @@ impl KilnCompensation {
         settings: &WalkSettings,
         reference: &ReferenceSettings,
     ) -> Result<Self, WalkError> {
+        Self::fitted(model, alpha, mu, settings, reference).map(|(fit, _)| fit)
+    }
+
+    /// [`KilnCompensation::at`], with the walk's albedo it was fitted to.
+    pub fn fitted(
+        model: Model,
+        alpha: f64,
+        mu: f64,
+        settings: &WalkSettings,
+        reference: &ReferenceSettings,
+    ) -> Result<(Self, SchlickPolynomial), WalkError> {
         let polynomial = walk_schlick_polynomial(model, alpha, mu, 1.0, settings, &|_| {})?;
         let schlick = |c: f64| (1.0 - c.clamp(0.0, 1.0)).powi(5);
         let e_scale =
             reference_weighted_albedo(model, alpha, mu, |c| 1.0 - schlick(c), reference).value;
         let e_bias = reference_weighted_albedo(model, alpha, mu, schlick, reference).value;
-        Ok(Self::fit(|f| polynomial.albedo(f).value, e_scale, e_bias))
+        let fit = Self::fit(|f| polynomial.albedo(f).value, e_scale, e_bias);
+        Ok((fit, polynomial))
     }
 }
 

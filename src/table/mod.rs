@@ -3,6 +3,7 @@
 pub mod axis;
 pub mod balanced_layout;
 pub mod check;
+pub mod compensation;
 pub mod glass_layout;
 pub mod lookup_fit;
 pub mod normalisation;
@@ -590,6 +591,23 @@ impl Table {
             format!("one_minus_{q}"),
             "std_error".to_string(),
         ]
+    }
+
+    /// A table of `spec` whose channels are zero: its layout, for looking up channels laid out
+    /// like it ([`Table::lookup_channel`]) that it does not hold.
+    #[must_use]
+    pub fn layout_of(spec: TableSpec) -> Self {
+        let n = spec.len();
+        Self {
+            spec,
+            value: vec![0.0; n],
+            one_minus_value: vec![0.0; n],
+            std_error: vec![0.0; n],
+            command: String::new(),
+            node_errors: None,
+            requested_max_error: None,
+            lookup_fit: None,
+        }
     }
 
     /// The channels in storage order, matching [`Table::channel_names`].

@@ -16,6 +16,7 @@ use crate::integrate::compensation::{
 use crate::integrate::reference::{ReferenceSettings, reference_average_albedo};
 use crate::integrate::walk::{Measured, WalkError, WalkSettings, walk_schlick_polynomial};
 use crate::model::{Fresnel, Model};
+use crate::table::compensation::CompensationTable;
 use serde::Serialize;
 
 /// Where to measure.
@@ -89,13 +90,15 @@ pub struct CompensationAudit {
     pub f90: f64,
 }
 
-/// Measures `compensations` against the walk over `grid` (GGX, height-correlated). `progress`
-/// hears the number of views done.
+/// Measures `compensations` against the walk over `grid` (GGX, height-correlated). kiln's is
+/// `table`'s lookup where a table is given (what a renderer reads, its interpolation included),
+/// else fitted at each view. `progress` hears the number of views done.
 pub fn audit_compensations(
     model: Model,
     grid: &CompensationGrid,
     compensations: &[Compensation],
     settings: &WalkSettings,
+    table: Option<&CompensationTable>,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Result<CompensationAudit, WalkError> {
     if let Some(&f0) = grid.f0s.iter().find(|f| !(0.0..=1.0).contains(*f)) {
@@ -114,13 +117,21 @@ pub fn audit_compensations(
                 if grid.f90 != 1.0 {
                     return Err(WalkError::KilnFresnel(format!("F90 {}", grid.f90)));
                 }
-                let fit_walks = WalkSettings {
-                    seed: KILN_FIT_SEED,
-                    ..*settings
-                };
-                Some(KilnCompensation::at(
-                    model, alpha, mu, &fit_walks, &reference,
-                )?)
+                match table {
+                    Some(table) => {
+                        let roughness = table.spec.roughness_convention().from_alpha(alpha);
+                        Some(table.lookup(mu, roughness))
+                    }
+                    None => {
+                        let fit_walks = WalkSettings {
+                            seed: KILN_FIT_SEED,
+                            ..*settings
+                        };
+                        Some(KilnCompensation::at(
+                            model, alpha, mu, &fit_walks, &reference,
+                        )?)
+                    }
+                }
             } else {
                 None
             };

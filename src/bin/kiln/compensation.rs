@@ -38,9 +38,22 @@ pub struct CompensationArgs {
     /// Schlick's F90, in [0, 1].
     #[arg(long, default_value_t = 1.0, value_parser = crate::args::parse_number, allow_negative_numbers = true)]
     f90: f64,
-    /// Walks per view, a power of two (every F0 shares them).
-    #[arg(long, default_value = "1048576", value_parser = parse_samples, allow_negative_numbers = true)]
-    walks: u64,
+    /// Walks per view, a power of two (every F0 shares them) [default: 2^20; with --bake, per
+    /// texel, 2^17: a standard error of at most 1e-4 at every texel of 32 x 32].
+    #[arg(long, value_parser = parse_samples, allow_negative_numbers = true)]
+    walks: Option<u64>,
+    /// Bake kiln's compensation into this folder instead: its four coefficients at every texel
+    /// of the E layout of --size (fitted to walks seeded from --seed and the texel) and their
+    /// averages over mu, as one JSON file (NDF-MASKING-kiln-compensation.json).
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["table", "compensation", "roughness", "mu", "f0", "f90", "json"])]
+    bake: Option<std::path::PathBuf>,
+    /// With --bake: the E layout's size (size x size texels, kiln's default layout).
+    #[arg(long, default_value_t = 32, requires = "bake", value_parser = crate::args::parse_size)]
+    size: usize,
+    /// Measure kiln's compensation as this baked table's lookup (what a renderer reads) instead
+    /// of fitting it at each view.
+    #[arg(long, value_name = "FILE")]
+    table: Option<std::path::PathBuf>,
     /// Base seed of the walks' scrambles.
     #[arg(long, default_value_t = 0)]
     seed: u64,
@@ -52,7 +65,76 @@ pub struct CompensationArgs {
     quiet: bool,
 }
 
+/// `kiln compensation --bake DIR`.
+fn bake(args: &CompensationArgs, out: &std::path::Path) -> kiln::Result<()> {
+    use kiln::table::compensation::CompensationTable;
+    let settings = WalkSettings {
+        walks: args.walks.unwrap_or(1 << 17),
+        seed: args.seed,
+        ..WalkSettings::default()
+    };
+    settings.validate()?;
+    kiln::format::check_output_dir(out)?;
+    let options = kiln::BakeOptions {
+        quantities: vec![kiln::Quantity::E, kiln::Quantity::EAvg],
+        size: args.size,
+        texels: Some(kiln::table::Texels::Nodes),
+        ..kiln::BakeOptions::default()
+    };
+    options.validate()?;
+    let mut specs = options.resolved().specs().into_iter();
+    let (spec, average_spec) = (specs.next().expect("E"), specs.next().expect("E_avg"));
+    let texels = spec.len() as u64;
+    // About 0.025 s a texel per 2^16 walks on two cores, the fit's references included (the
+    // 32 x 32 table: 25.2 s at 2^16, 49.5 s at 2^17, one run each, 2026-12-07).
+    crate::announce_cost(
+        texels as f64 * 0.05 * settings.walks as f64 / f64::from(1 << 16),
+        args.quiet,
+    );
+    let bar = crate::progress_bar(args.quiet, texels, "walking");
+    let model = spec.model;
+    let table = CompensationTable::bake(model, spec, average_spec, &settings, &|done| {
+        bar.set_position(done)
+    })?;
+    bar.finish_and_clear();
+    let command = format!(
+        "kiln compensation --bake {} --size {} --walks {} --seed {}",
+        out.display(),
+        args.size,
+        settings.walks,
+        settings.seed
+    );
+    let name = kiln::format::compensation::file_name(&table);
+    let bytes = kiln::format::compensation::encode(&table, &command);
+    let written = kiln::format::write_files(out, &[(name, bytes)])?;
+    if !args.quiet {
+        println!(
+            "{}: kiln's compensation at {} x {} texels, {} walks each, largest standard error \
+             {:.1e}",
+            kiln::error::escaped_path(&written[0]),
+            args.size,
+            args.size,
+            settings.walks,
+            table.max_std_error()
+        );
+    }
+    Ok(())
+}
+
 pub fn run(args: CompensationArgs) -> kiln::Result<()> {
+    if let Some(out) = &args.bake {
+        return bake(&args, out);
+    }
+    let table = match &args.table {
+        Some(path) => {
+            let bytes = kiln::format::read_file(path)?;
+            let table =
+                kiln::format::compensation::decode(&bytes, &kiln::error::escaped_path(path))?;
+            Some(table)
+        }
+        None => None,
+    };
+    let walks = args.walks.unwrap_or(1 << 20);
     let compensations = if args.compensation.is_empty() {
         Compensation::ALL.to_vec()
     } else {
@@ -72,7 +154,7 @@ pub fn run(args: CompensationArgs) -> kiln::Result<()> {
         return Err(kiln::integrate::walk::WalkError::F90(args.f90).into());
     }
     let settings = WalkSettings {
-        walks: args.walks,
+        walks,
         seed: args.seed,
         ..WalkSettings::default()
     };
@@ -85,24 +167,37 @@ pub fn run(args: CompensationArgs) -> kiln::Result<()> {
     if !args.quiet {
         // About 0.5 s a view per 2^20 walks on two cores, walks and references (measured
         // 2026-12-07: 16 s for the default 32 views), twice that with kiln's own fit.
-        let fits = if compensations.contains(&Compensation::Kiln) {
+        let fits = if compensations.contains(&Compensation::Kiln) && table.is_none() {
             2.0
         } else {
             1.0
         };
-        let seconds = views as f64 * 0.5 * fits * args.walks as f64 / f64::from(1 << 20);
+        let seconds = views as f64 * 0.5 * fits * walks as f64 / f64::from(1 << 20);
         if seconds > 5.0 {
             eprintln!(
                 "kiln: {views} views of {} walks, about {} (fewer with --walks)",
-                args.walks,
+                walks,
                 crate::human_seconds(seconds)
             );
         }
     }
     let bar = crate::progress_bar(args.quiet, views, "walking");
-    let audit = audit_compensations(model, &grid, &compensations, &settings, &|done| {
-        bar.set_position(done)
-    })?;
+    if let Some(table) = &table
+        && table.spec.model != model
+    {
+        return Err(kiln::Error::InvalidInput(format!(
+            "--table holds kiln's compensation for {}; the walk is {model}",
+            table.spec.model
+        )));
+    }
+    let audit = audit_compensations(
+        model,
+        &grid,
+        &compensations,
+        &settings,
+        table.as_ref(),
+        &|done| bar.set_position(done),
+    )?;
     bar.finish_and_clear();
     if args.json {
         println!(

@@ -105,6 +105,8 @@ pub enum WalkError {
     F90(f64),
     /// kiln's compensation is fitted for Schlick's Fresnel with `F90 = 1`; this is another.
     KilnFresnel(String),
+    /// A walk from this view did not end within [`conductor::MAX_VERTICES`] vertices.
+    Unresolved { alpha: f64, mu: f64 },
 }
 
 impl std::fmt::Display for WalkError {
@@ -132,6 +134,16 @@ impl std::fmt::Display for WalkError {
                  give --f0 (and --f90 1), or measure kulla-conty and turquin only"
             ),
             WalkError::F90(v) => write!(f, "f90 {} is out of range [0, 1]", shown(*v)),
+            WalkError::Unresolved { alpha, mu } => write!(
+                f,
+                "the walk at alpha {}, mu {} did not end within {} vertices: a ray skimming a \
+                 near-mirror surface (mu and alpha both near 0) stays nearly tangent at every \
+                 bounce; the walk cannot resolve it (take alpha 0, a mirror, or a larger mu or \
+                 alpha)",
+                shown(*alpha),
+                shown(*mu),
+                conductor::MAX_VERTICES
+            ),
             WalkError::Model(model) => write!(
                 f,
                 "the microsurface walk is written for GGX (its masking is the walk's own, \
@@ -338,6 +350,7 @@ fn run(
         .flat_map(|s| (0..chunks).map(move |c| (s, c)))
         .collect();
     let done = std::sync::atomic::AtomicU64::new(0);
+    let capped = std::sync::atomic::AtomicBool::new(false);
     let sums: Vec<Tallies> = tasks
         .par_iter()
         .map(|&(s, c)| {
@@ -347,8 +360,12 @@ fn run(
             let start = c * u64::from(CHUNK);
             let end = (start + u64::from(CHUNK)).min(per_scramble);
             for index in start..end {
+                // One walk that cannot end refuses the point: the rest need not run.
+                if capped.load(std::sync::atomic::Ordering::Relaxed) {
+                    break;
+                }
                 let mut random = random::WalkRandom::new(&sobol, seed, index as u32);
-                conductor::walk(
+                if conductor::walk(
                     &ndf,
                     wi,
                     fresnel,
@@ -356,13 +373,18 @@ fn run(
                     settings.heights,
                     &mut random,
                     &mut tallies,
-                );
+                ) {
+                    capped.store(true, std::sync::atomic::Ordering::Relaxed);
+                }
             }
             let total = done.fetch_add(end - start, std::sync::atomic::Ordering::Relaxed);
             progress(total + end - start);
             tallies
         })
         .collect();
+    if capped.into_inner() {
+        return Err(WalkError::Unresolved { alpha, mu });
+    }
     // Each scramble's sums, in chunk order: the same bits on any number of threads.
     let mut replicates =
         vec![Tallies::new(orders, schlick_f90.is_some()); settings.scrambles as usize];
