@@ -21,26 +21,70 @@ pub struct FolderLock {
 }
 
 impl FolderLock {
-    /// Waits for and takes the lock on `dir`, which must exist.
+    /// Creates `dir` if need be, then waits for and takes the lock on it. Another kiln may
+    /// remove a folder it created for its start-up check ([`super::check_output_dir`]) while
+    /// this one takes the lock: the lock is taken again until it holds the folder that is at
+    /// `dir` (on Unix, the same inode), so that two writers never lock two different folders.
     pub fn acquire(dir: &Path) -> Result<Self> {
         let io = |action, source| Error::Io {
             path: dir.to_path_buf(),
             action,
             source,
         };
-        #[cfg(unix)]
-        let file = File::open(dir).map_err(|e| io("open the output directory to lock", e))?;
-        #[cfg(not(unix))]
-        let file = std::fs::OpenOptions::new()
-            .create(true)
-            .truncate(false)
-            .write(true)
-            .open(dir.join(".kiln.lock"))
-            .map_err(|e| io("create the lock file in", e))?;
-        file.lock()
-            .map_err(|e| io("lock the output directory", e))?;
-        Ok(Self { _file: file })
+        let mut attempts = 0;
+        loop {
+            attempts += 1;
+            std::fs::create_dir_all(dir).map_err(|e| io("create the output directory", e))?;
+            #[cfg(unix)]
+            let opened = File::open(dir);
+            #[cfg(not(unix))]
+            let opened = std::fs::OpenOptions::new()
+                .create(true)
+                .truncate(false)
+                .write(true)
+                .open(dir.join(".kiln.lock"));
+            let file = match opened {
+                Ok(file) => file,
+                Err(e) if e.kind() == std::io::ErrorKind::NotFound && attempts < 100 => continue,
+                Err(e) => return Err(io("open the output directory to lock", e)),
+            };
+            file.lock()
+                .map_err(|e| io("lock the output directory", e))?;
+            if holds(&file, dir) || attempts >= 100 {
+                return Ok(Self { _file: file });
+            }
+        }
     }
+}
+
+/// Removes the empty folder `dir` unless another kiln holds its lock (it is about to write
+/// there): what a start-up check does with a folder it created ([`super::check_output_dir`]).
+/// Failures are harmless: the folder stays.
+pub fn remove_if_free(dir: &Path) {
+    #[cfg(unix)]
+    if let Ok(file) = File::open(dir) {
+        if file.try_lock().is_ok() {
+            let _ = std::fs::remove_dir(dir);
+        }
+        return;
+    }
+    let _ = std::fs::remove_dir(dir);
+}
+
+/// Whether the locked `file` is (on Unix) the folder now at `dir`.
+#[cfg(unix)]
+fn holds(file: &File, dir: &Path) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    match (file.metadata(), std::fs::metadata(dir)) {
+        (Ok(locked), Ok(there)) => locked.ino() == there.ino() && locked.dev() == there.dev(),
+        _ => false,
+    }
+}
+
+/// Elsewhere the lock file in the folder keeps it from being removed.
+#[cfg(not(unix))]
+fn holds(_: &File, _: &Path) -> bool {
+    true
 }
 
 #[cfg(test)]

@@ -307,19 +307,34 @@ pub fn check_output_dir(dir: &Path) -> Result<()> {
         .ancestors()
         .take_while(|a| !a.as_os_str().is_empty() && !a.exists())
         .collect();
-    create_output_dir(dir)?;
-    let probe = tempfile::Builder::new()
-        .prefix(".kiln-probe-")
-        .tempfile_in(dir)
-        .map(drop)
-        .map_err(|source| Error::Io {
-            path: dir.to_path_buf(),
-            action: "write to the output directory",
-            source,
-        });
+    // Another kiln's check may remove the folder it created between this one's creating it
+    // and probing it (two bakes started into one new folder): then create it again.
+    let mut attempts = 0;
+    let probe = loop {
+        attempts += 1;
+        create_output_dir(dir)?;
+        match tempfile::Builder::new()
+            .prefix(".kiln-probe-")
+            .tempfile_in(dir)
+        {
+            Ok(file) => {
+                drop(file);
+                break Ok(());
+            }
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound && attempts < 100 => {}
+            Err(source) => {
+                break Err(Error::Io {
+                    path: dir.to_path_buf(),
+                    action: "write to the output directory",
+                    source,
+                });
+            }
+        }
+    };
     for created in missing {
-        // Fails, harmlessly, if another process has put something there meanwhile.
-        let _ = std::fs::remove_dir(created);
+        // Fails, harmlessly, if another process has put something there meanwhile; not while
+        // another kiln holds the folder to write into it.
+        folder_lock::remove_if_free(created);
     }
     probe
 }
@@ -336,7 +351,6 @@ fn create_output_dir(dir: &Path) -> Result<()> {
 /// each goes to a temporary file first; only when all were written are they renamed into place.
 /// Under the folder's lock ([`folder_lock`]), so that two writers' sets are never interleaved.
 pub fn write_files(dir: &Path, files: &[(String, Vec<u8>)]) -> Result<Vec<PathBuf>> {
-    create_output_dir(dir)?;
     let _lock = folder_lock::FolderLock::acquire(dir)?;
     write_files_locked(dir, files)
 }
@@ -439,7 +453,6 @@ pub fn write_table_files(
 ) -> Result<Vec<PathBuf>> {
     let names: Vec<String> = files.iter().map(|(name, _)| name.clone()).collect();
     let specs: Vec<crate::table::TableSpec> = tables.iter().map(|t| t.spec.clone()).collect();
-    create_output_dir(dir)?;
     let _lock = folder_lock::FolderLock::acquire(dir)?;
     let stale = replace::check(dir, &specs, &names, replace)?;
     let written = write_files_locked(dir, files)?;
