@@ -15,6 +15,7 @@
 //! Lambda(-w)` for a downward `w`, section 4.1).
 
 use super::heights::Heights;
+use super::lobe::LobeTargets;
 use super::random::WalkRandom;
 use crate::model::fresnel::{Fresnel, Rgb};
 use crate::model::ndf::MicrofacetDistribution;
@@ -57,12 +58,16 @@ pub struct Tallies {
     pub dropped: Rgb,
     /// Vertices visited, over all walks.
     pub vertices: u64,
+    /// With exit directions asked for ([`LobeTargets`]): the next-event sums of the first order
+    /// at each direction, then those of every later order; empty when not asked for.
+    pub lobe: Vec<f64>,
 }
 
 impl Tallies {
-    /// Empty tallies for `orders` orders, with the `F0` polynomial or not.
+    /// Empty tallies for `orders` orders, with the `F0` polynomial or not, and `lobe_slots`
+    /// exit directions (0 for none).
     #[must_use]
-    pub fn new(orders: usize, polynomial: bool) -> Self {
+    pub fn new(orders: usize, polynomial: bool, lobe_slots: usize) -> Self {
         Self {
             orders: vec![0.0; orders],
             beyond: 0.0,
@@ -74,6 +79,7 @@ impl Tallies {
             },
             dropped: [0.0; 3],
             vertices: 0,
+            lobe: vec![0.0; 2 * lobe_slots],
         }
     }
 
@@ -86,6 +92,9 @@ impl Tallies {
         for (a, b) in self.polynomial.iter_mut().zip(&other.polynomial) {
             *a += b;
         }
+        for (a, b) in self.lobe.iter_mut().zip(&other.lobe) {
+            *a += b;
+        }
         for j in 0..3 {
             self.albedo[j] += other.albedo[j];
             self.dropped[j] += other.dropped[j];
@@ -94,24 +103,39 @@ impl Tallies {
     }
 }
 
+/// What a walk tallies beside the orders.
+#[derive(Clone, Copy, Debug)]
+pub struct Asked<'a> {
+    /// The Fresnel model at every vertex, for the albedo ([`Fresnel::None`]: `F = 1` only).
+    pub fresnel: &'a Fresnel,
+    /// Schlick's `F90`, to carry the albedo as a polynomial in `F0`.
+    pub schlick_f90: Option<f64>,
+    /// Exit directions at which to estimate the lobe ([`super::lobe`]).
+    pub lobe: Option<&'a LobeTargets>,
+}
+
 /// Walks once from the incident direction `wi` (unit, `wi.z > 0`) and adds what leaves to
-/// `tallies`. With `fresnel` equal to [`Fresnel::None`] the walk stops after the last order
-/// tallied and puts what it still carries into `beyond` (with `F = 1` every walk leaves in the
-/// end, so that is exactly the expected energy of the later orders); otherwise it goes on to
-/// the end for the Fresnel-weighted albedo. With `schlick_f90`, and `tallies` made with a
-/// polynomial, the walk also carries Schlick's Fresnel `F0 + (F90 - F0) (1 - c)^5` as a
-/// polynomial in `F0`. Returns whether the walk reached [`MAX_VERTICES`].
+/// `tallies`. With `asked.fresnel` equal to [`Fresnel::None`] (and no polynomial or lobe) the
+/// walk stops after the last order tallied and puts what it still carries into `beyond` (with
+/// `F = 1` every walk leaves in the end, so that is exactly the expected energy of the later
+/// orders); otherwise it goes on to the end for the Fresnel-weighted albedo. With
+/// `asked.schlick_f90`, and `tallies` made with a polynomial, the walk also carries Schlick's
+/// Fresnel `F0 + (F90 - F0) (1 - c)^5` as a polynomial in `F0`; with `asked.lobe` it adds the
+/// next-event estimates of the lobe at every vertex. Returns whether the walk reached
+/// [`MAX_VERTICES`].
 pub fn walk<N: MicrofacetDistribution>(
     ndf: &N,
     wi: Vec3,
-    fresnel: &Fresnel,
-    schlick_f90: Option<f64>,
+    asked: &Asked<'_>,
     heights: Heights,
     random: &mut WalkRandom<'_>,
     tallies: &mut Tallies,
 ) -> bool {
-    let polynomial = schlick_f90.filter(|_| !tallies.polynomial.is_empty());
-    let to_the_end = *fresnel != Fresnel::None || polynomial.is_some();
+    let fresnel = asked.fresnel;
+    let polynomial = asked.schlick_f90.filter(|_| !tallies.polynomial.is_empty());
+    let lobe = asked.lobe.filter(|_| !tallies.lobe.is_empty());
+    let rotations = lobe.map(|l| l.rotations(random)).unwrap_or_default();
+    let to_the_end = *fresnel != Fresnel::None || polynomial.is_some() || lobe.is_some();
     // The throughput's coefficients of F0^0 ..= F0^degree.
     let mut coefficients = [0.0; MAX_DEGREE + 1];
     coefficients[0] = 1.0;
@@ -129,6 +153,9 @@ pub fn walk<N: MicrofacetDistribution>(
         tallies.vertices += 1;
         let log_c1 = heights.log_c1(h);
         let v = Vec3::new(-w.x, -w.y, -w.z);
+        if let Some(lobe) = lobe {
+            lobe.add(ndf, v, log_c1, plain, vertex, &rotations, &mut tallies.lobe);
+        }
         let mirror = ndf.alpha() == 0.0;
         let m = if mirror {
             // Every microfacet faces up (and a tangent view has no visible normal to sample).

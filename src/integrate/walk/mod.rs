@@ -17,6 +17,7 @@
 
 pub mod conductor;
 pub mod heights;
+pub mod lobe;
 pub mod random;
 
 pub use conductor::Tallies;
@@ -107,6 +108,14 @@ pub enum WalkError {
     KilnFresnel(String),
     /// A walk from this view did not end within [`conductor::MAX_VERTICES`] vertices.
     Unresolved { alpha: f64, mu: f64 },
+    /// A lobe asked of a mirror or from a tangent view: a delta, not a function.
+    DeltaLobe { alpha: f64, mu: f64 },
+    /// An exit cosine of a lobe not in `(0, 1]`.
+    ExitMu(f64),
+    /// An exit azimuth of a lobe not in `[0, pi]`.
+    Azimuth(f64),
+    /// More exit directions than a walk evaluates at each vertex, or none.
+    Directions(usize),
 }
 
 impl std::fmt::Display for WalkError {
@@ -143,6 +152,30 @@ impl std::fmt::Display for WalkError {
                 shown(*alpha),
                 shown(*mu),
                 conductor::MAX_VERTICES
+            ),
+            WalkError::DeltaLobe { alpha, mu } => write!(
+                f,
+                "the lobe at alpha {}, mu {} is a delta (a mirror, or light along the surface): \
+                 take alpha and mu above 0",
+                shown(*alpha),
+                shown(*mu)
+            ),
+            WalkError::ExitMu(mu) => write!(
+                f,
+                "exit cosine {} is out of range (0, 1]: the lobe is measured above the surface",
+                shown(*mu)
+            ),
+            WalkError::Azimuth(phi) => write!(
+                f,
+                "exit azimuth {} degrees is out of range [0, 180] (the lobe is even in the \
+                 azimuth)",
+                shown(phi.to_degrees())
+            ),
+            WalkError::Directions(n) => write!(
+                f,
+                "{n} exit directions a vertex: take 1 to {} (exit cosines times azimuths and \
+                 strata)",
+                lobe::LobeGrid::MAX_DIRECTIONS
             ),
             WalkError::Model(model) => write!(
                 f,
@@ -229,7 +262,9 @@ pub fn walk_albedo(
     settings: &WalkSettings,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Result<WalkEstimate, WalkError> {
-    let replicates = run(model, alpha, mu, fresnel, None, orders, settings, progress)?;
+    let replicates = run(
+        model, alpha, mu, fresnel, None, None, orders, settings, progress,
+    )?;
     let per_scramble = (settings.walks / u64::from(settings.scrambles)) as f64;
     let measure = |get: &dyn Fn(&Tallies) -> f64| {
         let means: Vec<f64> = replicates.iter().map(|t| get(t) / per_scramble).collect();
@@ -307,6 +342,7 @@ pub fn walk_schlick_polynomial(
         mu,
         &Fresnel::None,
         Some(f90),
+        None,
         0,
         settings,
         progress,
@@ -323,6 +359,87 @@ pub fn walk_schlick_polynomial(
     })
 }
 
+/// The lobe the walk measured from one view ([`walk_lobe`]): BRDF values `f(w_i, w_o)` (not
+/// times the cosine), each with its standard error.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LobeEstimate {
+    /// The view's cosine.
+    pub mu: f64,
+    /// Where the lobe was measured.
+    pub grid: lobe::LobeGrid,
+    /// The first order at each fixed direction, `grid.mus`-major: `[i_mu * azimuths + i_phi]`.
+    pub single: Vec<Measured>,
+    /// Every later order, as `single`.
+    pub multiple: Vec<Measured>,
+    /// The first order averaged over the azimuth, at each of `grid.mus`.
+    pub single_averaged: Vec<Measured>,
+    /// Every later order averaged over the azimuth, at each of `grid.mus`.
+    pub multiple_averaged: Vec<Measured>,
+    /// Walks run.
+    pub walks: u64,
+}
+
+/// Walks as [`walk_albedo`] from the view `mu` and estimates the lobe (`F = 1`) of the first
+/// and of every later order at `grid`'s exit directions by next-event estimation
+/// ([`lobe`]). A mirror's lobe is a delta and is refused.
+pub fn walk_lobe(
+    model: Model,
+    alpha: f64,
+    mu: f64,
+    grid: &lobe::LobeGrid,
+    settings: &WalkSettings,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<LobeEstimate, WalkError> {
+    check_inputs(model, alpha, mu, 0)?;
+    if alpha == 0.0 || mu == 0.0 {
+        return Err(WalkError::DeltaLobe { alpha, mu });
+    }
+    if let Some(&m) = grid.mus.iter().find(|m| !(**m > 0.0 && **m <= 1.0)) {
+        return Err(WalkError::ExitMu(m));
+    }
+    if let Some(&phi) = grid
+        .azimuths
+        .iter()
+        .find(|p| !(0.0..=std::f64::consts::PI).contains(*p))
+    {
+        return Err(WalkError::Azimuth(phi));
+    }
+    let directions = grid.mus.len() * (grid.azimuths.len() + grid.strata as usize);
+    if grid.mus.is_empty() || directions > lobe::LobeGrid::MAX_DIRECTIONS {
+        return Err(WalkError::Directions(directions));
+    }
+    let replicates = run(
+        model,
+        alpha,
+        mu,
+        &Fresnel::None,
+        None,
+        Some(grid),
+        0,
+        settings,
+        progress,
+    )?;
+    let per_scramble = (settings.walks / u64::from(settings.scrambles)) as f64;
+    let slots = grid.slots();
+    let measure = |slot: usize| {
+        let means: Vec<f64> = replicates
+            .iter()
+            .map(|t| t.lobe[slot] / per_scramble)
+            .collect();
+        Measured::from_replicates(&means)
+    };
+    let fixed = grid.mus.len() * grid.azimuths.len();
+    Ok(LobeEstimate {
+        mu,
+        grid: grid.clone(),
+        single: (0..fixed).map(measure).collect(),
+        multiple: (0..fixed).map(|k| measure(slots + k)).collect(),
+        single_averaged: (fixed..slots).map(measure).collect(),
+        multiple_averaged: (fixed..slots).map(|k| measure(slots + k)).collect(),
+        walks: settings.walks,
+    })
+}
+
 /// Runs the walks and returns each scramble's sums.
 #[allow(clippy::too_many_arguments)]
 fn run(
@@ -331,6 +448,7 @@ fn run(
     mu: f64,
     fresnel: &Fresnel,
     schlick_f90: Option<f64>,
+    lobe: Option<&lobe::LobeGrid>,
     orders: usize,
     settings: &WalkSettings,
     progress: &(dyn Fn(u64) + Sync),
@@ -344,6 +462,13 @@ fn run(
     }
     let ndf = Ggx { alpha };
     let wi = Vec3::from_mu(mu);
+    let targets = lobe.map(|grid| lobe::LobeTargets::new(&ndf, grid));
+    let lobe_slots = targets.as_ref().map_or(0, lobe::LobeTargets::slots);
+    let asked = conductor::Asked {
+        fresnel,
+        schlick_f90,
+        lobe: targets.as_ref(),
+    };
     let per_scramble = settings.walks / u64::from(settings.scrambles);
     let chunks = per_scramble.div_ceil(u64::from(CHUNK));
     let tasks: Vec<(u32, u64)> = (0..settings.scrambles)
@@ -356,7 +481,7 @@ fn run(
         .map(|&(s, c)| {
             let seed = mix_seed(&[settings.seed, 0x5741_4c4b, u64::from(s)]);
             let sobol = OwenSobol::new(seed);
-            let mut tallies = Tallies::new(orders, schlick_f90.is_some());
+            let mut tallies = Tallies::new(orders, schlick_f90.is_some(), lobe_slots);
             let start = c * u64::from(CHUNK);
             let end = (start + u64::from(CHUNK)).min(per_scramble);
             for index in start..end {
@@ -368,8 +493,7 @@ fn run(
                 if conductor::walk(
                     &ndf,
                     wi,
-                    fresnel,
-                    schlick_f90,
+                    &asked,
                     settings.heights,
                     &mut random,
                     &mut tallies,
@@ -387,7 +511,7 @@ fn run(
     }
     // Each scramble's sums, in chunk order: the same bits on any number of threads.
     let mut replicates =
-        vec![Tallies::new(orders, schlick_f90.is_some()); settings.scrambles as usize];
+        vec![Tallies::new(orders, schlick_f90.is_some(), lobe_slots); settings.scrambles as usize];
     for (&(s, _), chunk) in tasks.iter().zip(&sums) {
         replicates[s as usize].add(chunk);
     }

@@ -10,18 +10,29 @@ pub struct WalkRandom<'a> {
     index: u32,
     dim: usize,
     state: u64,
+    key: u64,
 }
 
 impl<'a> WalkRandom<'a> {
     /// Walk `index` of the scramble `sobol` (whose seed also keys the generator's stream).
     #[must_use]
     pub fn new(sobol: &'a OwenSobol, stream_seed: u64, index: u32) -> Self {
+        let key = mix_seed(&[stream_seed, u64::from(index)]);
         Self {
             sobol,
             index,
             dim: 0,
-            state: mix_seed(&[stream_seed, u64::from(index)]),
+            state: key,
+            key,
         }
+    }
+
+    /// A number uniform in (0, 1) for a purpose beside the walk (`tag` names it), from the
+    /// walk's key: it neither reads nor advances the walk's own numbers.
+    #[must_use]
+    pub fn side_uniform(&self, tag: u64) -> f64 {
+        let z = mix_seed(&[self.key, tag]);
+        ((z >> 11) as f64 + 0.5) * (1.0 / 9_007_199_254_740_992.0)
     }
 
     /// The next number, uniform in (0, 1): the Sobol point's coordinates first (the first two

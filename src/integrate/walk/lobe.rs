@@ -1,0 +1,162 @@
+//! The lobe of the microsurface walk: the BRDF of each order of scattering at given exit
+//! directions, by next-event estimation.
+//!
+//! At every vertex of a walk the ray, arriving from `v` (unit; below the horizon when it was
+//! travelling up) at a height with `ln C1 = l`, reflects into a direction `o` with the density
+//! of the phase function `p(v -> o) = D(m) / (4 A(v))`, `m` the half vector of `v` and `o` and
+//! `A(v) = v.z (1 + Lambda(v))` the microsurface's area projected along `v` (visible normals
+//! `(v.m)+ D(m) / A(v)` times the reflection's Jacobian `1 / (4 o.m)`, `o.m = v.m`), and leaves
+//! from there with probability `C1^Lambda(o)` (Heitz, Hanika, d'Eon and Dachsbacher 2016,
+//! "Multiple-Scattering Microfacet BSDFs with the Smith Model", sections 4 and 5). The energy
+//! leaving after vertex `k` per unit solid angle is the expectation of the throughput before the
+//! vertex times `p(v -> o) C1^Lambda(o)`, and the BRDF of order `k` is that over `o.z`. The walk
+//! itself goes on as [`super::conductor`] draws it: next-event estimation only reads it.
+//!
+//! The first order is the height-correlated Smith BRDF `D G2 / (4 mu_i mu_o)` exactly (the
+//! expectation of `C1^Lambda(o)` over the first hit's height is `(1 + Lambda(i)) G2`); the test
+//! measures it against that closed form.
+//!
+//! Two kinds of exit direction: fixed ones, `(mu_o, phi)` with `phi` the azimuth from the
+//! view's plane (0: back towards the light's side, `pi`: the mirror direction's side); and the
+//! average over the azimuth at each `mu_o`, taken over `strata` azimuths `pi (j + u) / strata`
+//! with one uniform `u` per walk (stratified, so its expectation is the average exactly: the
+//! lobe is even in `phi`).
+
+use super::random::WalkRandom;
+use crate::model::ndf::MicrofacetDistribution;
+use crate::model::vector::Vec3;
+use std::f64::consts::PI;
+
+/// Where to evaluate the lobe.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LobeGrid {
+    /// Exit cosines, each in `(0, 1]`.
+    pub mus: Vec<f64>,
+    /// Exit azimuths in `[0, pi]` (radians) from the view's plane, 0 on the view's side.
+    pub azimuths: Vec<f64>,
+    /// Azimuths per walk for the averages over the azimuth (at least 1).
+    pub strata: u32,
+}
+
+impl LobeGrid {
+    /// Most exit directions a walk may evaluate at each vertex.
+    pub const MAX_DIRECTIONS: usize = 4096;
+
+    /// Fixed directions, then averaged cosines: how many sums each order needs.
+    #[must_use]
+    pub fn slots(&self) -> usize {
+        self.mus.len() * self.azimuths.len() + self.mus.len()
+    }
+}
+
+/// A grid made ready for the walk: each exit direction and its `Lambda`.
+#[derive(Clone, Debug)]
+pub struct LobeTargets {
+    fixed: Vec<(Vec3, f64)>,
+    /// `(mu_o, sin theta_o, Lambda(o))` for each averaged cosine.
+    averaged: Vec<(f64, f64, f64)>,
+    strata: u32,
+}
+
+impl LobeTargets {
+    /// The exit directions of `grid` for `ndf`.
+    pub fn new<N: MicrofacetDistribution>(ndf: &N, grid: &LobeGrid) -> Self {
+        let fixed = grid
+            .mus
+            .iter()
+            .flat_map(|&mu| {
+                grid.azimuths.iter().map(move |&phi| {
+                    let s = ((1.0 - mu) * (1.0 + mu)).max(0.0).sqrt();
+                    Vec3::new(s * phi.cos(), s * phi.sin(), mu)
+                })
+            })
+            .map(|o| (o, ndf.lambda(o)))
+            .collect();
+        let averaged = grid
+            .mus
+            .iter()
+            .map(|&mu| {
+                let o = Vec3::from_mu(mu);
+                (mu, o.x, ndf.lambda(o))
+            })
+            .collect();
+        Self {
+            fixed,
+            averaged,
+            strata: grid.strata.max(1),
+        }
+    }
+
+    /// Sums per order (`slots` for the first order, then as many for the later ones).
+    #[must_use]
+    pub fn slots(&self) -> usize {
+        self.fixed.len() + self.averaged.len()
+    }
+
+    /// This walk's azimuths for the averages: `(cos, sin)` of `pi (j + u) / strata`, `u` drawn
+    /// from the walk's own key so that the walk's numbers are untouched.
+    #[must_use]
+    pub fn rotations(&self, random: &WalkRandom<'_>) -> Vec<(f64, f64)> {
+        let u = random.side_uniform(0x4c4f_4245);
+        (0..self.strata)
+            .map(|j| {
+                let phi = PI * (f64::from(j) + u) / f64::from(self.strata);
+                (phi.cos(), phi.sin())
+            })
+            .collect()
+    }
+
+    /// Adds the next-event estimates of vertex `vertex` (1 for the first) to `sums`: arriving
+    /// from `v` with throughput `throughput` at `ln C1 = log_c1`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn add<N: MicrofacetDistribution>(
+        &self,
+        ndf: &N,
+        v: Vec3,
+        log_c1: f64,
+        throughput: f64,
+        vertex: u32,
+        rotations: &[(f64, f64)],
+        sums: &mut [f64],
+    ) {
+        // 4 A(v), signed: v.z (1 + Lambda(v)) above the horizon, |v.z| Lambda(v) below.
+        let area = 4.0 * ndf.projected_area(v.z);
+        if area <= 0.0 || !area.is_finite() {
+            return;
+        }
+        let slots = self.slots();
+        let sums = if vertex == 1 {
+            &mut sums[..slots]
+        } else {
+            &mut sums[slots..]
+        };
+        let weight = throughput / area;
+        let contribution = |o: Vec3, lambda: f64| {
+            let z = v.z + o.z;
+            if z <= 0.0 {
+                return 0.0;
+            }
+            // tan^2 of the half vector from its unnormalised components: no cancellation.
+            let (x, y) = (v.x + o.x, v.y + o.y);
+            let d = ndf.d_from_tan2((x * x + y * y) / (z * z));
+            let escape = if log_c1 == 0.0 {
+                1.0
+            } else {
+                (lambda * log_c1).exp()
+            };
+            weight * d * escape
+        };
+        let (fixed, averaged) = sums.split_at_mut(self.fixed.len());
+        for (sum, &(o, lambda)) in fixed.iter_mut().zip(&self.fixed) {
+            *sum += contribution(o, lambda) / o.z;
+        }
+        let share = 1.0 / rotations.len() as f64;
+        for (sum, &(mu, s, lambda)) in averaged.iter_mut().zip(&self.averaged) {
+            let total: f64 = rotations
+                .iter()
+                .map(|&(c, sn)| contribution(Vec3::new(s * c, s * sn, mu), lambda))
+                .sum();
+            *sum += total * share / mu;
+        }
+    }
+}
