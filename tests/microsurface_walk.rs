@@ -787,3 +787,82 @@ fn the_measured_lobe_is_reciprocal() {
         }
     }
 }
+
+/// `kiln compensation --lobe`: at `alpha = 1` the compensations' lobes are closed forms
+/// (Kulla-Conty's `(1 - E(mu_i)) (1 - E(mu_o)) / (pi (1 - E_avg))`, Turquin's `f_ss (1 - E) / E`
+/// with `D = 1 / pi`), and the walk's lobe does not depend on the azimuth (`D` is constant, so
+/// every reflection is uniform on its cap): the fixed azimuths' estimates and the stratified
+/// average are different estimators of one number. The refusals name the range.
+#[cfg(feature = "cli")]
+#[test]
+fn the_lobe_audit_reports_the_closed_forms_and_refuses_by_name() {
+    let json = kiln_json(&[
+        "compensation",
+        "--lobe",
+        "--roughness",
+        "1",
+        "--mu",
+        "0.3,0.8",
+        "--exit",
+        "0.15,0.6",
+        "--azimuth",
+        "0,90,180",
+        "--walks",
+        "2^18",
+        "--compensation",
+        "kulla-conty,turquin",
+        "-q",
+    ]);
+    let e_avg = 4.0 / 3.0 * (1.0 - std::f64::consts::LN_2);
+    let points = json["points"].as_array().unwrap();
+    assert_eq!(points.len(), 2 * 2 * 4);
+    let mut averaged = std::collections::HashMap::new();
+    for p in points {
+        let (view, exit) = (p["view"].as_f64().unwrap(), p["exit"].as_f64().unwrap());
+        let walk = p["walk"]["value"].as_f64().unwrap();
+        let se = p["walk"]["std_error"].as_f64().unwrap();
+        let added: Vec<f64> = p["added"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
+        let (e_i, e_o) = (e_alpha_one(view), e_alpha_one(exit));
+        let kulla_conty = (1.0 - e_i) * (1.0 - e_o) / (PI * (1.0 - e_avg));
+        let lambda = |c: f64| (1.0 / c - 1.0) / 2.0;
+        let turquin = 1.0 / PI / (4.0 * view * exit * (1.0 + lambda(view) + lambda(exit)))
+            * (1.0 - e_i)
+            / e_i;
+        assert!((added[0] - kulla_conty).abs() < 1e-9 * kulla_conty, "{p}");
+        assert!((added[1] - turquin).abs() < 1e-9 * turquin, "{p}");
+        assert!(se > 0.0 && se < 2e-3 * walk, "{p}");
+        match p["azimuth"].as_f64() {
+            None => {
+                averaged.insert((view.to_bits(), exit.to_bits()), (walk, se));
+            }
+            Some(_) => {
+                let (mean, mean_se) = averaged[&(view.to_bits(), exit.to_bits())];
+                let allowed = 4.0 * (se * se + mean_se * mean_se).sqrt();
+                assert!((walk - mean).abs() <= allowed, "{p} vs averaged {mean}");
+            }
+        }
+    }
+    for (args, says) in [
+        (&["--exit", "0"][..], "(0, 1]"),
+        (&["--azimuth", "200"][..], "[0, 180]"),
+        (&["--roughness", "0"][..], "delta"),
+        (
+            &["--mu", "0.1,0.2,0.3,0.4,0.5", "--plot", "lobe.png"][..],
+            "at most 12",
+        ),
+    ] {
+        let output = std::process::Command::new(env!("CARGO_BIN_EXE_kiln"))
+            .args(["compensation", "--lobe", "--walks", "2^10", "-q"])
+            .args(args)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(stderr.contains(says), "{args:?}: {stderr}");
+    }
+}

@@ -29,10 +29,10 @@ pub enum Compensation {
     /// `1 + F0 (1 / E(mu) - 1)`, `F0` the reflectance at normal incidence; its albedo is
     /// `E_F(mu) (1 + F0 (1 - E) / E)`.
     Turquin,
-    /// kiln's (issue 60, in progress): the reciprocal lobe `M(mu_o) M(mu_i) / (pi M_avg)` per
-    /// channel, `M(mu, F0)` the walk's albedo less single scattering's, held as four
-    /// coefficients in `F0` (`KilnCompensation`); its albedo is `E_F(mu) + M(mu, F0)`.
-    /// Schlick's Fresnel with `F90 = 1` only, at points (no table yet).
+    /// kiln's: the reciprocal lobe `M(mu_o) M(mu_i) / (pi M_avg)` per channel, `M(mu, F0)`
+    /// the walk's albedo less single scattering's, held as four coefficients in `F0`
+    /// (`KilnCompensation`, tabulated by `table::compensation`); its albedo is
+    /// `E_F(mu) + M(mu, F0)`. Schlick's Fresnel with `F90 = 1` only.
     Kiln,
 }
 
@@ -73,6 +73,34 @@ impl Compensation {
                 Some(kiln) => s.e_f[j] + kiln.multiple(s.f0[j]),
                 None => f64::NAN,
             }),
+        }
+    }
+}
+
+impl Compensation {
+    /// The lobe this compensation adds to the single-scattering BRDF at `F = 1` (the white
+    /// furnace), from the view `i` to the exit `o`: what the walk's orders after the first are
+    /// ([`crate::integrate::walk::walk_lobe`]). `e_view`, `e_exit` are `E` at their cosines,
+    /// `single` the single-scattering BRDF `f_ss(i, o)` (or its average over the azimuth, for
+    /// the averaged lobe).
+    ///
+    /// Kulla-Conty: `(1 - E(mu_i)) (1 - E(mu_o)) / (pi (1 - E_avg))` (its colour term is 1 at
+    /// `F = 1`). Turquin: `f_ss (1 - E(mu_i)) / E(mu_i)`, the single-scattering lobe scaled by
+    /// the view's lost energy. kiln's: `M(mu_i) M(mu_o) / (pi M_avg)` with `M(mu, 1) = 1 - E`
+    /// pinned, so at `F = 1` it is Kulla-Conty's lobe exactly.
+    #[must_use]
+    pub fn added_lobe_white(self, e_view: f64, e_exit: f64, e_avg: f64, single: f64) -> f64 {
+        match self {
+            Compensation::KullaConty | Compensation::Kiln => {
+                (1.0 - e_view) * (1.0 - e_exit) / (std::f64::consts::PI * (1.0 - e_avg))
+            }
+            Compensation::Turquin => {
+                if e_view > 0.0 {
+                    single * (1.0 - e_view) / e_view
+                } else {
+                    0.0
+                }
+            }
         }
     }
 }

@@ -203,3 +203,297 @@ fn summarise(
         rms,
     }
 }
+
+/// Where to measure the lobes ([`audit_lobes`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct LobeAuditGrid {
+    /// Slope-space roughness values (`alpha`, above 0).
+    pub alphas: Vec<f64>,
+    /// View cosines (above 0).
+    pub views: Vec<f64>,
+    /// Exit cosines (above 0).
+    pub exits: Vec<f64>,
+    /// Exit azimuths in `[0, pi]` from the view's plane (0: the view's side; `pi`: the mirror
+    /// direction's side), for the lobe in full.
+    pub azimuths: Vec<f64>,
+}
+
+/// Azimuths a walk averages the lobe over (stratified): see [`crate::integrate::walk::lobe`].
+pub const LOBE_STRATA: u32 = 8;
+
+/// Nodes of the azimuthal average of the single-scattering BRDF (Turquin's lobe).
+const AZIMUTH_NODES: usize = 4096;
+
+/// One point of the lobe audit: the multiple-scattering lobe (`F = 1`) at a view and an exit,
+/// in full (at an azimuth) or averaged over the azimuth.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct LobePoint {
+    pub alpha: f64,
+    pub view: f64,
+    pub exit: f64,
+    /// The exit's azimuth in radians, or `None` for the average over the azimuth.
+    pub azimuth: Option<f64>,
+    /// The walk's BRDF of the second and later orders.
+    pub walk: Measured,
+    /// Each compensation's added lobe, in the order asked for.
+    pub added: Vec<f64>,
+}
+
+impl LobePoint {
+    /// `added / walk - 1` for compensation `k`, and its 95 % confidence half-width.
+    #[must_use]
+    pub fn deviation(&self, k: usize) -> (f64, f64) {
+        let ratio = self.added[k] / self.walk.value;
+        (
+            ratio - 1.0,
+            1.96 * ratio * self.walk.std_error / self.walk.value,
+        )
+    }
+}
+
+/// The largest lobe deviation of one sign, where it is, and its confidence half-width.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct LobeExtreme {
+    pub deviation: f64,
+    pub confidence: f64,
+    pub alpha: f64,
+    pub view: f64,
+    pub exit: f64,
+    pub azimuth: Option<f64>,
+}
+
+/// Highest, lowest and RMS deviation over a set of lobe points.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct LobeFigures {
+    pub highest: LobeExtreme,
+    pub lowest: LobeExtreme,
+    pub rms: f64,
+    /// The widest confidence half-width among the points.
+    pub widest_confidence: f64,
+}
+
+/// One compensation's lobe figures at one roughness: averaged over the azimuth, and in full.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct LobeSummary {
+    pub compensation: Compensation,
+    pub alpha: f64,
+    pub averaged: LobeFigures,
+    pub full: Option<LobeFigures>,
+}
+
+/// The lobe audit: every point and a summary per compensation and roughness.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct LobeAudit {
+    pub points: Vec<LobePoint>,
+    pub summaries: Vec<LobeSummary>,
+    /// Walks per view.
+    pub walks: u64,
+}
+
+/// Measures the lobes `compensations` add at `F = 1` against the walk's multiple-scattering
+/// lobe over `grid` (GGX, height-correlated): next-event estimates at every exit direction
+/// from one set of walks per view ([`crate::integrate::walk::walk_lobe`]); the compensations
+/// from kiln's reference `E` and `E_avg` and the closed-form single-scattering BRDF
+/// ([`Compensation::added_lobe_white`]). `progress` hears the number of views done.
+pub fn audit_lobes(
+    model: Model,
+    grid: &LobeAuditGrid,
+    compensations: &[Compensation],
+    settings: &WalkSettings,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<LobeAudit, WalkError> {
+    use crate::integrate::reference::reference_albedo;
+    use crate::integrate::walk::lobe::{self, LobeGrid};
+    use crate::integrate::walk::walk_lobe;
+    use crate::model::ndf::Ggx;
+    use crate::model::vector::Vec3;
+    let reference = ReferenceSettings::default();
+    let walk_grid = LobeGrid {
+        mus: grid.exits.clone(),
+        azimuths: grid.azimuths.clone(),
+        strata: LOBE_STRATA,
+    };
+    let mut points = Vec::new();
+    let mut done = 0;
+    for &alpha in &grid.alphas {
+        let ndf = Ggx { alpha };
+        let e_avg = reference_average_albedo(model, alpha, &reference).value;
+        let e = |mu: f64| reference_albedo(model, alpha, mu, &reference).value;
+        let e_exits: Vec<f64> = grid.exits.iter().map(|&mu| e(mu)).collect();
+        for &view in &grid.views {
+            let walked = walk_lobe(model, alpha, view, &walk_grid, settings, &|_| {})?;
+            let e_view = e(view);
+            let i = Vec3::from_mu(view);
+            for (j, (&exit, &e_exit)) in grid.exits.iter().zip(&e_exits).enumerate() {
+                let added = |single: f64| {
+                    compensations
+                        .iter()
+                        .map(|c| c.added_lobe_white(e_view, e_exit, e_avg, single))
+                        .collect()
+                };
+                let averaged = lobe::single_scattering_averaged(&ndf, view, exit, AZIMUTH_NODES);
+                points.push(LobePoint {
+                    alpha,
+                    view,
+                    exit,
+                    azimuth: None,
+                    walk: walked.multiple_averaged[j],
+                    added: added(averaged),
+                });
+                let s = ((1.0 - exit) * (1.0 + exit)).max(0.0).sqrt();
+                for (k, &phi) in grid.azimuths.iter().enumerate() {
+                    let o = Vec3::new(s * phi.cos(), s * phi.sin(), exit);
+                    points.push(LobePoint {
+                        alpha,
+                        view,
+                        exit,
+                        azimuth: Some(phi),
+                        walk: walked.multiple[j * grid.azimuths.len() + k],
+                        added: added(lobe::single_scattering(&ndf, i, o)),
+                    });
+                }
+            }
+            done += 1;
+            progress(done);
+        }
+    }
+    let figures = |k: usize, alpha: f64, full: bool| {
+        let chosen: Vec<&LobePoint> = points
+            .iter()
+            .filter(|p| p.alpha == alpha && p.azimuth.is_some() == full)
+            .collect();
+        if chosen.is_empty() {
+            return None;
+        }
+        let all: Vec<LobeExtreme> = chosen
+            .iter()
+            .map(|p| {
+                let (deviation, confidence) = p.deviation(k);
+                LobeExtreme {
+                    deviation,
+                    confidence,
+                    alpha: p.alpha,
+                    view: p.view,
+                    exit: p.exit,
+                    azimuth: p.azimuth,
+                }
+            })
+            .collect();
+        let highest = *all
+            .iter()
+            .max_by(|a, b| a.deviation.total_cmp(&b.deviation))
+            .expect("not empty");
+        let lowest = *all
+            .iter()
+            .min_by(|a, b| a.deviation.total_cmp(&b.deviation))
+            .expect("not empty");
+        let rms =
+            (all.iter().map(|e| e.deviation * e.deviation).sum::<f64>() / all.len() as f64).sqrt();
+        let widest_confidence = all.iter().map(|e| e.confidence).fold(0.0, f64::max);
+        Some(LobeFigures {
+            highest,
+            lowest,
+            rms,
+            widest_confidence,
+        })
+    };
+    let summaries = compensations
+        .iter()
+        .enumerate()
+        .flat_map(|(k, &compensation)| {
+            grid.alphas
+                .iter()
+                .map(move |&alpha| (k, compensation, alpha))
+        })
+        .map(|(k, compensation, alpha)| LobeSummary {
+            compensation,
+            alpha,
+            averaged: figures(k, alpha, false).expect("every exit has its average"),
+            full: figures(k, alpha, true),
+        })
+        .collect();
+    Ok(LobeAudit {
+        points,
+        summaries,
+        walks: settings.walks,
+    })
+}
+
+/// The lobes in the plane of incidence from one view, for a picture ([`lobe_profile`]).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct LobeProfile {
+    pub alpha: f64,
+    pub view: f64,
+    /// Signed exit angles in degrees: negative on the view's side (azimuth 0), positive on the
+    /// mirror direction's side (azimuth 180).
+    pub angles: Vec<f64>,
+    /// The walk's lobe of the second and later orders at each angle.
+    pub walk: Vec<Measured>,
+    /// Each compensation's added lobe at each angle, in the order asked for.
+    pub added: Vec<Vec<f64>>,
+}
+
+/// Exit angles of a profile, in degrees from the normal.
+pub const PROFILE_ANGLES: [f64; 19] = [
+    1.0, 5.0, 10.0, 15.0, 20.0, 25.0, 30.0, 35.0, 40.0, 45.0, 50.0, 55.0, 60.0, 65.0, 70.0, 75.0,
+    80.0, 85.0, 89.0,
+];
+
+/// The lobes at `F = 1` in the plane of incidence from `view` at `alpha`, at
+/// [`PROFILE_ANGLES`] on both sides: the walk's (as [`audit_lobes`] measures it) and each
+/// compensation's.
+pub fn lobe_profile(
+    model: Model,
+    alpha: f64,
+    view: f64,
+    compensations: &[Compensation],
+    settings: &WalkSettings,
+) -> Result<LobeProfile, WalkError> {
+    use crate::integrate::reference::reference_albedo;
+    use crate::integrate::walk::lobe::{self, LobeGrid};
+    use crate::integrate::walk::walk_lobe;
+    use crate::model::ndf::Ggx;
+    use crate::model::vector::Vec3;
+    let reference = ReferenceSettings::default();
+    let exits: Vec<f64> = PROFILE_ANGLES
+        .iter()
+        .map(|a| a.to_radians().cos())
+        .collect();
+    let grid = LobeGrid {
+        mus: exits.clone(),
+        azimuths: vec![0.0, std::f64::consts::PI],
+        strata: 1,
+    };
+    let walked = walk_lobe(model, alpha, view, &grid, settings, &|_| {})?;
+    let ndf = Ggx { alpha };
+    let e_avg = reference_average_albedo(model, alpha, &reference).value;
+    let e_view = reference_albedo(model, alpha, view, &reference).value;
+    let i = Vec3::from_mu(view);
+    let mut rows: Vec<(f64, Measured, Vec<f64>)> = Vec::new();
+    for (j, (&angle, &exit)) in PROFILE_ANGLES.iter().zip(&exits).enumerate() {
+        let e_exit = reference_albedo(model, alpha, exit, &reference).value;
+        let s = ((1.0 - exit) * (1.0 + exit)).max(0.0).sqrt();
+        for (k, side) in [(0, -1.0), (1, 1.0)] {
+            let o = Vec3::new(-side * s, 0.0, exit);
+            let single = lobe::single_scattering(&ndf, i, o);
+            rows.push((
+                side * angle,
+                walked.multiple[2 * j + k],
+                compensations
+                    .iter()
+                    .map(|c| c.added_lobe_white(e_view, e_exit, e_avg, single))
+                    .collect(),
+            ));
+        }
+    }
+    rows.sort_by(|a, b| a.0.total_cmp(&b.0));
+    Ok(LobeProfile {
+        alpha,
+        view,
+        angles: rows.iter().map(|r| r.0).collect(),
+        walk: rows.iter().map(|r| r.1).collect(),
+        added: (0..compensations.len())
+            .map(|c| rows.iter().map(|r| r.2[c]).collect())
+            .collect(),
+    })
+}

@@ -23,11 +23,14 @@ use kiln::{Masking, Model, Ndf, RoughnessConvention};
     after_help = SEE_CONVENTIONS
 )]
 pub struct CompensationArgs {
-    /// The compensations to measure [default: all three].
+    /// The compensations to measure [default: all three; with --lobe kulla-conty and turquin,
+    /// since at F = 1 kiln's lobe is Kulla-Conty's].
     #[arg(long, value_enum, value_delimiter = ',')]
     compensation: Vec<Compensation>,
-    /// Perceptual roughness values r (alpha = r^2), comma-separated, in [0, 1].
-    #[arg(long, value_delimiter = ',', default_value = "0.25,0.5,0.75,1", value_parser = crate::args::parse_roughness, allow_negative_numbers = true)]
+    /// Perceptual roughness values r (alpha = r^2), comma-separated, in [0, 1] [default:
+    /// 0.25,0.5,0.75,1; with --lobe 0.5,0.75,1: below r = 0.5 the walk's lobe needs far more
+    /// walks for a useful confidence, docs/multiple-scattering.md].
+    #[arg(long, value_delimiter = ',', value_parser = crate::args::parse_roughness, allow_negative_numbers = true)]
     roughness: Vec<f64>,
     /// View cosines mu, comma-separated, in [0, 1].
     #[arg(long, value_delimiter = ',', default_value = "0.05,0.1,0.2,0.35,0.5,0.7,0.85,1", value_parser = crate::args::parse_mu, allow_negative_numbers = true)]
@@ -54,6 +57,23 @@ pub struct CompensationArgs {
     /// of fitting it at each view.
     #[arg(long, value_name = "FILE")]
     table: Option<std::path::PathBuf>,
+    /// Measure the lobes instead of the albedo: the lobe each compensation adds at F = 1 (the
+    /// white furnace, where kiln's is Kulla-Conty's) against the walk's lobe of the second and
+    /// later orders, by next-event estimation, from each view (--mu) to each exit (--exit),
+    /// averaged over the azimuth and at each --azimuth.
+    #[arg(long, conflicts_with_all = ["table", "f0", "f90", "bake"])]
+    lobe: bool,
+    /// With --lobe: exit cosines, comma-separated, in (0, 1] [default: the --mu values].
+    #[arg(long, value_delimiter = ',', requires = "lobe", value_parser = crate::args::parse_mu, allow_negative_numbers = true)]
+    exit: Vec<f64>,
+    /// With --lobe: exit azimuths in degrees from the view's plane, comma-separated, in
+    /// [0, 180] (0: back towards the light's side, 180: the mirror direction's side).
+    #[arg(long, value_delimiter = ',', requires = "lobe", default_value = "0,45,90,135,180", value_parser = crate::args::parse_number, allow_negative_numbers = true)]
+    azimuth: Vec<f64>,
+    /// With --lobe: also draw the lobes in the plane of incidence, one panel per roughness and
+    /// view (at most 12), into this SVG or PNG file.
+    #[arg(long, value_name = "FILE", requires = "lobe")]
+    plot: Option<std::path::PathBuf>,
     /// Base seed of the walks' scrambles.
     #[arg(long, default_value_t = 0)]
     seed: u64,
@@ -125,6 +145,9 @@ pub fn run(args: CompensationArgs) -> kiln::Result<()> {
     if let Some(out) = &args.bake {
         return bake(&args, out);
     }
+    if args.lobe {
+        return lobes(&args);
+    }
     let table = match &args.table {
         Some(path) => {
             let bytes = kiln::format::read_file(path)?;
@@ -140,9 +163,13 @@ pub fn run(args: CompensationArgs) -> kiln::Result<()> {
     } else {
         args.compensation.clone()
     };
+    let roughness = if args.roughness.is_empty() {
+        vec![0.25, 0.5, 0.75, 1.0]
+    } else {
+        args.roughness.clone()
+    };
     let grid = CompensationGrid {
-        alphas: args
-            .roughness
+        alphas: roughness
             .iter()
             .map(|&r| RoughnessConvention::Perceptual.to_alpha(r))
             .collect(),
@@ -240,4 +267,155 @@ fn print(audit: &CompensationAudit, grid: &CompensationGrid) {
             100.0 * summary.rms
         );
     }
+}
+
+/// `kiln compensation --lobe`.
+fn lobes(args: &CompensationArgs) -> kiln::Result<()> {
+    use kiln::verify::compensation::{LobeAuditGrid, LobeExtreme, audit_lobes};
+    // At F = 1 kiln's lobe is Kulla-Conty's (M(mu, 1) = 1 - E is pinned): measured only when
+    // asked for by name.
+    let compensations = if args.compensation.is_empty() {
+        vec![Compensation::KullaConty, Compensation::Turquin]
+    } else {
+        args.compensation.clone()
+    };
+    let roughness = if args.roughness.is_empty() {
+        vec![0.5, 0.75, 1.0]
+    } else {
+        args.roughness.clone()
+    };
+    let grid = LobeAuditGrid {
+        alphas: roughness
+            .iter()
+            .map(|&r| RoughnessConvention::Perceptual.to_alpha(r))
+            .collect(),
+        views: args.mu.clone(),
+        exits: if args.exit.is_empty() {
+            args.mu.clone()
+        } else {
+            args.exit.clone()
+        },
+        azimuths: args.azimuth.iter().map(|d| d.to_radians()).collect(),
+    };
+    let settings = WalkSettings {
+        walks: args.walks.unwrap_or(1 << 20),
+        seed: args.seed,
+        ..WalkSettings::default()
+    };
+    settings.validate()?;
+    let model = Model {
+        ndf: Ndf::Ggx,
+        masking: Masking::HeightCorrelated,
+    };
+    let svg = crate::verify::plot_kind_of(args.plot.as_deref())?;
+    let panels = grid.alphas.len() * grid.views.len();
+    if svg.is_some() && panels > 12 {
+        return Err(kiln::Error::InvalidInput(format!(
+            "--plot draws one panel per roughness and view, at most 12: {} roughness x {} views \
+             is {panels}; give fewer --roughness or --mu values",
+            grid.alphas.len(),
+            grid.views.len()
+        )));
+    }
+    let views = (grid.alphas.len() * grid.views.len()) as u64 * if svg.is_some() { 2 } else { 1 };
+    if !args.quiet {
+        // Measured 2026-12-07 on two cores: 2^20 walks from a view, evaluated at 8 exits x
+        // (5 azimuths + 8 strata), take about 1.5 s.
+        let directions = grid.exits.len() * (grid.azimuths.len() + 8);
+        let seconds =
+            views as f64 * (0.3 + 1.2 * directions as f64 / 104.0) * settings.walks as f64
+                / f64::from(1 << 20);
+        if seconds > 5.0 {
+            eprintln!(
+                "kiln: {views} views of {} walks, about {} (fewer with --walks)",
+                settings.walks,
+                crate::human_seconds(seconds)
+            );
+        }
+    }
+    let bar = crate::progress_bar(args.quiet, views, "walking");
+    let audit = audit_lobes(model, &grid, &compensations, &settings, &|done| {
+        bar.set_position(done)
+    })?;
+    if let (Some(path), Some(svg)) = (&args.plot, svg) {
+        let mut profiles = Vec::new();
+        for &alpha in &grid.alphas {
+            for &view in &grid.views {
+                profiles.push(kiln::verify::compensation::lobe_profile(
+                    model,
+                    alpha,
+                    view,
+                    &compensations,
+                    &settings,
+                )?);
+                bar.inc(1);
+            }
+        }
+        let names: Vec<&str> = compensations.iter().map(|c| c.name()).collect();
+        let title = format!(
+            "The lobe added at F = 1 against the microsurface walk's (GGX, {} walks a view)",
+            settings.walks
+        );
+        crate::verify::write_plot(path, svg, crate::plot::lobe_plot(&title, &profiles, &names))?;
+    }
+    bar.finish_and_clear();
+    if args.json {
+        println!(
+            "{}",
+            serde_json::to_string(&audit).expect("the audit serialises")
+        );
+        return Ok(());
+    }
+    println!(
+        "the lobe added at F = 1 against the walk's orders 2 and later (ggx height-correlated), \
+         {} walks a view: {} roughness x {} views x {} exits, averaged over the azimuth and at \
+         {} azimuths",
+        audit.walks,
+        grid.alphas.len(),
+        grid.views.len(),
+        grid.exits.len(),
+        grid.azimuths.len()
+    );
+    let at = |e: &LobeExtreme| {
+        format!(
+            "{:+.1}% +- {:.1}% (view {}, exit {}{})",
+            100.0 * e.deviation,
+            100.0 * e.confidence,
+            e.view,
+            e.exit,
+            e.azimuth
+                .map(|p| format!(", {} deg", kiln::error::brief(p.to_degrees())))
+                .unwrap_or_default()
+        )
+    };
+    let mut last = None;
+    for summary in &audit.summaries {
+        if last != Some(summary.compensation) {
+            last = Some(summary.compensation);
+            let same = if summary.compensation == Compensation::Kiln {
+                " (at F = 1 kiln's lobe is Kulla-Conty's)"
+            } else {
+                ""
+            };
+            println!("  {}{same}", summary.compensation.name());
+        }
+        let mut rows = vec![("averaged", &summary.averaged)];
+        if let Some(full) = &summary.full {
+            rows.push(("in full", full));
+        }
+        for (what, f) in rows {
+            println!(
+                "    r = {:<5} {what:<9} {} to {}, rms {:.1}%, confidence up to +- {:.1}%",
+                kiln::error::brief(RoughnessConvention::Perceptual.from_alpha(summary.alpha)),
+                at(&f.lowest),
+                at(&f.highest),
+                100.0 * f.rms,
+                100.0 * f.widest_confidence
+            );
+        }
+    }
+    if !compensations.contains(&Compensation::Kiln) {
+        println!("  kiln: at F = 1 its lobe is Kulla-Conty's (M(mu, 1) = 1 - E is pinned)");
+    }
+    Ok(())
 }

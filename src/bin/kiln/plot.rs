@@ -655,3 +655,130 @@ where
     root.present()?;
     Ok(())
 }
+
+/// `kiln compensation --lobe --plot`: the multiple-scattering lobe in the plane of incidence,
+/// one panel per roughness and view: the walk's (dots, with 95 % bars) against each
+/// compensation's added lobe (lines; a line past the panel's top is clipped there).
+pub fn lobe_plot(
+    title: &str,
+    profiles: &[kiln::verify::compensation::LobeProfile],
+    names: &[&str],
+) -> Result<(String, Vec<u8>), String> {
+    register_font();
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
+        lobe_panels(&root, title, profiles, names).map_err(|e| e.to_string())?;
+    }
+    let mut pixels = vec![255u8; (SIZE.0 * SIZE.1 * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut pixels, SIZE).into_drawing_area();
+        lobe_panels(&root, title, profiles, names).map_err(|e| e.to_string())?;
+    }
+    Ok((svg, png_of(&pixels)?))
+}
+
+fn lobe_panels<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    title: &str,
+    profiles: &[kiln::verify::compensation::LobeProfile],
+    names: &[&str],
+) -> Result<(), Box<dyn std::error::Error>>
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE)?;
+    let root = root.titled(title, ("sans-serif", 20))?;
+    let columns = profiles.len().clamp(1, 3);
+    let rows = profiles.len().div_ceil(columns).max(1);
+    let panels = root.split_evenly((rows, columns));
+    for (n, (panel, profile)) in panels.iter().zip(profiles).enumerate() {
+        // The top: the walk's bars and the reciprocal lobes; Turquin's spike may be clipped.
+        let top = profile
+            .walk
+            .iter()
+            .map(|m| m.value + 1.96 * m.std_error)
+            .chain(
+                profile
+                    .added
+                    .iter()
+                    .zip(names)
+                    .filter(|(_, name)| **name != "turquin")
+                    .flat_map(|(a, _)| a.iter().copied()),
+            )
+            .fold(0.0_f64, f64::max)
+            * 1.25;
+        let top = if top > 0.0 { top } else { 1.0 };
+        let mut chart = ChartBuilder::on(panel)
+            .caption(
+                format!(
+                    "r = {}, view {:.0} deg",
+                    kiln::error::brief(
+                        kiln::RoughnessConvention::Perceptual.from_alpha(profile.alpha)
+                    ),
+                    profile.view.acos().to_degrees()
+                ),
+                ("sans-serif", 15),
+            )
+            .margin(10)
+            .x_label_area_size(36)
+            .y_label_area_size(52)
+            .build_cartesian_2d(-90.0..90.0, 0.0..top)?;
+        chart
+            .configure_mesh()
+            .light_line_style(WHITE.mix(0.0))
+            .x_desc("exit angle (deg; < 0: view's side, > 0: mirror side)")
+            .y_desc("BRDF, orders 2+, F = 1")
+            .label_style(("sans-serif", 12))
+            .axis_desc_style(("sans-serif", 12))
+            .y_label_formatter(&|y| format!("{y:.2}"))
+            .draw()?;
+        for (k, (added, name)) in profile.added.iter().zip(names).enumerate() {
+            let colour = COLOURS[(k + 1) % COLOURS.len()];
+            let points: Vec<(f64, f64)> = profile
+                .angles
+                .iter()
+                .zip(added)
+                .map(|(&x, &y)| (x, y.min(top)))
+                .collect();
+            let drawn = chart.draw_series(LineSeries::new(points, colour.stroke_width(2)))?;
+            if n == 0 {
+                drawn.label(*name).legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(3))
+                });
+            }
+        }
+        let black = BLACK;
+        let bars = chart.draw_series(profile.angles.iter().zip(&profile.walk).map(|(&x, m)| {
+            PathElement::new(
+                vec![
+                    (x, (m.value - 1.96 * m.std_error).max(0.0)),
+                    (x, (m.value + 1.96 * m.std_error).min(top)),
+                ],
+                black.stroke_width(1),
+            )
+        }))?;
+        if n == 0 {
+            bars.label("walk (95 %)")
+                .legend(move |(x, y)| Circle::new((x + 10, y), 3, black.filled()));
+        }
+        chart.draw_series(
+            profile
+                .angles
+                .iter()
+                .zip(&profile.walk)
+                .map(|(&x, m)| Circle::new((x, m.value), 3, black.filled())),
+        )?;
+        if n == 0 {
+            chart
+                .configure_series_labels()
+                .label_font(("sans-serif", 12))
+                .background_style(WHITE.mix(0.9))
+                .border_style(BLACK)
+                .position(SeriesLabelPosition::UpperLeft)
+                .draw()?;
+        }
+    }
+    root.present()?;
+    Ok(())
+}

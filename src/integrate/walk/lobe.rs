@@ -160,3 +160,33 @@ impl LobeTargets {
         }
     }
 }
+
+/// The height-correlated Smith BRDF `D(h) / (4 mu_i mu_o (1 + Lambda(i) + Lambda(o)))` from `i`
+/// to `o` (both above the surface; Heitz 2014, eq. 99), the walk's first order in closed form.
+#[must_use]
+pub fn single_scattering<N: MicrofacetDistribution>(ndf: &N, i: Vec3, o: Vec3) -> f64 {
+    let (x, y, z) = (i.x + o.x, i.y + o.y, i.z + o.z);
+    let d = ndf.d_from_tan2((x * x + y * y) / (z * z));
+    d / (4.0 * i.z * o.z * (1.0 + ndf.lambda(i) + ndf.lambda(o)))
+}
+
+/// [`single_scattering`] averaged over the exit's azimuth (midpoint rule on `[0, pi]` with
+/// `nodes` nodes: the lobe is even and periodic in the azimuth, so the rule converges
+/// geometrically once it resolves the specular peak, about `alpha` wide).
+#[must_use]
+pub fn single_scattering_averaged<N: MicrofacetDistribution>(
+    ndf: &N,
+    mu_i: f64,
+    mu_o: f64,
+    nodes: usize,
+) -> f64 {
+    let i = Vec3::from_mu(mu_i);
+    let s = ((1.0 - mu_o) * (1.0 + mu_o)).max(0.0).sqrt();
+    (0..nodes)
+        .map(|k| {
+            let phi = PI * (k as f64 + 0.5) / nodes as f64;
+            single_scattering(ndf, i, Vec3::new(s * phi.cos(), s * phi.sin(), mu_o))
+        })
+        .sum::<f64>()
+        / nodes as f64
+}
