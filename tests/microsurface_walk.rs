@@ -866,3 +866,35 @@ fn the_lobe_audit_reports_the_closed_forms_and_refuses_by_name() {
         assert!(stderr.contains(says), "{args:?}: {stderr}");
     }
 }
+
+/// The benchmark's other estimators measure the same walk: the analog walk (escapes drawn) with
+/// pseudorandom numbers agrees with kiln's (expected escapes, Sobol) order by order and on the
+/// coloured albedo, within their combined errors, so that `examples/walk_estimators.rs`
+/// compares costs of one quantity.
+#[test]
+fn the_analog_walk_measures_the_same_orders() {
+    use kiln::integrate::walk::{Escape, Numbers};
+    let run = |escape, numbers| {
+        let settings = WalkSettings {
+            walks: 1 << 18,
+            escape,
+            numbers,
+            ..WalkSettings::default()
+        };
+        walk_albedo(GGX, 0.5, 0.4, &schlick(0.5, 1.0), 3, &settings, &|_| {}).unwrap()
+    };
+    let kilns = run(Escape::Expected, Numbers::Sobol);
+    let analog = run(Escape::Sampled, Numbers::Pseudorandom);
+    let pairs = kilns
+        .orders
+        .iter()
+        .zip(&analog.orders)
+        .chain([(&kilns.albedo[0], &analog.albedo[0])]);
+    for (a, b) in pairs {
+        let allowed = 4.0 * (a.std_error.powi(2) + b.std_error.powi(2)).sqrt();
+        assert!(
+            (a.value - b.value).abs() <= allowed && b.std_error > 3.0 * a.std_error,
+            "kiln's {a:?}, analog {b:?}"
+        );
+    }
+}

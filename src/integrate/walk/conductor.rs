@@ -112,6 +112,8 @@ pub struct Asked<'a> {
     pub schlick_f90: Option<f64>,
     /// Exit directions at which to estimate the lobe ([`super::lobe`]).
     pub lobe: Option<&'a LobeTargets>,
+    /// Escapes tallied as their expectation or drawn.
+    pub escape: super::Escape,
 }
 
 /// Walks once from the incident direction `wi` (unit, `wi.z > 0`) and adds what leaves to
@@ -194,11 +196,18 @@ pub fn walk<N: MicrofacetDistribution>(
             let lambda = ndf.lambda(w);
             // At the very top (a grazing entry that met the surface at once) every upward
             // direction leaves; `inf * 0` would say otherwise.
-            let escape = if log_c1 == 0.0 || mirror {
+            let mut escape = if log_c1 == 0.0 || mirror {
                 1.0
             } else {
                 (lambda * log_c1).exp()
             };
+            // The analog walk: leave with everything, or stay with everything.
+            let stays = asked.escape == super::Escape::Sampled
+                && escape < 1.0
+                && random.uniform() >= escape;
+            if asked.escape == super::Escape::Sampled {
+                escape = if stays { 0.0 } else { 1.0 };
+            }
             if vertex <= tallied {
                 tallies.orders[vertex as usize - 1] += plain * escape;
             } else {
@@ -222,9 +231,15 @@ pub fn walk<N: MicrofacetDistribution>(
             for c in &mut coefficients[..=degree] {
                 *c *= 1.0 - escape;
             }
-            // A hit below h given no escape: C1(h') = C1(h) / (1 - u (1 - P))^(1 / Lambda).
+            // A hit below h given no escape: C1(h') = C1(h) / (1 - u (1 - P))^(1 / Lambda),
+            // with P the escape's probability (also when the escape was drawn).
+            let p = if stays {
+                (lambda * log_c1).exp()
+            } else {
+                escape
+            };
             let u = random.uniform();
-            h = heights.height(log_c1 - (-u * (1.0 - escape)).ln_1p() / lambda);
+            h = heights.height(log_c1 - (-u * (1.0 - p)).ln_1p() / lambda);
         } else {
             h = heights.height(log_c1 + random.uniform().ln() / (1.0 + ndf.lambda(w)));
         }

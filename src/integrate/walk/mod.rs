@@ -47,6 +47,36 @@ pub struct WalkSettings {
     pub seed: u64,
     /// The microsurface's height distribution (the walk's result does not depend on it).
     pub heights: Heights,
+    /// The walk's numbers: scrambled Sobol for the first vertices, or pseudorandom throughout
+    /// (the benchmark's comparison).
+    pub numbers: Numbers,
+    /// How an escape is tallied: its expectation at every vertex, or sampled (the benchmark's
+    /// comparison).
+    pub escape: Escape,
+}
+
+/// Where a walk's numbers come from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Numbers {
+    /// An Owen-scrambled Sobol point for the first two vertices (a depth and a normal each),
+    /// then a counter-seeded generator ([`random::WalkRandom`]).
+    #[default]
+    Sobol,
+    /// The counter-seeded generator for every number.
+    Pseudorandom,
+}
+
+/// How a walk tallies the light that leaves.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Escape {
+    /// At every upward vertex the escape probability times the throughput is tallied and the
+    /// walk goes on with the rest (the expected-value estimator: every order smooth in the
+    /// walk's numbers).
+    #[default]
+    Expected,
+    /// The escape is drawn: the walk leaves with all it carries, or goes on with all of it
+    /// (the analog walk of Heitz et al. 2016).
+    Sampled,
 }
 
 impl WalkSettings {
@@ -81,6 +111,8 @@ impl Default for WalkSettings {
             scrambles: Self::DEFAULT_SCRAMBLES,
             seed: 0,
             heights: Heights::default(),
+            numbers: Numbers::default(),
+            escape: Escape::default(),
         }
     }
 }
@@ -468,6 +500,7 @@ fn run(
         fresnel,
         schlick_f90,
         lobe: targets.as_ref(),
+        escape: settings.escape,
     };
     let per_scramble = settings.walks / u64::from(settings.scrambles);
     let chunks = per_scramble.div_ceil(u64::from(CHUNK));
@@ -489,7 +522,8 @@ fn run(
                 if capped.load(std::sync::atomic::Ordering::Relaxed) {
                     break;
                 }
-                let mut random = random::WalkRandom::new(&sobol, seed, index as u32);
+                let sobol = (settings.numbers == Numbers::Sobol).then_some(&sobol);
+                let mut random = random::WalkRandom::new(sobol, seed, index as u32);
                 if conductor::walk(
                     &ndf,
                     wi,

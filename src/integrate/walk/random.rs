@@ -6,7 +6,7 @@ use crate::integrate::sobol::{DIMENSIONS, OwenSobol, mix_seed};
 
 /// The numbers one walk draws, in order.
 pub struct WalkRandom<'a> {
-    sobol: &'a OwenSobol,
+    sobol: Option<&'a OwenSobol>,
     index: u32,
     dim: usize,
     state: u64,
@@ -14,9 +14,10 @@ pub struct WalkRandom<'a> {
 }
 
 impl<'a> WalkRandom<'a> {
-    /// Walk `index` of the scramble `sobol` (whose seed also keys the generator's stream).
+    /// Walk `index` of the scramble `sobol` (whose seed also keys the generator's stream); with
+    /// `None`, every number from the generator.
     #[must_use]
-    pub fn new(sobol: &'a OwenSobol, stream_seed: u64, index: u32) -> Self {
+    pub fn new(sobol: Option<&'a OwenSobol>, stream_seed: u64, index: u32) -> Self {
         let key = mix_seed(&[stream_seed, u64::from(index)]);
         Self {
             sobol,
@@ -39,8 +40,10 @@ impl<'a> WalkRandom<'a> {
     /// vertices: a depth and a normal each), then SplitMix64 (Steele, Lea and Flood 2014).
     #[inline]
     pub fn uniform(&mut self) -> f64 {
-        if self.dim < DIMENSIONS {
-            let u = self.sobol.sample(self.index, self.dim);
+        if let Some(sobol) = self.sobol
+            && self.dim < DIMENSIONS
+        {
+            let u = sobol.sample(self.index, self.dim);
             self.dim += 1;
             return u;
         }

@@ -36,7 +36,7 @@ pub fn multiple_scattering(args: &EvalArgs, view: View, order: Option<u64>) -> k
         walks: args.walks.unwrap_or(WalkSettings::DEFAULT_WALKS),
         scrambles: args.scrambles.unwrap_or(WalkSettings::DEFAULT_SCRAMBLES),
         seed: args.seed,
-        heights: Default::default(),
+        ..WalkSettings::default()
     };
     settings.validate()?;
     let orders = match order {
