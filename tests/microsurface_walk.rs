@@ -614,6 +614,31 @@ fn the_compensation_table_bakes_reads_back_and_is_audited() {
     let table = kiln::format::compensation::decode(&bytes, "baked").unwrap();
     assert_eq!(table.spec.shape(), vec![6, 6]);
     assert_eq!(table.walks, 1 << 12);
+    // The textures beside it hold the same coefficients, R to A, x = mu (6 wide, 6 high).
+    for (extension, decode) in [
+        (
+            "ktx2",
+            kiln::format::ktx2::decode
+                as fn(&[u8]) -> Result<kiln::format::texture::DecodedTexture, String>,
+        ),
+        ("dds", kiln::format::dds::decode),
+    ] {
+        let path = out.join(format!(
+            "ggx-height-correlated-kiln-compensation.{extension}"
+        ));
+        let texture = decode(&std::fs::read(&path).unwrap()).unwrap();
+        assert_eq!(texture.extent.0, 6, "{extension}");
+        assert_eq!(texture.channels.len(), 4, "{extension}");
+        for (j, channel) in texture.channels.iter().enumerate() {
+            for (k, &v) in channel.iter().enumerate() {
+                assert_eq!(
+                    v,
+                    f64::from(table.coefficients[j][k] as f32),
+                    "{extension} c_{j}[{k}]"
+                );
+            }
+        }
+    }
     let audit = run(&[
         "compensation",
         "--table",

@@ -57,13 +57,25 @@ inline int min(int a, int b) { return a < b ? a : b; }
 inline float max(float a, float b) { return a > b ? a : b; }
 inline V3 max(V3 a, V3 b) { return V3(max(a.x, b.x), max(a.y, b.y), max(a.z, b.z)); }
 inline float clamp(float x, float a, float b) { return min(max(x, a), b); }
-struct Sample2 { V2 rg; };
+struct V4 {
+    float x, y, z, w;
+    V4(float x, float y, float z, float w) : x(x), y(y), z(z), w(w) {}
+};
+inline V4 operator/(V4 a, float s) { return V4(a.x / s, a.y / s, a.z / s, a.w / s); }
+inline float dot(V4 a, V4 b) { return a.x * b.x + a.y * b.y + a.z * b.z + a.w * b.w; }
+// A sample: .rg as the tables' lookups read it, or the whole RGBA (kiln's compensation).
+struct Sample2 {
+    V2 rg;
+    V4 rgba;
+    operator V4() const { return rgba; }
+};
 struct Sampler {};
-// A 2-D texture of (R, G) texels, row 0 at v = 0: bilinear between texel centres
-// ((i + 0.5) / W), clamp to edge, as a GPU's linear filter samples level 0.
+// A 2-D texture of (R, G) or (R, G, B, A) texels, row 0 at v = 0: bilinear between texel
+// centres ((i + 0.5) / W), clamp to edge, as a GPU's linear filter samples level 0.
 struct Tex {
     int width, height;
-    std::vector<float> texels; // R, G interleaved, row-major
+    std::vector<float> texels; // channels interleaved, row-major
+    int channels = 2;
     Sample2 SampleLevel(Sampler, V2 uv, int) const {
         float x = uv.x * width - 0.5f, y = uv.y * height - 0.5f;
         float fx0 = floor(x), fy0 = floor(y);
@@ -71,16 +83,16 @@ struct Tex {
         auto at = [&](int i, int j, int c) {
             i = i < 0 ? 0 : (i >= width ? width - 1 : i);
             j = j < 0 ? 0 : (j >= height ? height - 1 : j);
-            return texels[2 * (j * width + i) + c];
+            return texels[channels * (j * width + i) + c];
         };
         int i0 = (int)fx0, j0 = (int)fy0;
-        float c[2];
-        for (int k = 0; k < 2; ++k) {
+        float c[4] = {0, 0, 0, 0};
+        for (int k = 0; k < channels; ++k) {
             float top = at(i0, j0, k) * (1 - fx) + at(i0 + 1, j0, k) * fx;
             float bottom = at(i0, j0 + 1, k) * (1 - fx) + at(i0 + 1, j0 + 1, k) * fx;
             c[k] = top * (1 - fy) + bottom * fy;
         }
-        return Sample2{V2(c[0], c[1])};
+        return Sample2{V2(c[0], c[1]), V4(c[0], c[1], c[2], c[3])};
     }
 };
 ";
@@ -108,6 +120,7 @@ impl Language {
                 r"
 using float2 = V2;
 using float3 = V3;
+using float4 = V4;
 using SamplerState = Sampler;
 template <typename T> using Texture2D = Tex;
 "
@@ -116,6 +129,7 @@ template <typename T> using Texture2D = Tex;
                 r"
 using vec2 = V2;
 using vec3 = V3;
+using vec4 = V4;
 using sampler2D = Tex;
 inline Sample2 textureLod(const Tex& t, V2 uv, float lod) { return t.SampleLevel(Sampler{}, uv, (int)lod); }
 "
@@ -124,6 +138,7 @@ inline Sample2 textureLod(const Tex& t, V2 uv, float lod) { return t.SampleLevel
                 r"
 using vec2 = V2;
 using vec3 = V3;
+using vec4 = V4;
 using texture_2d = Tex;
 using sampler = Sampler;
 inline Sample2 textureSampleLevel(const Tex& t, Sampler s, V2 uv, float lod) { return t.SampleLevel(s, uv, (int)lod); }
@@ -175,6 +190,7 @@ fn wgsl_as_cpp(source: &str) -> String {
     let types = |text: &str| {
         text.replace("vec2<f32>", "vec2")
             .replace("vec3<f32>", "vec3")
+            .replace("vec4<f32>", "vec4")
             .replace("texture_2d<f32>", "texture_2d")
             .replace("f32", "float")
             .replace("i32", "int")
@@ -341,6 +357,111 @@ fn generated_shaders_run_and_agree_with_the_library() {
                         "{set} at {point:?}: {language:?} {got:e}, library {want:e}"
                     );
                 }
+            }
+        }
+        assert!(values.next().is_none());
+    }
+}
+
+/// kiln's compensation (issue 60) as a renderer reads it: the generated lookup of the RGBA
+/// coefficient texture, `M_avg`'s arrays, the basis in `F0`, the albedo and the lobe, run as
+/// C++ in f32 against the library's f64 (`CompensationTable::lookup`, `lookup_average`,
+/// `KilnCompensation::multiple`). A missing half-texel remap, channels in the wrong order, a
+/// wrong pole or an average read at the wrong roughness fails here, in each language.
+#[test]
+fn generated_compensation_shaders_run_and_agree_with_the_library() {
+    if std::env::var_os("CXX").is_none()
+        && cxx::compiler_or_skip("generated_compensation_shaders_run_and_agree_with_the_library")
+            .is_none()
+    {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("tables");
+    let baked = Command::new(env!("CARGO_BIN_EXE_kiln"))
+        .args(["compensation", "--bake"])
+        .arg(&out)
+        .args(["--size", "8", "--walks", "2^10", "-q"])
+        .output()
+        .unwrap();
+    assert!(
+        baked.status.success(),
+        "{}",
+        String::from_utf8_lossy(&baked.stderr)
+    );
+    let stem = "ggx-height-correlated-kiln-compensation";
+    let bytes = std::fs::read(out.join(format!("{stem}.json"))).unwrap();
+    let table = kiln::format::compensation::decode(&bytes, stem).unwrap();
+    let [rows, columns] = table.spec.shape()[..] else {
+        unreachable!()
+    };
+    let texels = floats((0..table.spec.len()).flat_map(|k| {
+        let c = &table.coefficients;
+        [c[0][k], c[1][k], c[2][k], c[3][k]]
+    }));
+    // (mu, r, F0, mu_i): inside cells, on texel rows, at the edges.
+    let mut points = Vec::new();
+    for &(mu, r) in &[
+        (0.0, 0.3),
+        (0.013, 0.27),
+        (0.2, 0.5),
+        (0.37, 0.81),
+        (0.5, 1.0),
+        (0.92, 0.64),
+        (1.0, 0.4),
+    ] {
+        for &f0 in &[0.02, 0.3, 0.955] {
+            points.extend([mu, r, f0, 0.61]);
+        }
+    }
+    let mut main = format!("const Tex K = {{{columns}, {rows}, {texels}, 4}};\n");
+    main += &point_array("POINTS", &points);
+    main += "int main() {\n";
+    let s = stem.replace('-', "_");
+    for language in [Language::Hlsl, Language::Glsl, Language::Wgsl] {
+        let mut program = main.clone();
+        let _ = writeln!(
+            program,
+            "    for (size_t k = 0; k < POINTS.size(); k += 4) {{\n\
+             float mu = POINTS[k], r = POINTS[k + 1], f = POINTS[k + 2], mu_i = POINTS[k + 3];\n\
+             V4 c = {s}_coefficients({tex}, mu, r);\n\
+             V4 ci = {s}_coefficients({tex}, mu_i, r);\n\
+             V4 a = {s}_average(r);\n\
+             V3 f0 = V3(f, 0.5 * f, 1.0);\n\
+             V3 m = {s}_albedo(c, f0);\n\
+             V3 m_avg = {s}_albedo(a, f0);\n\
+             V3 lobe = {s}_lobe(m, {s}_albedo(ci, f0), m_avg);\n\
+             printf(\"%.9g\\n%.9g\\n%.9g\\n%.9g\\n\", c.x, c.y, c.z, c.w);\n\
+             printf(\"%.9g\\n%.9g\\n%.9g\\n\", m.x, m.y, m.z);\n\
+             printf(\"%.9g\\n%.9g\\n%.9g\\n\", m_avg.x, lobe.x, lobe.z);\n\
+             }}\n    return 0;\n}}",
+            tex = language.texture_arguments("K")
+        );
+        let printed = run(&out, language, &[stem], &program);
+        let mut values = printed.into_iter();
+        let mut check = |want: f64, tolerance: f64, what: &str, point: &[f64]| {
+            let got = values.next().expect("as many numbers as asked for");
+            assert!(
+                (got - want).abs() <= tolerance * (1.0 + want.abs()),
+                "{what} at {point:?}: {language:?} {got:e}, library {want:e}"
+            );
+        };
+        for point in points.chunks(4) {
+            let (mu, r, f, mu_i) = (point[0], point[1], point[2], point[3]);
+            let c = table.lookup(mu, r);
+            for j in 0..4 {
+                check(c.coefficients[j], 2e-6, &format!("c_{j}"), point);
+            }
+            for f0 in [f, 0.5 * f, 1.0] {
+                check(c.multiple(f0), 2e-6, "M", point);
+            }
+            let average = table.lookup_average(r);
+            let ci = table.lookup(mu_i, r);
+            check(average.multiple(f), 2e-6, "M_avg", point);
+            for f0 in [f, 1.0] {
+                let lobe = c.multiple(f0) * ci.multiple(f0)
+                    / (std::f64::consts::PI * average.multiple(f0));
+                check(lobe, 1e-5, "lobe", point);
             }
         }
         assert!(values.next().is_none());

@@ -264,3 +264,79 @@ fn gpu_filtering_at_the_generated_coordinates_equals_the_table_lookup() {
         }
     }
 }
+
+/// kiln's compensation (issue 60) at 4 x 4 texels from a few walks: what the shader code is
+/// generated from (its numbers do not matter here).
+fn compensation_table() -> kiln::table::compensation::CompensationTable {
+    let options = BakeOptions {
+        quantities: vec![Quantity::E, Quantity::EAvg],
+        size: 4,
+        texels: Some(kiln::table::Texels::Nodes),
+        ..BakeOptions::default()
+    };
+    let mut specs = options.resolved().specs().into_iter();
+    let (spec, average) = (specs.next().unwrap(), specs.next().unwrap());
+    let settings = kiln::integrate::walk::WalkSettings {
+        walks: 1 << 6,
+        scrambles: 2,
+        ..Default::default()
+    };
+    kiln::table::compensation::CompensationTable::bake(
+        spec.model,
+        spec,
+        average,
+        &settings,
+        &|_| {},
+    )
+    .unwrap()
+}
+
+/// The compensation's WGSL and GLSL parse and validate with naga, called as a renderer calls
+/// them: the coefficients at both directions, `M_avg`, the albedo and the lobe.
+#[test]
+fn compensation_shaders_validate() {
+    use kiln::format::shader::encode_compensation;
+    let table = compensation_table();
+    let s = kiln::format::compensation::stem(&table);
+    let wgsl = format!(
+        "@group(0) @binding(0) var lut: texture_2d<f32>;\n\
+         @group(0) @binding(1) var linear_clamp: sampler;\n{}\n\
+         @fragment\nfn main() -> @location(0) vec4<f32> {{\n\
+         let f0 = vec3<f32>(0.9, 0.6, 0.5);\n\
+         let m_o = {s}_albedo({s}_coefficients(lut, linear_clamp, 0.5, 0.3), f0);\n\
+         let m_i = {s}_albedo({s}_coefficients(lut, linear_clamp, 0.8, 0.3), f0);\n\
+         let m_avg = {s}_albedo({s}_average(0.3), f0);\n\
+         return vec4<f32>({s}_lobe(m_o, m_i, m_avg), 1.0);\n}}\n",
+        encode_compensation(&table, Language::Wgsl, "kiln compensation --bake tables")
+    );
+    let module = naga::front::wgsl::parse_str(&wgsl)
+        .unwrap_or_else(|e| panic!("{}\n{wgsl}", e.emit_to_string(&wgsl)));
+    validate(&module, &wgsl, "the compensation's WGSL");
+    let glsl = format!(
+        "#version 450\n#define KILN_NO_COMBINED_SAMPLERS\nlayout(location = 0) out vec4 colour;\n\
+         layout(set = 0, binding = 0) uniform texture2D lut;\n\
+         layout(set = 0, binding = 1) uniform sampler linear_clamp;\n{}\n\
+         void main() {{\n\
+         vec3 f0 = vec3(0.9, 0.6, 0.5);\n\
+         vec3 m_o = {s}_albedo(textureLod(sampler2D(lut, linear_clamp), {s}_uv(0.5, 0.3), 0.0), f0);\n\
+         vec3 m_i = {s}_albedo(textureLod(sampler2D(lut, linear_clamp), {s}_uv(0.8, 0.3), 0.0), f0);\n\
+         vec3 m_avg = {s}_albedo({s}_average(0.3), f0);\n\
+         colour = vec4({s}_lobe(m_o, m_i, m_avg), 1.0);\n}}\n",
+        encode_compensation(&table, Language::Glsl, "kiln compensation --bake tables")
+    );
+    let mut frontend = naga::front::glsl::Frontend::default();
+    let module = frontend
+        .parse(
+            &naga::front::glsl::Options::from(naga::ShaderStage::Fragment),
+            &glsl,
+        )
+        .unwrap_or_else(|e| panic!("{e:?}\n{glsl}"));
+    validate(&module, &glsl, "the compensation's GLSL");
+    let hlsl = encode_compensation(&table, Language::Hlsl, "kiln compensation --bake tables");
+    assert!(hlsl.contains("Texture2D<float4> table"), "{hlsl}");
+    assert_eq!(
+        hlsl.matches('{').count(),
+        hlsl.matches('}').count(),
+        "{hlsl}"
+    );
+}

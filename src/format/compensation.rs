@@ -36,19 +36,55 @@ pub fn file_name(table: &CompensationTable) -> String {
     )
 }
 
+/// The name stem of `table`'s files and shader functions: `ggx_height_correlated_kiln_compensation`.
+#[must_use]
+pub fn stem(table: &CompensationTable) -> String {
+    format!(
+        "{}_{}_kiln_compensation",
+        table.spec.model.ndf.name(),
+        table.spec.model.masking.name()
+    )
+    .replace('-', "_")
+}
+
+/// `table`'s coefficients as an RGBA texture over its `E` layout (R = `c_0` .. A = `c_3`),
+/// for [`super::ktx2`] and [`super::dds`].
+#[must_use]
+pub fn texture(table: &CompensationTable) -> super::texture::Texture {
+    let metadata = serde_json::json!({
+        "kind": KIND,
+        "channels": ["c0", "c1", "c2", "c3"],
+        "basis": basis_text(),
+        "spec": table.spec,
+        "walks": table.walks,
+        "max_std_error": table.max_std_error(),
+    });
+    super::texture::Texture {
+        shape: table.spec.shape(),
+        channels: (0..4)
+            .map(|j| (format!("c{j}"), table.coefficients[j].clone()))
+            .collect(),
+        metadata: metadata.to_string(),
+    }
+}
+
+fn basis_text() -> String {
+    format!(
+        "M(mu, F0) = sum_j c_j(mu, r) B_j(F0) / (1 - {KILN_POLE} F0), B_j the cubic \
+         Bernstein polynomials (1 - F0)^3, 3 F0 (1 - F0)^2, 3 F0^2 (1 - F0), F0^3; c_j by \
+         the bilinear lookup of the coefficients at (mu, r) in the E layout of `spec`, \
+         M_avg's by the lookup of `average` at r in `average_spec`; the lobe M(mu_o) M(mu_i) \
+         / (pi M_avg) per channel"
+    )
+}
+
 /// `table` as its JSON document, with the `command` that made it.
 #[must_use]
 pub fn encode(table: &CompensationTable, command: &str) -> Vec<u8> {
     let document = Document {
         kind: KIND.to_string(),
         kiln_version: super::metadata::KILN_VERSION.to_string(),
-        basis: format!(
-            "M(mu, F0) = sum_j c_j(mu, r) B_j(F0) / (1 - {KILN_POLE} F0), B_j the cubic \
-             Bernstein polynomials (1 - F0)^3, 3 F0 (1 - F0)^2, 3 F0^2 (1 - F0), F0^3; c_j by \
-             the bilinear lookup of the coefficients at (mu, r) in the E layout of `spec`, \
-             M_avg's by the lookup of `average` at r in `average_spec`; the lobe M(mu_o) M(mu_i) \
-             / (pi M_avg) per channel"
-        ),
+        basis: basis_text(),
         pole: KILN_POLE,
         command: command.to_string(),
         max_std_error: table.max_std_error(),

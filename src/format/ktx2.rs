@@ -34,6 +34,8 @@ pub fn vk_format(channels: usize, precision: Precision) -> Option<u32> {
         (2, Precision::F16) => Some(83),
         (1, Precision::F32) => Some(100),
         (2, Precision::F32) => Some(103),
+        (4, Precision::F16) => Some(97),
+        (4, Precision::F32) => Some(109),
         _ => None,
     }
 }
@@ -51,12 +53,12 @@ fn align(n: usize, to: usize) -> usize {
     n.div_ceil(to) * to
 }
 
-/// Encodes a texture of one or two channels, uncompressed.
+/// Encodes a texture of one, two or four channels, uncompressed.
 pub fn encode(texture: &Texture, precision: Precision) -> std::result::Result<Vec<u8>, String> {
     encode_with(texture, precision, Supercompression::None)
 }
 
-/// Encodes a texture of one or two channels with the given supercompression.
+/// Encodes a texture of one, two or four channels with the given supercompression.
 pub fn encode_with(
     texture: &Texture,
     precision: Precision,
@@ -64,7 +66,7 @@ pub fn encode_with(
 ) -> std::result::Result<Vec<u8>, String> {
     let channels = texture.channels.len();
     let format = vk_format(channels, precision)
-        .ok_or_else(|| format!("KTX2 output takes one or two channels (got {channels})"))?;
+        .ok_or_else(|| format!("KTX2 output takes one, two or four channels (got {channels})"))?;
     let type_size = precision.bytes();
     let texel_bytes = type_size * channels;
     let raw = texture.interleaved(precision);
@@ -95,8 +97,10 @@ pub fn encode_with(
     dfd.extend_from_slice(&[plane_bytes, 0, 0, 0, 0, 0, 0, 0]); // bytes per plane
     let bits = 8 * type_size as u32;
     for c in 0..channels as u32 {
-        // Float (0x80) and signed (0x40) qualifiers; channel id R = 0, G = 1.
-        let channel_type = 0x80 | 0x40 | c;
+        // Float (0x80) and signed (0x40) qualifiers; channel id R = 0, G = 1, B = 2, A = 15
+        // (KHR_DF_CHANNEL_RGBSDA_ALPHA).
+        let id = if c == 3 { 15 } else { c };
+        let channel_type = 0x80 | 0x40 | id;
         put(&mut dfd, (c * bits) | (bits - 1) << 16 | channel_type << 24);
         put(&mut dfd, 0); // sample position
         put(&mut dfd, (-1.0f32).to_bits());

@@ -50,6 +50,17 @@ pub struct CompensationArgs {
     /// averages over mu, as one JSON file (NDF-MASKING-kiln-compensation.json).
     #[arg(long, value_name = "DIR", conflicts_with_all = ["table", "compensation", "roughness", "mu", "f0", "f90", "json"])]
     bake: Option<std::path::PathBuf>,
+    /// With --bake: the files to write, comma-separated: json (the checked document every
+    /// audit reads), ktx2 and dds (the coefficients as an RGBA32F texture over the E layout),
+    /// wgsl, glsl and hlsl (the lookup, M(mu, F0) and the lobe).
+    #[arg(
+        long,
+        value_enum,
+        value_delimiter = ',',
+        requires = "bake",
+        default_value = "json,ktx2,dds,wgsl,glsl,hlsl"
+    )]
+    format: Vec<CompensationFormat>,
     /// With --bake: the E layout's size (size x size texels, kiln's default layout).
     #[arg(long, default_value_t = 32, requires = "bake", value_parser = crate::args::parse_size)]
     size: usize,
@@ -83,6 +94,17 @@ pub struct CompensationArgs {
     /// No progress on stderr.
     #[arg(long, short)]
     quiet: bool,
+}
+
+/// The files `kiln compensation --bake` writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+enum CompensationFormat {
+    Json,
+    Ktx2,
+    Dds,
+    Wgsl,
+    Glsl,
+    Hlsl,
 }
 
 /// `kiln compensation --bake DIR`.
@@ -124,18 +146,57 @@ fn bake(args: &CompensationArgs, out: &std::path::Path) -> kiln::Result<()> {
         settings.walks,
         settings.seed
     );
-    let name = kiln::format::compensation::file_name(&table);
-    let bytes = kiln::format::compensation::encode(&table, &command);
-    let written = kiln::format::write_files(out, &[(name, bytes)])?;
+    use kiln::format::Precision;
+    use kiln::format::shader::{Language, encode_compensation};
+    let stem = kiln::format::compensation::stem(&table).replace('_', "-");
+    let mut files = Vec::new();
+    let mut formats = args.format.clone();
+    formats.dedup();
+    for format in formats {
+        let texture = || kiln::format::compensation::texture(&table);
+        let (extension, bytes) = match format {
+            CompensationFormat::Json => {
+                ("json", kiln::format::compensation::encode(&table, &command))
+            }
+            CompensationFormat::Ktx2 => (
+                "ktx2",
+                kiln::format::ktx2::encode(&texture(), Precision::F32)
+                    .map_err(kiln::Error::InvalidInput)?,
+            ),
+            CompensationFormat::Dds => (
+                "dds",
+                kiln::format::dds::encode(&texture(), Precision::F32)
+                    .map_err(kiln::Error::InvalidInput)?,
+            ),
+            CompensationFormat::Wgsl => (
+                "wgsl",
+                encode_compensation(&table, Language::Wgsl, &command).into_bytes(),
+            ),
+            CompensationFormat::Glsl => (
+                "glsl",
+                encode_compensation(&table, Language::Glsl, &command).into_bytes(),
+            ),
+            CompensationFormat::Hlsl => (
+                "hlsl",
+                encode_compensation(&table, Language::Hlsl, &command).into_bytes(),
+            ),
+        };
+        files.push((format!("{stem}.{extension}"), bytes));
+    }
+    let written = kiln::format::write_files(out, &files)?;
     if !args.quiet {
         println!(
-            "{}: kiln's compensation at {} x {} texels, {} walks each, largest standard error \
-             {:.1e}",
-            kiln::error::escaped_path(&written[0]),
+            "kiln's compensation at {} x {} texels, {} walks each, largest standard error \
+             {:.1e}: {}",
             args.size,
             args.size,
             settings.walks,
-            table.max_std_error()
+            table.max_std_error(),
+            written
+                .iter()
+                .map(|p| kiln::error::escaped_path(p))
+                .collect::<Vec<_>>()
+                .join(", ")
         );
     }
     Ok(())
