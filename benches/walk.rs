@@ -99,7 +99,17 @@ fn walks(c: &mut Criterion) {
         };
         group.bench_with_input(BenchmarkId::new("lobe-104", alpha), &alpha, |b, &alpha| {
             b.iter(|| {
-                pool.install(|| walk_lobe(GGX, black_box(alpha), 0.5, &grid, &settings, &|_| {}))
+                pool.install(|| {
+                    walk_lobe(
+                        GGX,
+                        black_box(alpha),
+                        0.5,
+                        &grid,
+                        &Fresnel::None,
+                        &settings,
+                        &|_| {},
+                    )
+                })
             })
         });
     }

@@ -70,7 +70,15 @@ fn chain(
         if k >= 1 {
             for (sum, &exit) in lobe.iter_mut().zip(exits) {
                 if exit > c {
-                    *sum += plain * (-lambda(exit) * tau).exp() / (2.0 * PI * (1.0 - c) * exit);
+                    // Schlick's F at the facet that sends v to the exit, at an azimuth drawn
+                    // about v (the average over the exit's azimuth).
+                    let psi = 2.0 * PI * uniform(rng);
+                    let v_dot_o = -c * exit
+                        + ((1.0 - c * c) * (1.0 - exit * exit)).max(0.0).sqrt() * psi.cos();
+                    let cosine = ((1.0 + v_dot_o) / 2.0).max(0.0).sqrt();
+                    let fresnel = f0 + (1.0 - f0) * (1.0 - cosine).powi(5);
+                    *sum += coloured * fresnel * (-lambda(exit) * tau).exp()
+                        / (2.0 * PI * (1.0 - c) * exit);
                 }
             }
         }
@@ -679,16 +687,16 @@ fn the_compensation_table_bakes_reads_back_and_is_audited() {
     );
 }
 
-/// The multiple-scattering lobe of the chain at `alpha = 1` (`F = 1`) at each exit cosine, with
-/// standard errors from 16 batches.
-fn chain_lobe(mu: f64, exits: &[f64], n: usize) -> Vec<(f64, f64)> {
+/// The multiple-scattering lobe of the chain at `alpha = 1` with Schlick's `f0` (`F90` = 1) at
+/// each exit cosine, averaged over the azimuth, with standard errors from 16 batches.
+fn chain_lobe(mu: f64, f0: f64, exits: &[f64], n: usize) -> Vec<(f64, f64)> {
     let batches = 16;
     let mut rng = rng::Rng(0x5851_f42d_4c95_7f2d ^ mu.to_bits());
     let mut means = vec![Vec::new(); exits.len()];
     for _ in 0..batches {
         let mut sums = vec![0.0; exits.len()];
         for _ in 0..n / batches {
-            chain(mu, 1.0, &mut rng, &mut [], &mut 0.0, (exits, &mut sums));
+            chain(mu, f0, &mut rng, &mut [], &mut 0.0, (exits, &mut sums));
         }
         for (m, s) in means.iter_mut().zip(&sums) {
             m.push(s / (n / batches) as f64);
@@ -710,7 +718,7 @@ fn lobe(alpha: f64, mu: f64, grid: &LobeGrid, walks: u64) -> LobeEstimate {
         walks,
         ..WalkSettings::default()
     };
-    walk_lobe(GGX, alpha, mu, grid, &settings, &|_| {}).unwrap()
+    walk_lobe(GGX, alpha, mu, grid, &Fresnel::None, &settings, &|_| {}).unwrap()
 }
 
 /// A direction with `cos(theta) = mu` at azimuth `phi` from the view's plane.
@@ -769,7 +777,7 @@ fn the_lobe_is_the_smith_brdf_then_the_chain() {
             );
         }
         if alpha == 1.0 {
-            let chain = chain_lobe(mu, &exits, 1 << 19);
+            let chain = chain_lobe(mu, 1.0, &exits, 1 << 19);
             for (j, &(value, se)) in chain.iter().enumerate() {
                 let averaged = walked.multiple_averaged[j];
                 let mut seen = vec![averaged];
@@ -834,13 +842,15 @@ fn the_lobe_audit_reports_the_closed_forms_and_refuses_by_name() {
         "0,90,180",
         "--walks",
         "2^18",
+        "--f0",
+        "1,0.5",
         "--compensation",
         "kulla-conty,turquin",
         "-q",
     ]);
     let e_avg = 4.0 / 3.0 * (1.0 - std::f64::consts::LN_2);
     let points = json["points"].as_array().unwrap();
-    assert_eq!(points.len(), 2 * 2 * 4);
+    assert_eq!(points.len(), 2 * 2 * 2 * 4);
     let mut averaged = std::collections::HashMap::new();
     for p in points {
         let (view, exit) = (p["view"].as_f64().unwrap(), p["exit"].as_f64().unwrap());
@@ -852,23 +862,37 @@ fn the_lobe_audit_reports_the_closed_forms_and_refuses_by_name() {
             .iter()
             .map(|v| v.as_f64().unwrap())
             .collect();
+        let f0 = p["f0"].as_f64().unwrap();
         let (e_i, e_o) = (e_alpha_one(view), e_alpha_one(exit));
-        let kulla_conty = (1.0 - e_i) * (1.0 - e_o) / (PI * (1.0 - e_avg));
-        let lambda = |c: f64| (1.0 / c - 1.0) / 2.0;
-        let turquin = 1.0 / PI / (4.0 * view * exit * (1.0 + lambda(view) + lambda(exit)))
-            * (1.0 - e_i)
-            / e_i;
+        // Schlick's average 2 ∫ F mu dmu = F0 + (1 - F0) / 21, and Kulla-Conty's colour.
+        let f_avg = f0 + (1.0 - f0) / 21.0;
+        let colour = f_avg * f_avg * e_avg / (1.0 - f_avg * (1.0 - e_avg));
+        let kulla_conty = colour * (1.0 - e_i) * (1.0 - e_o) / (PI * (1.0 - e_avg));
         assert!((added[0] - kulla_conty).abs() < 1e-9 * kulla_conty, "{p}");
-        assert!((added[1] - turquin).abs() < 1e-9 * turquin, "{p}");
         assert!(se > 0.0 && se < 2e-3 * walk, "{p}");
+        let key = (view.to_bits(), exit.to_bits(), f0.to_bits());
         match p["azimuth"].as_f64() {
             None => {
-                averaged.insert((view.to_bits(), exit.to_bits()), (walk, se));
+                averaged.insert(key, (walk, se));
             }
-            Some(_) => {
-                let (mean, mean_se) = averaged[&(view.to_bits(), exit.to_bits())];
-                let allowed = 4.0 * (se * se + mean_se * mean_se).sqrt();
-                assert!((walk - mean).abs() <= allowed, "{p} vs averaged {mean}");
+            Some(phi) => {
+                // Turquin's: D = 1 / pi, Schlick at the half vector, times F0 (1 - E) / E.
+                let (i, o) = (Vec3::from_mu(view), direction(exit, phi));
+                let cosine = ((1.0 + i.dot(o)) / 2.0).sqrt();
+                let fresnel = f0 + (1.0 - f0) * (1.0 - cosine).powi(5);
+                let lambda = |c: f64| (1.0 / c - 1.0) / 2.0;
+                let turquin =
+                    fresnel / PI / (4.0 * view * exit * (1.0 + lambda(view) + lambda(exit)))
+                        * f0
+                        * (1.0 - e_i)
+                        / e_i;
+                assert!((added[1] - turquin).abs() < 1e-9 * turquin, "{p}");
+                // At F = 1 nothing depends on the azimuth.
+                if f0 == 1.0 {
+                    let (mean, mean_se) = averaged[&key];
+                    let allowed = 4.0 * (se * se + mean_se * mean_se).sqrt();
+                    assert!((walk - mean).abs() <= allowed, "{p} vs averaged {mean}");
+                }
             }
         }
     }
@@ -876,6 +900,8 @@ fn the_lobe_audit_reports_the_closed_forms_and_refuses_by_name() {
         (&["--exit", "0"][..], "(0, 1]"),
         (&["--azimuth", "200"][..], "[0, 180]"),
         (&["--roughness", "0"][..], "delta"),
+        (&["--compensation", "kiln"][..], "--table"),
+        (&["--f0", "1.5"][..], "[0, 1]"),
         (
             &["--mu", "0.1,0.2,0.3,0.4,0.5", "--plot", "lobe.png"][..],
             "at most 12",
@@ -921,5 +947,37 @@ fn the_analog_walk_measures_the_same_orders() {
             (a.value - b.value).abs() <= allowed && b.std_error > 3.0 * a.std_error,
             "kiln's {a:?}, analog {b:?}"
         );
+    }
+}
+
+/// With Schlick's Fresnel at every vertex, the walk's lobe (averaged over the azimuth, where the
+/// last facet's Fresnel depends on it) is the chain's at `alpha = 1`: the Fresnel of the
+/// next-event reflection is taken at the right cosine and the throughput carries every earlier
+/// one. With `F0 = 0.3` a factor at the wrong cosine moves it by far more than its error.
+#[test]
+fn the_lobe_with_fresnel_is_the_chain() {
+    let exits = [0.1, 0.5, 0.9];
+    let grid = LobeGrid {
+        mus: exits.to_vec(),
+        azimuths: vec![0.0],
+        strata: 8,
+    };
+    let settings = WalkSettings {
+        walks: 1 << 18,
+        ..WalkSettings::default()
+    };
+    let fresnel = schlick(0.3, 1.0);
+    for mu in [0.2, 0.7] {
+        let walked = walk_lobe(GGX, 1.0, mu, &grid, &fresnel, &settings, &|_| {}).unwrap();
+        let chain = chain_lobe(mu, 0.3, &exits, 1 << 19);
+        for (j, &(value, se)) in chain.iter().enumerate() {
+            let got = walked.multiple_averaged[j];
+            let allowed = 4.0 * (got.std_error.powi(2) + se * se).sqrt();
+            assert!(
+                (got.value - value).abs() <= allowed && allowed < 0.03 * value,
+                "mu {mu} -> {}: walk {got:?}, chain {value} +- {se}",
+                exits[j]
+            );
+        }
     }
 }

@@ -77,30 +77,60 @@ impl Compensation {
     }
 }
 
+/// What the lobes the compensations add are computed from, at one view, exit and Fresnel
+/// ([`Compensation::added_lobe`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LobeInputs {
+    /// `E` at the view's and at the exit's cosine, and `E_avg`.
+    pub e_view: f64,
+    pub e_exit: f64,
+    pub e_avg: f64,
+    /// The single-scattering BRDF with the Fresnel factor at the half vector, `f_ss F(v.h)`,
+    /// from the view to the exit (or its average over the azimuth, for the averaged lobe).
+    pub single: f64,
+    /// Schlick's `F0` and the Fresnel's hemispherical average `F_avg`.
+    pub f0: f64,
+    pub f_avg: f64,
+    /// kiln's `M` at the view and at the exit and `M_avg`, from its table at this `F0`.
+    pub kiln: Option<[f64; 3]>,
+}
+
 impl Compensation {
-    /// The lobe this compensation adds to the single-scattering BRDF at `F = 1` (the white
-    /// furnace), from the view `i` to the exit `o`: what the walk's orders after the first are
-    /// ([`crate::integrate::walk::walk_lobe`]). `e_view`, `e_exit` are `E` at their cosines,
-    /// `single` the single-scattering BRDF `f_ss(i, o)` (or its average over the azimuth, for
-    /// the averaged lobe).
+    /// The lobe this compensation adds to the single-scattering BRDF, from the view to the exit:
+    /// what the walk's orders after the first are ([`crate::integrate::walk::walk_lobe`]).
     ///
-    /// Kulla-Conty: `(1 - E(mu_i)) (1 - E(mu_o)) / (pi (1 - E_avg))` (its colour term is 1 at
-    /// `F = 1`). Turquin: `f_ss (1 - E(mu_i)) / E(mu_i)`, the single-scattering lobe scaled by
-    /// the view's lost energy. kiln's: `M(mu_i) M(mu_o) / (pi M_avg)` with `M(mu, 1) = 1 - E`
-    /// pinned, so at `F = 1` it is Kulla-Conty's lobe exactly.
+    /// Kulla-Conty: `(1 - E(mu_i)) (1 - E(mu_o)) / (pi (1 - E_avg))` times its colour
+    /// `F_avg^2 E_avg / (1 - F_avg (1 - E_avg))` (1 at `F = 1`). Turquin: the
+    /// single-scattering lobe with its Fresnel times `F0 (1 - E(mu_i)) / E(mu_i)`. kiln's:
+    /// `M(mu_i) M(mu_o) / (pi M_avg)` (NaN without `inputs.kiln`); with `M(mu, 1) = 1 - E`
+    /// pinned, at `F = 1` it is Kulla-Conty's lobe.
     #[must_use]
-    pub fn added_lobe_white(self, e_view: f64, e_exit: f64, e_avg: f64, single: f64) -> f64 {
+    pub fn added_lobe(self, inputs: &LobeInputs) -> f64 {
+        let LobeInputs {
+            e_view,
+            e_exit,
+            e_avg,
+            single,
+            f0,
+            f_avg,
+            kiln,
+        } = *inputs;
         match self {
-            Compensation::KullaConty | Compensation::Kiln => {
-                (1.0 - e_view) * (1.0 - e_exit) / (std::f64::consts::PI * (1.0 - e_avg))
+            Compensation::KullaConty => {
+                fresnel_colour(f_avg, e_avg) * (1.0 - e_view) * (1.0 - e_exit)
+                    / (std::f64::consts::PI * (1.0 - e_avg))
             }
             Compensation::Turquin => {
                 if e_view > 0.0 {
-                    single * (1.0 - e_view) / e_view
+                    single * f0 * (1.0 - e_view) / e_view
                 } else {
                     0.0
                 }
             }
+            Compensation::Kiln => match kiln {
+                Some([m_view, m_exit, m_avg]) => m_view * m_exit / (std::f64::consts::PI * m_avg),
+                None => f64::NAN,
+            },
         }
     }
 }

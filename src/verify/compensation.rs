@@ -11,7 +11,7 @@
 //! reference to 1e-10, so the walk's standard error is all the uncertainty there is).
 
 use crate::integrate::compensation::{
-    Compensation, KILN_FIT_SEED, KilnCompensation, SingleScattering,
+    Compensation, KILN_FIT_SEED, KilnCompensation, LobeInputs, SingleScattering,
 };
 use crate::integrate::reference::{ReferenceSettings, reference_average_albedo};
 use crate::integrate::walk::{Measured, WalkError, WalkSettings, walk_schlick_polynomial};
@@ -216,6 +216,8 @@ pub struct LobeAuditGrid {
     /// Exit azimuths in `[0, pi]` from the view's plane (0: the view's side; `pi`: the mirror
     /// direction's side), for the lobe in full.
     pub azimuths: Vec<f64>,
+    /// Schlick `F0` values (`F90` = 1) at every vertex; 1 is the white furnace.
+    pub f0s: Vec<f64>,
 }
 
 /// Azimuths a walk averages the lobe over (stratified): see [`crate::integrate::walk::lobe`].
@@ -224,13 +226,14 @@ pub const LOBE_STRATA: u32 = 8;
 /// Nodes of the azimuthal average of the single-scattering BRDF (Turquin's lobe).
 const AZIMUTH_NODES: usize = 4096;
 
-/// One point of the lobe audit: the multiple-scattering lobe (`F = 1`) at a view and an exit,
+/// One point of the lobe audit: the multiple-scattering lobe at a view, an exit and an `F0`,
 /// in full (at an azimuth) or averaged over the azimuth.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct LobePoint {
     pub alpha: f64,
     pub view: f64,
     pub exit: f64,
+    pub f0: f64,
     /// The exit's azimuth in radians, or `None` for the average over the azimuth.
     pub azimuth: Option<f64>,
     /// The walk's BRDF of the second and later orders.
@@ -259,6 +262,7 @@ pub struct LobeExtreme {
     pub alpha: f64,
     pub view: f64,
     pub exit: f64,
+    pub f0: f64,
     pub azimuth: Option<f64>,
 }
 
@@ -286,27 +290,91 @@ pub struct LobeSummary {
 pub struct LobeAudit {
     pub points: Vec<LobePoint>,
     pub summaries: Vec<LobeSummary>,
-    /// Walks per view.
+    /// Walks per view and `F0`.
     pub walks: u64,
 }
 
-/// Measures the lobes `compensations` add at `F = 1` against the walk's multiple-scattering
-/// lobe over `grid` (GGX, height-correlated): next-event estimates at every exit direction
-/// from one set of walks per view ([`crate::integrate::walk::walk_lobe`]); the compensations
-/// from kiln's reference `E` and `E_avg` and the closed-form single-scattering BRDF
-/// ([`Compensation::added_lobe_white`]). `progress` hears the number of views done.
+/// What the compensations' lobes need at one roughness and `F0`: `E` and kiln's `M` at a
+/// cosine, `E_avg`, `F_avg` and kiln's `M_avg`.
+struct LobeContext<'a> {
+    model: Model,
+    alpha: f64,
+    f0: f64,
+    fresnel: Fresnel,
+    e_avg: f64,
+    f_avg: f64,
+    table: Option<&'a CompensationTable>,
+    reference: ReferenceSettings,
+}
+
+impl LobeContext<'_> {
+    fn e(&self, mu: f64) -> f64 {
+        crate::integrate::reference::reference_albedo(self.model, self.alpha, mu, &self.reference)
+            .value
+    }
+
+    /// The inputs at (view, exit) given `f_ss F` there.
+    fn inputs(&self, view: f64, exit: f64, e_view: f64, e_exit: f64, single: f64) -> LobeInputs {
+        let kiln = self.table.map(|t| {
+            let r = t.spec.roughness_convention().from_alpha(self.alpha);
+            [
+                t.lookup(view, r).multiple(self.f0),
+                t.lookup(exit, r).multiple(self.f0),
+                t.lookup_average(r).multiple(self.f0),
+            ]
+        });
+        LobeInputs {
+            e_view,
+            e_exit,
+            e_avg: self.e_avg,
+            single,
+            f0: self.f0,
+            f_avg: self.f_avg,
+            kiln,
+        }
+    }
+}
+
+/// Schlick's Fresnel at `F0 = 1` (with `F90 = 1`) is 1 everywhere: the walk then runs without
+/// a Fresnel (the same lobe, and the same bits as the white furnace's).
+fn white_as_none(fresnel: &Fresnel, f0: f64) -> Fresnel {
+    if f0 == 1.0 { Fresnel::None } else { *fresnel }
+}
+
+/// Checks the lobe audit's `F0` values and that kiln's lobe has its table.
+fn check_lobe_request(
+    f0s: &[f64],
+    compensations: &[Compensation],
+    table: Option<&CompensationTable>,
+) -> Result<(), WalkError> {
+    if let Some(&f0) = f0s.iter().find(|f| !(0.0..=1.0).contains(*f)) {
+        return Err(WalkError::F0(f0));
+    }
+    if compensations.contains(&Compensation::Kiln) && table.is_none() {
+        return Err(WalkError::KilnLobeTable);
+    }
+    Ok(())
+}
+
+/// Measures the lobes `compensations` add against the walk's multiple-scattering lobe over
+/// `grid` (GGX, height-correlated, Schlick's Fresnel with `F90 = 1` at every vertex):
+/// next-event estimates at every exit direction from one set of walks per view and `F0`
+/// ([`crate::integrate::walk::walk_lobe`]); the compensations from kiln's reference `E` and
+/// `E_avg`, the closed-form single-scattering BRDF and, for kiln's, `table`'s lookup
+/// ([`Compensation::added_lobe`]). `progress` hears the number of views done.
 pub fn audit_lobes(
     model: Model,
     grid: &LobeAuditGrid,
     compensations: &[Compensation],
+    table: Option<&CompensationTable>,
     settings: &WalkSettings,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Result<LobeAudit, WalkError> {
-    use crate::integrate::reference::reference_albedo;
     use crate::integrate::walk::lobe::{self, LobeGrid};
     use crate::integrate::walk::walk_lobe;
     use crate::model::ndf::Ggx;
     use crate::model::vector::Vec3;
+    check_lobe_request(&grid.f0s, compensations, table)?;
     let reference = ReferenceSettings::default();
     let walk_grid = LobeGrid {
         mus: grid.exits.clone(),
@@ -318,55 +386,83 @@ pub fn audit_lobes(
     for &alpha in &grid.alphas {
         let ndf = Ggx { alpha };
         let e_avg = reference_average_albedo(model, alpha, &reference).value;
-        let e = |mu: f64| reference_albedo(model, alpha, mu, &reference).value;
-        let e_exits: Vec<f64> = grid.exits.iter().map(|&mu| e(mu)).collect();
-        for &view in &grid.views {
-            let walked = walk_lobe(model, alpha, view, &walk_grid, settings, &|_| {})?;
-            let e_view = e(view);
-            let i = Vec3::from_mu(view);
-            for (j, (&exit, &e_exit)) in grid.exits.iter().zip(&e_exits).enumerate() {
-                let added = |single: f64| {
-                    compensations
-                        .iter()
-                        .map(|c| c.added_lobe_white(e_view, e_exit, e_avg, single))
-                        .collect()
-                };
-                let averaged = lobe::single_scattering_averaged(&ndf, view, exit, AZIMUTH_NODES);
-                points.push(LobePoint {
+        for &f0 in &grid.f0s {
+            let fresnel = Fresnel::Schlick {
+                f0: [f0; 3],
+                f90: [1.0; 3],
+            };
+            let context = LobeContext {
+                model,
+                alpha,
+                f0,
+                fresnel,
+                e_avg,
+                f_avg: fresnel.average()[0],
+                table,
+                reference,
+            };
+            let e_exits: Vec<f64> = grid.exits.iter().map(|&mu| context.e(mu)).collect();
+            for &view in &grid.views {
+                let walked = walk_lobe(
+                    model,
                     alpha,
                     view,
-                    exit,
-                    azimuth: None,
-                    walk: walked.multiple_averaged[j],
-                    added: added(averaged),
-                });
-                let s = ((1.0 - exit) * (1.0 + exit)).max(0.0).sqrt();
-                for (k, &phi) in grid.azimuths.iter().enumerate() {
-                    let o = Vec3::new(s * phi.cos(), s * phi.sin(), exit);
+                    &walk_grid,
+                    &white_as_none(&fresnel, f0),
+                    settings,
+                    &|_| {},
+                )?;
+                let e_view = context.e(view);
+                let i = Vec3::from_mu(view);
+                for (j, (&exit, &e_exit)) in grid.exits.iter().zip(&e_exits).enumerate() {
+                    let added = |single: f64| {
+                        let inputs = context.inputs(view, exit, e_view, e_exit, single);
+                        compensations
+                            .iter()
+                            .map(|c| c.added_lobe(&inputs))
+                            .collect()
+                    };
+                    let averaged = lobe::single_scattering_averaged(
+                        &ndf,
+                        view,
+                        exit,
+                        &context.fresnel,
+                        AZIMUTH_NODES,
+                    );
                     points.push(LobePoint {
                         alpha,
                         view,
                         exit,
-                        azimuth: Some(phi),
-                        walk: walked.multiple[j * grid.azimuths.len() + k],
-                        added: added(lobe::single_scattering(&ndf, i, o)),
+                        f0,
+                        azimuth: None,
+                        walk: walked.multiple_averaged[j],
+                        added: added(averaged),
                     });
+                    let s = ((1.0 - exit) * (1.0 + exit)).max(0.0).sqrt();
+                    for (k, &phi) in grid.azimuths.iter().enumerate() {
+                        let o = Vec3::new(s * phi.cos(), s * phi.sin(), exit);
+                        let single = lobe::single_scattering(&ndf, i, o)
+                            * lobe::reflectance_at_half(&context.fresnel, i, o);
+                        points.push(LobePoint {
+                            alpha,
+                            view,
+                            exit,
+                            f0,
+                            azimuth: Some(phi),
+                            walk: walked.multiple[j * grid.azimuths.len() + k],
+                            added: added(single),
+                        });
+                    }
                 }
+                done += 1;
+                progress(done);
             }
-            done += 1;
-            progress(done);
         }
     }
     let figures = |k: usize, alpha: f64, full: bool| {
-        let chosen: Vec<&LobePoint> = points
+        let all: Vec<LobeExtreme> = points
             .iter()
             .filter(|p| p.alpha == alpha && p.azimuth.is_some() == full)
-            .collect();
-        if chosen.is_empty() {
-            return None;
-        }
-        let all: Vec<LobeExtreme> = chosen
-            .iter()
             .map(|p| {
                 let (deviation, confidence) = p.deviation(k);
                 LobeExtreme {
@@ -375,10 +471,14 @@ pub fn audit_lobes(
                     alpha: p.alpha,
                     view: p.view,
                     exit: p.exit,
+                    f0: p.f0,
                     azimuth: p.azimuth,
                 }
             })
             .collect();
+        if all.is_empty() {
+            return None;
+        }
         let highest = *all
             .iter()
             .max_by(|a, b| a.deviation.total_cmp(&b.deviation))
@@ -424,6 +524,7 @@ pub fn audit_lobes(
 pub struct LobeProfile {
     pub alpha: f64,
     pub view: f64,
+    pub f0: f64,
     /// Signed exit angles in degrees: negative on the view's side (azimuth 0), positive on the
     /// mirror direction's side (azimuth 180).
     pub angles: Vec<f64>,
@@ -439,21 +540,24 @@ pub const PROFILE_ANGLES: [f64; 19] = [
     80.0, 85.0, 89.0,
 ];
 
-/// The lobes at `F = 1` in the plane of incidence from `view` at `alpha`, at
-/// [`PROFILE_ANGLES`] on both sides: the walk's (as [`audit_lobes`] measures it) and each
+/// The lobes in the plane of incidence from `view` at `alpha` with Schlick's `f0` (`F90` = 1),
+/// at [`PROFILE_ANGLES`] on both sides: the walk's (as [`audit_lobes`] measures it) and each
 /// compensation's.
+#[allow(clippy::too_many_arguments)]
 pub fn lobe_profile(
     model: Model,
     alpha: f64,
     view: f64,
+    f0: f64,
     compensations: &[Compensation],
+    table: Option<&CompensationTable>,
     settings: &WalkSettings,
 ) -> Result<LobeProfile, WalkError> {
-    use crate::integrate::reference::reference_albedo;
     use crate::integrate::walk::lobe::{self, LobeGrid};
     use crate::integrate::walk::walk_lobe;
     use crate::model::ndf::Ggx;
     use crate::model::vector::Vec3;
+    check_lobe_request(&[f0], compensations, table)?;
     let reference = ReferenceSettings::default();
     let exits: Vec<f64> = PROFILE_ANGLES
         .iter()
@@ -464,24 +568,47 @@ pub fn lobe_profile(
         azimuths: vec![0.0, std::f64::consts::PI],
         strata: 1,
     };
-    let walked = walk_lobe(model, alpha, view, &grid, settings, &|_| {})?;
+    let fresnel = Fresnel::Schlick {
+        f0: [f0; 3],
+        f90: [1.0; 3],
+    };
+    let walked = walk_lobe(
+        model,
+        alpha,
+        view,
+        &grid,
+        &white_as_none(&fresnel, f0),
+        settings,
+        &|_| {},
+    )?;
     let ndf = Ggx { alpha };
-    let e_avg = reference_average_albedo(model, alpha, &reference).value;
-    let e_view = reference_albedo(model, alpha, view, &reference).value;
+    let context = LobeContext {
+        model,
+        alpha,
+        f0,
+        fresnel,
+        e_avg: reference_average_albedo(model, alpha, &reference).value,
+        f_avg: fresnel.average()[0],
+        table,
+        reference,
+    };
+    let e_view = context.e(view);
     let i = Vec3::from_mu(view);
     let mut rows: Vec<(f64, Measured, Vec<f64>)> = Vec::new();
     for (j, (&angle, &exit)) in PROFILE_ANGLES.iter().zip(&exits).enumerate() {
-        let e_exit = reference_albedo(model, alpha, exit, &reference).value;
+        let e_exit = context.e(exit);
         let s = ((1.0 - exit) * (1.0 + exit)).max(0.0).sqrt();
         for (k, side) in [(0, -1.0), (1, 1.0)] {
             let o = Vec3::new(-side * s, 0.0, exit);
-            let single = lobe::single_scattering(&ndf, i, o);
+            let single = lobe::single_scattering(&ndf, i, o)
+                * lobe::reflectance_at_half(&context.fresnel, i, o);
+            let inputs = context.inputs(view, exit, e_view, e_exit, single);
             rows.push((
                 side * angle,
                 walked.multiple[2 * j + k],
                 compensations
                     .iter()
-                    .map(|c| c.added_lobe_white(e_view, e_exit, e_avg, single))
+                    .map(|c| c.added_lobe(&inputs))
                     .collect(),
             ));
         }
@@ -490,6 +617,7 @@ pub fn lobe_profile(
     Ok(LobeProfile {
         alpha,
         view,
+        f0,
         angles: rows.iter().map(|r| r.0).collect(),
         walk: rows.iter().map(|r| r.1).collect(),
         added: (0..compensations.len())

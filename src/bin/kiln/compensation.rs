@@ -35,8 +35,9 @@ pub struct CompensationArgs {
     /// View cosines mu, comma-separated, in [0, 1].
     #[arg(long, value_delimiter = ',', default_value = "0.05,0.1,0.2,0.35,0.5,0.7,0.85,1", value_parser = crate::args::parse_mu, allow_negative_numbers = true)]
     mu: Vec<f64>,
-    /// Schlick's F0 values, comma-separated, in [0, 1].
-    #[arg(long, value_delimiter = ',', default_value = "0.02,0.04,0.1,0.25,0.5,0.75,0.9,1", value_parser = crate::args::parse_number, allow_negative_numbers = true)]
+    /// Schlick's F0 values, comma-separated, in [0, 1] [default: 0.02,0.04,0.1,0.25,0.5,0.75,
+    /// 0.9,1; with --lobe 1, the white furnace].
+    #[arg(long, value_delimiter = ',', value_parser = crate::args::parse_number, allow_negative_numbers = true)]
     f0: Vec<f64>,
     /// Schlick's F90, in [0, 1].
     #[arg(long, default_value_t = 1.0, value_parser = crate::args::parse_number, allow_negative_numbers = true)]
@@ -68,11 +69,12 @@ pub struct CompensationArgs {
     /// of fitting it at each view.
     #[arg(long, value_name = "FILE")]
     table: Option<std::path::PathBuf>,
-    /// Measure the lobes instead of the albedo: the lobe each compensation adds at F = 1 (the
-    /// white furnace, where kiln's is Kulla-Conty's) against the walk's lobe of the second and
-    /// later orders, by next-event estimation, from each view (--mu) to each exit (--exit),
-    /// averaged over the azimuth and at each --azimuth.
-    #[arg(long, conflicts_with_all = ["table", "f0", "f90", "bake"])]
+    /// Measure the lobes instead of the albedo: the lobe each compensation adds (with Schlick's
+    /// --f0 at every bounce, F90 = 1; at F0 = 1 kiln's is Kulla-Conty's) against the walk's
+    /// lobe of the second and later orders, by next-event estimation, from each view (--mu) to
+    /// each exit (--exit), averaged over the azimuth and at each --azimuth. kiln's lobe needs
+    /// its baked --table (for M_avg).
+    #[arg(long, conflicts_with_all = ["f90", "bake"])]
     lobe: bool,
     /// With --lobe: exit cosines, comma-separated, in (0, 1] [default: the --mu values].
     #[arg(long, value_delimiter = ',', requires = "lobe", value_parser = crate::args::parse_mu, allow_negative_numbers = true)]
@@ -82,7 +84,7 @@ pub struct CompensationArgs {
     #[arg(long, value_delimiter = ',', requires = "lobe", default_value = "0,45,90,135,180", value_parser = crate::args::parse_number, allow_negative_numbers = true)]
     azimuth: Vec<f64>,
     /// With --lobe: also draw the lobes in the plane of incidence, one panel per roughness and
-    /// view (at most 12), into this SVG or PNG file.
+    /// view (at most 12, at the first --f0), into this SVG or PNG file.
     #[arg(long, value_name = "FILE", requires = "lobe")]
     plot: Option<std::path::PathBuf>,
     /// Base seed of the walks' scrambles.
@@ -209,15 +211,12 @@ pub fn run(args: CompensationArgs) -> kiln::Result<()> {
     if args.lobe {
         return lobes(&args);
     }
-    let table = match &args.table {
-        Some(path) => {
-            let bytes = kiln::format::read_file(path)?;
-            let table =
-                kiln::format::compensation::decode(&bytes, &kiln::error::escaped_path(path))?;
-            Some(table)
-        }
-        None => None,
+    let f0 = if args.f0.is_empty() {
+        vec![0.02, 0.04, 0.1, 0.25, 0.5, 0.75, 0.9, 1.0]
+    } else {
+        args.f0.clone()
     };
+    let table = read_table(args.table.as_deref())?;
     let walks = args.walks.unwrap_or(1 << 20);
     let compensations = if args.compensation.is_empty() {
         Compensation::ALL.to_vec()
@@ -235,7 +234,7 @@ pub fn run(args: CompensationArgs) -> kiln::Result<()> {
             .map(|&r| RoughnessConvention::Perceptual.to_alpha(r))
             .collect(),
         mus: args.mu.clone(),
-        f0s: args.f0.clone(),
+        f0s: f0,
         f90: args.f90,
     };
     if !(0.0..=1.0).contains(&args.f90) {
@@ -270,14 +269,6 @@ pub fn run(args: CompensationArgs) -> kiln::Result<()> {
         }
     }
     let bar = crate::progress_bar(args.quiet, views, "walking");
-    if let Some(table) = &table
-        && table.spec.model != model
-    {
-        return Err(kiln::Error::InvalidInput(format!(
-            "--table holds kiln's compensation for {}; the walk is {model}",
-            table.spec.model
-        )));
-    }
     let audit = audit_compensations(
         model,
         &grid,
@@ -330,13 +321,39 @@ fn print(audit: &CompensationAudit, grid: &CompensationGrid) {
     }
 }
 
+/// kiln's compensation table from `--table`, checked, if given.
+fn read_table(
+    path: Option<&std::path::Path>,
+) -> kiln::Result<Option<kiln::table::compensation::CompensationTable>> {
+    let Some(path) = path else {
+        return Ok(None);
+    };
+    let bytes = kiln::format::read_file(path)?;
+    let table = kiln::format::compensation::decode(&bytes, &kiln::error::escaped_path(path))?;
+    let model = Model {
+        ndf: Ndf::Ggx,
+        masking: Masking::HeightCorrelated,
+    };
+    if table.spec.model != model {
+        return Err(kiln::Error::InvalidInput(format!(
+            "--table holds kiln's compensation for {}; the walk is {model}",
+            table.spec.model
+        )));
+    }
+    Ok(Some(table))
+}
+
 /// `kiln compensation --lobe`.
 fn lobes(args: &CompensationArgs) -> kiln::Result<()> {
     use kiln::verify::compensation::{LobeAuditGrid, LobeExtreme, audit_lobes};
-    // At F = 1 kiln's lobe is Kulla-Conty's (M(mu, 1) = 1 - E is pinned): measured only when
-    // asked for by name.
+    let table = read_table(args.table.as_deref())?;
+    // kiln's lobe needs its table's M_avg; at F = 1 it is Kulla-Conty's anyway.
     let compensations = if args.compensation.is_empty() {
-        vec![Compensation::KullaConty, Compensation::Turquin]
+        let mut all = vec![Compensation::KullaConty, Compensation::Turquin];
+        if table.is_some() {
+            all.push(Compensation::Kiln);
+        }
+        all
     } else {
         args.compensation.clone()
     };
@@ -357,6 +374,11 @@ fn lobes(args: &CompensationArgs) -> kiln::Result<()> {
             args.exit.clone()
         },
         azimuths: args.azimuth.iter().map(|d| d.to_radians()).collect(),
+        f0s: if args.f0.is_empty() {
+            vec![1.0]
+        } else {
+            args.f0.clone()
+        },
     };
     let settings = WalkSettings {
         walks: args.walks.unwrap_or(1 << 20),
@@ -378,7 +400,8 @@ fn lobes(args: &CompensationArgs) -> kiln::Result<()> {
             grid.views.len()
         )));
     }
-    let views = (grid.alphas.len() * grid.views.len()) as u64 * if svg.is_some() { 2 } else { 1 };
+    let views = (grid.alphas.len() * grid.views.len() * grid.f0s.len()) as u64
+        * if svg.is_some() { 2 } else { 1 };
     if !args.quiet {
         // Measured 2026-12-07 on two cores: 2^20 walks from a view, evaluated at 8 exits x
         // (5 azimuths + 8 strata), take about 1.5 s.
@@ -395,9 +418,14 @@ fn lobes(args: &CompensationArgs) -> kiln::Result<()> {
         }
     }
     let bar = crate::progress_bar(args.quiet, views, "walking");
-    let audit = audit_lobes(model, &grid, &compensations, &settings, &|done| {
-        bar.set_position(done)
-    })?;
+    let audit = audit_lobes(
+        model,
+        &grid,
+        &compensations,
+        table.as_ref(),
+        &settings,
+        &|done| bar.set_position(done),
+    )?;
     if let (Some(path), Some(svg)) = (&args.plot, svg) {
         let mut profiles = Vec::new();
         for &alpha in &grid.alphas {
@@ -406,15 +434,22 @@ fn lobes(args: &CompensationArgs) -> kiln::Result<()> {
                     model,
                     alpha,
                     view,
+                    grid.f0s[0],
                     &compensations,
+                    table.as_ref(),
                     &settings,
                 )?);
                 bar.inc(1);
             }
         }
         let names: Vec<&str> = compensations.iter().map(|c| c.name()).collect();
+        let fresnel = if grid.f0s[0] == 1.0 {
+            "at F = 1".to_string()
+        } else {
+            format!("with Schlick F0 = {}", grid.f0s[0])
+        };
         let title = format!(
-            "The lobe added at F = 1 against the microsurface walk's (GGX, {} walks a view)",
+            "The lobe added {fresnel} against the microsurface walk's (GGX, {} walks a view)",
             settings.walks
         );
         crate::verify::write_plot(path, svg, crate::plot::lobe_plot(&title, &profiles, &names))?;
@@ -427,8 +462,21 @@ fn lobes(args: &CompensationArgs) -> kiln::Result<()> {
         );
         return Ok(());
     }
+    let white = grid.f0s == [1.0];
+    let fresnel = if white {
+        "at F = 1".to_string()
+    } else {
+        format!(
+            "with Schlick F0 {} (F90 1)",
+            grid.f0s
+                .iter()
+                .map(|f| f.to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        )
+    };
     println!(
-        "the lobe added at F = 1 against the walk's orders 2 and later (ggx height-correlated), \
+        "the lobe added {fresnel} against the walk's orders 2 and later (ggx height-correlated), \
          {} walks a view: {} roughness x {} views x {} exits, averaged over the azimuth and at \
          {} azimuths",
         audit.walks,
@@ -439,21 +487,26 @@ fn lobes(args: &CompensationArgs) -> kiln::Result<()> {
     );
     let at = |e: &LobeExtreme| {
         format!(
-            "{:+.1}% +- {:.1}% (view {}, exit {}{})",
+            "{:+.1}% +- {:.1}% (view {}, exit {}{}{})",
             100.0 * e.deviation,
             100.0 * e.confidence,
             e.view,
             e.exit,
             e.azimuth
                 .map(|p| format!(", {} deg", kiln::error::brief(p.to_degrees())))
-                .unwrap_or_default()
+                .unwrap_or_default(),
+            if white {
+                String::new()
+            } else {
+                format!(", F0 {}", e.f0)
+            }
         )
     };
     let mut last = None;
     for summary in &audit.summaries {
         if last != Some(summary.compensation) {
             last = Some(summary.compensation);
-            let same = if summary.compensation == Compensation::Kiln {
+            let same = if summary.compensation == Compensation::Kiln && white {
                 " (at F = 1 kiln's lobe is Kulla-Conty's)"
             } else {
                 ""
@@ -476,7 +529,13 @@ fn lobes(args: &CompensationArgs) -> kiln::Result<()> {
         }
     }
     if !compensations.contains(&Compensation::Kiln) {
-        println!("  kiln: at F = 1 its lobe is Kulla-Conty's (M(mu, 1) = 1 - E is pinned)");
+        if white {
+            println!("  kiln: at F = 1 its lobe is Kulla-Conty's (M(mu, 1) = 1 - E is pinned)");
+        } else {
+            println!(
+                "  kiln: give its baked --table (kiln compensation --bake DIR) to measure its lobe"
+            );
+        }
     }
     Ok(())
 }

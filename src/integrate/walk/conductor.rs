@@ -156,7 +156,20 @@ pub fn walk<N: MicrofacetDistribution>(
         let log_c1 = heights.log_c1(h);
         let v = Vec3::new(-w.x, -w.y, -w.z);
         if let Some(lobe) = lobe {
-            lobe.add(ndf, v, log_c1, plain, vertex, &rotations, &mut tallies.lobe);
+            let throughput = if lobe.has_fresnel() {
+                coloured[0]
+            } else {
+                plain
+            };
+            lobe.add(
+                ndf,
+                v,
+                log_c1,
+                throughput,
+                vertex,
+                &rotations,
+                &mut tallies.lobe,
+            );
         }
         let mirror = ndf.alpha() == 0.0;
         let m = if mirror {

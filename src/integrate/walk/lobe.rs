@@ -23,6 +23,7 @@
 //! lobe is even in `phi`).
 
 use super::random::WalkRandom;
+use crate::model::fresnel::Fresnel;
 use crate::model::ndf::MicrofacetDistribution;
 use crate::model::vector::Vec3;
 use std::f64::consts::PI;
@@ -56,11 +57,14 @@ pub struct LobeTargets {
     /// `(mu_o, sin theta_o, Lambda(o))` for each averaged cosine.
     averaged: Vec<(f64, f64, f64)>,
     strata: u32,
+    /// The Fresnel factor at the last vertex (its first channel), or `None` for `F = 1`.
+    fresnel: Option<Fresnel>,
 }
 
 impl LobeTargets {
-    /// The exit directions of `grid` for `ndf`.
-    pub fn new<N: MicrofacetDistribution>(ndf: &N, grid: &LobeGrid) -> Self {
+    /// The exit directions of `grid` for `ndf`, with `fresnel` at every vertex (its first
+    /// channel; [`Fresnel::None`] for `F = 1`).
+    pub fn new<N: MicrofacetDistribution>(ndf: &N, grid: &LobeGrid, fresnel: &Fresnel) -> Self {
         let fixed = grid
             .mus
             .iter()
@@ -84,6 +88,7 @@ impl LobeTargets {
             fixed,
             averaged,
             strata: grid.strata.max(1),
+            fresnel: (*fresnel != Fresnel::None).then_some(*fresnel),
         }
     }
 
@@ -106,8 +111,17 @@ impl LobeTargets {
             .collect()
     }
 
+    /// Whether the lobe carries a Fresnel factor (the walk then passes its Fresnel-weighted
+    /// throughput).
+    #[must_use]
+    pub fn has_fresnel(&self) -> bool {
+        self.fresnel.is_some()
+    }
+
     /// Adds the next-event estimates of vertex `vertex` (1 for the first) to `sums`: arriving
-    /// from `v` with throughput `throughput` at `ln C1 = log_c1`.
+    /// from `v` with throughput `throughput` (Fresnel-weighted if [`Self::has_fresnel`]) at
+    /// `ln C1 = log_c1`; the reflection towards `o` picks up the Fresnel factor at the half
+    /// vector's cosine `v.m = sqrt((1 + v.o) / 2)`.
     #[allow(clippy::too_many_arguments)]
     pub fn add<N: MicrofacetDistribution>(
         &self,
@@ -144,7 +158,11 @@ impl LobeTargets {
             } else {
                 (lambda * log_c1).exp()
             };
-            weight * d * escape
+            let reflectance = self
+                .fresnel
+                .as_ref()
+                .map_or(1.0, |f| reflectance_at_half(f, v, o));
+            weight * d * escape * reflectance
         };
         let (fixed, averaged) = sums.split_at_mut(self.fixed.len());
         for (sum, &(o, lambda)) in fixed.iter_mut().zip(&self.fixed) {
@@ -170,14 +188,16 @@ pub fn single_scattering<N: MicrofacetDistribution>(ndf: &N, i: Vec3, o: Vec3) -
     d / (4.0 * i.z * o.z * (1.0 + ndf.lambda(i) + ndf.lambda(o)))
 }
 
-/// [`single_scattering`] averaged over the exit's azimuth (midpoint rule on `[0, pi]` with
-/// `nodes` nodes: the lobe is even and periodic in the azimuth, so the rule converges
-/// geometrically once it resolves the specular peak, about `alpha` wide).
+/// [`single_scattering`] times `fresnel`'s first channel at the half vector's cosine, averaged
+/// over the exit's azimuth (midpoint rule on `[0, pi]` with `nodes` nodes: the lobe is even and
+/// periodic in the azimuth, so the rule converges geometrically once it resolves the specular
+/// peak, about `alpha` wide).
 #[must_use]
 pub fn single_scattering_averaged<N: MicrofacetDistribution>(
     ndf: &N,
     mu_i: f64,
     mu_o: f64,
+    fresnel: &Fresnel,
     nodes: usize,
 ) -> f64 {
     let i = Vec3::from_mu(mu_i);
@@ -185,8 +205,19 @@ pub fn single_scattering_averaged<N: MicrofacetDistribution>(
     (0..nodes)
         .map(|k| {
             let phi = PI * (k as f64 + 0.5) / nodes as f64;
-            single_scattering(ndf, i, Vec3::new(s * phi.cos(), s * phi.sin(), mu_o))
+            let o = Vec3::new(s * phi.cos(), s * phi.sin(), mu_o);
+            single_scattering(ndf, i, o) * reflectance_at_half(fresnel, i, o)
         })
         .sum::<f64>()
         / nodes as f64
+}
+
+/// `fresnel`'s first channel at the cosine of `i` and the half vector of `i` and `o`,
+/// `sqrt((1 + i.o) / 2)` (1 for [`Fresnel::None`]).
+#[must_use]
+pub fn reflectance_at_half(fresnel: &Fresnel, i: Vec3, o: Vec3) -> f64 {
+    match fresnel {
+        Fresnel::None => 1.0,
+        f => f.reflectance((0.5 * (1.0 + i.dot(o))).max(0.0).sqrt())[0],
+    }
 }

@@ -148,6 +148,8 @@ pub enum WalkError {
     Azimuth(f64),
     /// More exit directions than a walk evaluates at each vertex, or none.
     Directions(usize),
+    /// kiln's lobe asked for without the table its `M_avg` comes from.
+    KilnLobeTable,
 }
 
 impl std::fmt::Display for WalkError {
@@ -202,6 +204,12 @@ impl std::fmt::Display for WalkError {
                 "exit azimuth {} degrees is out of range [0, 180] (the lobe is even in the \
                  azimuth)",
                 shown(phi.to_degrees())
+            ),
+            WalkError::KilnLobeTable => write!(
+                f,
+                "kiln's lobe divides by M_avg, which comes from its baked table: give --table \
+                 FILE (kiln compensation --bake DIR writes it), or measure kulla-conty and \
+                 turquin only"
             ),
             WalkError::Directions(n) => write!(
                 f,
@@ -411,14 +419,16 @@ pub struct LobeEstimate {
     pub walks: u64,
 }
 
-/// Walks as [`walk_albedo`] from the view `mu` and estimates the lobe (`F = 1`) of the first
-/// and of every later order at `grid`'s exit directions by next-event estimation
-/// ([`lobe`]). A mirror's lobe is a delta and is refused.
+/// Walks as [`walk_albedo`] from the view `mu` and estimates the lobe of the first and of every
+/// later order at `grid`'s exit directions by next-event estimation ([`lobe`]), with
+/// `fresnel` at every vertex (its first channel; [`Fresnel::None`] for `F = 1`). A mirror's
+/// lobe is a delta and is refused.
 pub fn walk_lobe(
     model: Model,
     alpha: f64,
     mu: f64,
     grid: &lobe::LobeGrid,
+    fresnel: &Fresnel,
     settings: &WalkSettings,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Result<LobeEstimate, WalkError> {
@@ -444,7 +454,7 @@ pub fn walk_lobe(
         model,
         alpha,
         mu,
-        &Fresnel::None,
+        fresnel,
         None,
         Some(grid),
         0,
@@ -494,7 +504,7 @@ fn run(
     }
     let ndf = Ggx { alpha };
     let wi = Vec3::from_mu(mu);
-    let targets = lobe.map(|grid| lobe::LobeTargets::new(&ndf, grid));
+    let targets = lobe.map(|grid| lobe::LobeTargets::new(&ndf, grid, fresnel));
     let lobe_slots = targets.as_ref().map_or(0, lobe::LobeTargets::slots);
     let asked = conductor::Asked {
         fresnel,
