@@ -50,7 +50,12 @@ fn integrate(a: f64, b: f64, pieces: usize, rule: &[(f64, f64)], f: impl Fn(f64)
     sum
 }
 
-fn e_quadrature<N: MicrofacetDistribution>(ndf: N, masking: Masking, mu: f64) -> f64 {
+fn e_quadrature<N: MicrofacetDistribution>(
+    ndf: N,
+    masking: Masking,
+    mu: f64,
+    weight: &dyn Fn(f64) -> f64,
+) -> f64 {
     let alpha = ndf.alpha();
     let o = Vec3::from_mu(mu);
     let lambda_o = ndf.lambda(o);
@@ -73,7 +78,7 @@ fn e_quadrature<N: MicrofacetDistribution>(ndf: N, masking: Masking, mu: f64) ->
             }
             // dω_m = sin dtheta dphi, dtheta = cos^2 tan dx.
             let jacobian = sin_t * cos_t * cos_t * tan;
-            ndf.d(cos_t) * masking.g2(lambda_o, ndf.lambda(i)) * om / mu * jacobian
+            ndf.d(cos_t) * masking.g2(lambda_o, ndf.lambda(i)) * om / mu * jacobian * weight(om)
         })
     };
     2.0 * integrate(0.0, PI, 16, &rule, inner)
@@ -82,9 +87,21 @@ fn e_quadrature<N: MicrofacetDistribution>(ndf: N, masking: Masking, mu: f64) ->
 /// `E(mu)` by deterministic quadrature, accurate to about 1e-9 for `mu >= 0.02` and
 /// `alpha >= 0.05` (it reproduces docs/physics.md's eight-digit check values).
 pub fn reference_e(model: Model, alpha: f64, mu: f64) -> f64 {
+    reference_weighted_e(model, alpha, mu, &|_| 1.0)
+}
+
+/// `E` with the integrand weighted by `weight(o.m)` (a Fresnel factor at the facet's cosine, or
+/// a split-sum weight), by the same quadrature and to the same accuracy as [`reference_e`].
+#[allow(dead_code)] // not every test binary that includes this module weights E
+pub fn reference_weighted_e(
+    model: Model,
+    alpha: f64,
+    mu: f64,
+    weight: &dyn Fn(f64) -> f64,
+) -> f64 {
     match model.ndf {
-        Ndf::Ggx => e_quadrature(Ggx { alpha }, model.masking, mu),
-        Ndf::Beckmann => e_quadrature(Beckmann { alpha }, model.masking, mu),
+        Ndf::Ggx => e_quadrature(Ggx { alpha }, model.masking, mu, weight),
+        Ndf::Beckmann => e_quadrature(Beckmann { alpha }, model.masking, mu, weight),
     }
 }
 
