@@ -314,8 +314,7 @@ fn fresnel_weighted_tables_bake_for_the_model_named() {
         let mu = mu.unwrap();
         if mu >= 0.02 && alpha >= 0.05 {
             let fresnel = |c: f64| kiln::model::fresnel::dielectric(1.5, c);
-            let independent =
-                common::reference_weighted_e(outside.spec.model, alpha, mu, &fresnel);
+            let independent = common::reference_weighted_e(outside.spec.model, alpha, mu, &fresnel);
             assert!(
                 (outside.value[k] - independent).abs() <= 1e-6 + 1e-9,
                 "texel {k}: {} vs {independent}",
@@ -374,4 +373,3 @@ fn fresnel_weighted_tables_bake_for_the_model_named() {
         assert!(error.contains(needle), "{needle}: {error}");
     }
 }
-

@@ -66,37 +66,43 @@ proptest! {
         ..ProptestConfig::default()
     })]
 
-    /// Both estimators: finite, `E` and `1 - E` in [0, 1] and summing to 1.
+    /// Both estimators finite; the reference's `E` and `1 - E` (integrated separately) in
+    /// [0, 1] and summing to 1 within the 1e-10 it promises (its error estimate is not a strict
+    /// bound: at a 1e-9 tolerance, Beckmann at alpha 1, mu 0.414 has the two 1.9e-9 apart with
+    /// an estimate of 4.9e-10). QMC derives `E` from `1 - E` and clamps it to [0, 1], so its
+    /// range and sum hold by construction and are not asserted; its value is checked against
+    /// the reference at the hard points below.
     #[test]
     fn albedo_is_finite_and_bounded(alpha in alpha(), mu in mu()) {
         for model in models() {
             let q = albedo(model, alpha, mu, &small_qmc());
             let r = reference_albedo(model, alpha, mu, &ReferenceSettings::default());
-            // QMC derives E from 1 - E; the reference integrates both, each to within the 1e-10
-            // it promises (its error estimate is not a strict bound: at a 1e-9 tolerance,
-            // Beckmann at alpha 1, mu 0.414 has the two 1.9e-9 apart with an estimate of 4.9e-10).
-            for (what, value, one_minus, apart) in [
-                ("qmc", q.value, q.one_minus_value, 0.0),
-                ("reference", r.value, r.one_minus_value, 1e-10 + 2.0 * r.error),
-            ] {
-                prop_assert!(
-                    value.is_finite() && (0.0..=1.0).contains(&value)
-                        && (0.0..=1.0).contains(&one_minus),
-                    "{what} {model:?} alpha {alpha:e} mu {mu:e}: {value} {one_minus}"
-                );
-                prop_assert!((value + one_minus - 1.0).abs() <= apart + 2.0 * f64::EPSILON, "{what} {model:?}: {value} + {one_minus} - 1 = {:e} ({apart:e})", value + one_minus - 1.0);
-            }
+            prop_assert!(
+                q.value.is_finite() && q.one_minus_value.is_finite(),
+                "qmc {model:?} alpha {alpha:e} mu {mu:e}: {} {}", q.value, q.one_minus_value
+            );
+            prop_assert!(
+                r.value.is_finite() && (0.0..=1.0).contains(&r.value)
+                    && (0.0..=1.0).contains(&r.one_minus_value),
+                "reference {model:?} alpha {alpha:e} mu {mu:e}: {} {}", r.value, r.one_minus_value
+            );
+            let apart = 1e-10 + 2.0 * r.error;
+            prop_assert!(
+                (r.value + r.one_minus_value - 1.0).abs() <= apart + 2.0 * f64::EPSILON,
+                "reference {model:?}: {} + {} - 1 = {:e} ({apart:e})",
+                r.value, r.one_minus_value, r.value + r.one_minus_value - 1.0
+            );
             prop_assert!(q.std_error.is_finite() && q.std_error >= 0.0);
             prop_assert!(r.error.is_finite() && r.error >= 0.0);
         }
     }
 
-    /// `E_avg` by QMC: finite and bounded everywhere.
+    /// `E_avg` by QMC: finite everywhere (its range is clamped, so not asserted).
     #[test]
     fn average_albedo_is_finite_and_bounded(alpha in alpha()) {
         for model in models() {
             let a = average_albedo(model, alpha, &small_qmc());
-            prop_assert!((0.0..=1.0).contains(&a.value) && (0.0..=1.0).contains(&a.one_minus_value));
+            prop_assert!(a.value.is_finite() && a.one_minus_value.is_finite());
             prop_assert!(a.std_error.is_finite());
         }
     }
@@ -126,8 +132,22 @@ proptest! {
             let sampled = albedo(model, alpha, 0.0, &small_qmc());
             match model.masking {
                 Masking::HeightCorrelated => {
+                    // mu = 0 itself is answered by a shortcut (albedo_is_exactly_one); the limit
+                    // is checked through the integration: deep inside the grazing layer
+                    // (mu = 1e-6 min(alpha, 1)), 1 - E is below 1e-4 at every alpha up to 4
+                    // (5.1e-5 at alpha 4, GGX), where the layer's own scale (mu = alpha) loses
+                    // about 0.108.
                     prop_assert_eq!(grazing.value, 1.0);
                     prop_assert_eq!(sampled.value, 1.0);
+                    if alpha > 0.0 {
+                        let deep = 1e-6 * alpha.min(1.0);
+                        let limit = reference_albedo(model, alpha, deep, &quick_reference());
+                        prop_assert!(
+                            limit.one_minus_value <= 1e-4,
+                            "{model:?} alpha {alpha:e}: 1 - E({deep:e}) = {:e}",
+                            limit.one_minus_value
+                        );
+                    }
                 }
                 Masking::Separable => {
                     prop_assert!(grazing.value < 1.0 && sampled.value < 1.0, "{model:?} {alpha:e}");

@@ -93,12 +93,7 @@ pub fn reference_e(model: Model, alpha: f64, mu: f64) -> f64 {
 /// `E` with the integrand weighted by `weight(o.m)` (a Fresnel factor at the facet's cosine, or
 /// a split-sum weight), by the same quadrature and to the same accuracy as [`reference_e`].
 #[allow(dead_code)] // not every test binary that includes this module weights E
-pub fn reference_weighted_e(
-    model: Model,
-    alpha: f64,
-    mu: f64,
-    weight: &dyn Fn(f64) -> f64,
-) -> f64 {
+pub fn reference_weighted_e(model: Model, alpha: f64, mu: f64, weight: &dyn Fn(f64) -> f64) -> f64 {
     match model.ndf {
         Ndf::Ggx => e_quadrature(Ggx { alpha }, model.masking, mu, weight),
         Ndf::Beckmann => e_quadrature(Beckmann { alpha }, model.masking, mu, weight),
