@@ -30,7 +30,11 @@ pub enum Outcome {
 }
 
 /// `v` as an f16, clamped into f16's finite non-zero range if it would overflow or underflow.
-/// Goes through f32 (whose rounding to f16 is the same on every CPU). NaN stays NaN.
+/// Rounded once, directly from f64, to nearest with ties to even (IEEE 754, so the same on
+/// every CPU): rounding through f32 first rounded twice, and a value within f32's half step of
+/// an f16 tie landed on the tie and went to the even side, one f16 step from the nearest
+/// (1.4477539513 stored as 1.447265625, not 1.4482421875; tests/f16_rounding.rs). NaN stays
+/// NaN.
 #[must_use]
 pub fn encode(v: f64) -> (f16, Outcome) {
     let magnitude = v.abs();
@@ -40,7 +44,7 @@ pub fn encode(v: f64) -> (f16, Outcome) {
     if magnitude > MAX {
         return (f16::from_f64(MAX.copysign(v)), Outcome::Clamped);
     }
-    let h = f16::from_f32(v as f32);
+    let h = nearest(v);
     if h.to_f32() == 0.0 {
         return (f16::from_f64(MIN_SUBNORMAL.copysign(v)), Outcome::Clamped);
     }
@@ -50,6 +54,31 @@ pub fn encode(v: f64) -> (f16, Outcome) {
         Outcome::Exact
     };
     (h, outcome)
+}
+
+/// The f16 nearest to `v` (finite, at most [`MAX`] in magnitude), ties to even: `half`'s
+/// conversions go through f32 (and F16C's through f32 in hardware), which rounds twice; the
+/// result is within one f16 step of the nearest, so the nearest of it and its two neighbours
+/// (distances exact in f64, the values being close) is the correctly rounded one.
+fn nearest(v: f64) -> f16 {
+    let first = f16::from_f32(v as f32);
+    let bits = first.to_bits();
+    let mut best = (first, (first.to_f64() - v).abs());
+    for neighbour in [bits.wrapping_sub(1), bits.wrapping_add(1)] {
+        let candidate = f16::from_bits(neighbour);
+        // Stay finite and on the same side of zero (0x0000 - 1 and 0x8000 - 1 are NaNs).
+        if !candidate.is_finite()
+            || (candidate.is_sign_negative() != first.is_sign_negative()
+                && candidate.to_f64() != 0.0)
+        {
+            continue;
+        }
+        let distance = (candidate.to_f64() - v).abs();
+        if distance < best.1 || (distance == best.1 && neighbour & 1 == 0) {
+            best = (candidate, distance);
+        }
+    }
+    best.0
 }
 
 /// The value a reader of the f16 file gets back for `v` ([`encode`], widened).
