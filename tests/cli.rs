@@ -3,6 +3,9 @@
 
 #![cfg(feature = "cli")]
 
+#[path = "common/f16_oracle.rs"]
+mod f16_oracle;
+
 use kiln::format::{binary, exr, json::Sidecar};
 use std::path::Path;
 use std::process::{Command, Output};
@@ -515,19 +518,12 @@ fn outputs_agree_with_each_other_and_round_trip() {
             let reference = &sidecar.data[q.as_str()];
             let one_minus = &sidecar.data[&format!("one_minus_{q}")];
             let std_error = &sidecar.data["std_error"];
-            // What a value becomes in storage: f32, or f16 rounded to nearest (the half crate),
-            // with kiln's documented rule that a non-zero value is never flushed to zero but
-            // kept as the smallest subnormal.
+            // What a value becomes in storage: f32, or f16 rounded to nearest even (the tests'
+            // own rounding, tests/common/f16_oracle.rs), with kiln's documented rule that a
+            // non-zero value is never flushed to zero but kept as the smallest subnormal.
             let stored = |v: f64| match precision {
                 "f32" => f64::from(v as f32),
-                _ => {
-                    let h = half::f16::from_f64(v);
-                    if h.to_f32() == 0.0 && v != 0.0 {
-                        f64::from(half::f16::from_bits(1).to_f32()).copysign(v)
-                    } else {
-                        f64::from(h.to_f32())
-                    }
-                }
+                _ => f16_oracle::oracle(v),
             };
             // f16: nothing non-zero is stored as zero, and the metadata counts what was clamped
             // (recounted here independently: values that plain rounding would flush to zero).
@@ -539,7 +535,7 @@ fn outputs_agree_with_each_other_and_round_trip() {
                 ] {
                     let flushed = values
                         .iter()
-                        .filter(|&&v| v != 0.0 && half::f16::from_f32(v as f32).to_f32() == 0.0)
+                        .filter(|&&v| v != 0.0 && f16_oracle::round_nearest_even(v) == 0.0)
                         .count();
                     assert_eq!(storage[&name].clamped, flushed, "{id} {name}");
                     assert!(

@@ -5,46 +5,11 @@
 //! f64 step either side of a tie (where rounding through f32 first rounds twice and can land
 //! on the tie), subnormals and the range's edges.
 
-use kiln::format::f16::{MAX, MIN_SUBNORMAL, stored};
+#[path = "common/f16_oracle.rs"]
+mod f16_oracle;
 
-/// `v` rounded to the nearest f16 (ties to even), with kiln's clamps, computed by hand.
-fn oracle(v: f64) -> f64 {
-    if v == 0.0 || v.is_nan() {
-        return v;
-    }
-    let magnitude = v.abs();
-    if magnitude > MAX {
-        return MAX.copysign(v);
-    }
-    // The spacing of f16 values at this magnitude: 2^(e - 10) for a normal value with
-    // 2^e <= |v| < 2^(e + 1), 2^-24 below 2^-14.
-    let exponent = magnitude.log2().floor().max(-14.0);
-    // log2 can be one off at powers of two: fix e so that 2^e <= |v| (for normal values).
-    let exponent = if exponent > -14.0 && 2f64.powf(exponent) > magnitude {
-        exponent - 1.0
-    } else if exponent >= -14.0 && 2f64.powf(exponent + 1.0) <= magnitude {
-        exponent + 1.0
-    } else {
-        exponent
-    };
-    let spacing = 2f64.powf(exponent - 10.0);
-    let q = magnitude / spacing; // exact: a power-of-two scaling
-    let floor = q.floor();
-    let rest = q - floor;
-    let rounded = if rest > 0.5 || (rest == 0.5 && floor % 2.0 == 1.0) {
-        floor + 1.0
-    } else {
-        floor
-    };
-    let result = rounded * spacing;
-    if result > MAX {
-        return MAX.copysign(v);
-    }
-    if result == 0.0 {
-        return MIN_SUBNORMAL.copysign(v);
-    }
-    result.copysign(v)
-}
+use f16_oracle::oracle;
+use kiln::format::f16::{MAX, MIN_SUBNORMAL, stored};
 
 fn check(v: f64) {
     let want = oracle(v);
