@@ -73,16 +73,57 @@ fn shapes_axes_and_measured_errors() {
     }
 }
 
-/// `F_avg(eta)` holds the Fresnel average at each axis value, and the smooth row (`r = 0`) of
-/// the average tables holds 1 (no energy lost by a smooth interface).
+/// The hemispherical average `2 ∫ F(mu) mu dmu` of the unpolarised Fresnel reflectance of a
+/// dielectric seen from the less dense side, in closed form (relative index `n > 1`; e.g.
+/// d'Eon and Irving 2011, "A quantized-diffusion model for rendering translucent materials",
+/// after Egan and Hilgeman 1979), written here independently of kiln's quadrature; checked in
+/// Python against a 400000-point midpoint rule to 4e-9 at n = 1.1 to 3 (2026-12-07). From the
+/// dense side (`eta = 1 / n`) energy conservation and reciprocity give
+/// `1 - F_avg(1 / n) = (1 - F_avg(n)) / n^2`.
+fn f_avg_closed_form(eta: f64) -> f64 {
+    let outside = |n: f64| {
+        let (n2, n4) = (n * n, n.powi(4));
+        0.5 + (n - 1.0) * (3.0 * n + 1.0) / (6.0 * (n + 1.0).powi(2))
+            + n2 * (n2 - 1.0).powi(2) / (n2 + 1.0).powi(3) * ((n - 1.0) / (n + 1.0)).ln()
+            - 2.0 * n.powi(3) * (n2 + 2.0 * n - 1.0) / ((n2 + 1.0) * (n4 - 1.0))
+            + 8.0 * n4 * (n4 + 1.0) / ((n2 + 1.0) * (n4 - 1.0).powi(2)) * n.ln()
+    };
+    if eta >= 1.0 {
+        outside(eta)
+    } else {
+        1.0 - (1.0 - outside(1.0 / eta)) * eta * eta
+    }
+}
+
+/// `F_avg(eta)` at each axis value against the closed form (its terms cancel near `eta = 1`,
+/// where it holds only to about 1e-7 at `eta = 1.01`), and the smooth row (`r = 0`) of the
+/// average tables holds 1 (no energy lost by a smooth interface).
 #[test]
 fn f_avg_and_the_smooth_limit() {
     let f_avg = table(Quantity::FAvg);
     for k in 0..f_avg.spec.len() {
         let eta = f_avg.spec.texel_eta(k).unwrap();
-        let expected = Fresnel::Dielectric { eta }.average()[0];
-        assert!((f_avg.value[k] - expected).abs() < 1e-13);
-        assert!((f_avg.one_minus_value[k] - (1.0 - expected)).abs() < 1e-13);
+        let n = eta.max(1.0 / eta);
+        if n == 1.0 {
+            assert_eq!(f_avg.value[k], 0.0, "eta 1: an interface that is not there");
+            continue;
+        }
+        let expected = f_avg_closed_form(eta);
+        let tolerance = if n >= 1.05 { 1e-12 } else { 1e-6 };
+        assert!(
+            (f_avg.value[k] - expected).abs() < tolerance,
+            "eta {eta}: {} vs {expected}",
+            f_avg.value[k]
+        );
+        assert!((f_avg.one_minus_value[k] - (1.0 - expected)).abs() < tolerance);
+    }
+    // Beyond the table's axis values, the function the bake calls, at both sides.
+    for eta in [1.05, 1.2, 1.33, 1.5, 2.0, 2.5, 3.0] {
+        for e in [eta, 1.0 / eta] {
+            let got = Fresnel::Dielectric { eta: e }.average()[0];
+            let want = f_avg_closed_form(e);
+            assert!((got - want).abs() < 1e-12, "eta {e}: {got} vs {want}");
+        }
     }
     for quantity in [Quantity::EAvgDielectric, Quantity::EAvgDielectricInside] {
         let t = table(quantity);

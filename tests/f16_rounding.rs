@@ -9,7 +9,7 @@
 mod f16_oracle;
 
 use f16_oracle::oracle;
-use kiln::format::f16::{MAX, MIN_SUBNORMAL, stored};
+use kiln::format::f16::{MIN_SUBNORMAL, stored};
 
 fn check(v: f64) {
     let want = oracle(v);

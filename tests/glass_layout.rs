@@ -287,7 +287,9 @@ fn near_eta_1_the_glass_layout_follows_the_albedo() {
         "near eta = 1: glass layout {:.2e}, product grid {:.2e}",
         worst[0], worst[1]
     );
-    assert!(worst[0] < 0.1, "glass layout: {:.3e}", worst[0]);
+    // Measured 3.95e-2 (product grid 0.784) at 8 x 8 x 8, 2026-12-07: the bound is the
+    // measurement and a margin, not ten percent.
+    assert!(worst[0] < 0.05, "glass layout: {:.3e}", worst[0]);
     assert!(worst[1] > 3.0 * worst[0], "{worst:?}");
 }
 
