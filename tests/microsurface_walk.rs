@@ -7,6 +7,9 @@
 
 #[path = "common/rng.rs"]
 mod rng;
+#[cfg(feature = "cli")]
+#[path = "common/rustc.rs"]
+mod rustc;
 
 use kiln::integrate::reference::{ReferenceSettings, reference_albedo};
 use kiln::integrate::walk::lobe::LobeGrid;
@@ -980,4 +983,79 @@ fn the_lobe_with_fresnel_is_the_chain() {
             );
         }
     }
+}
+
+/// The compensation's generated Rust (`--format rs`), compiled with rustc and run in f32: its
+/// coefficients, `M`, `M_avg` and lobe against the library's f64 lookups of the same table at
+/// points inside cells, on texel rows and at the edges.
+#[cfg(feature = "cli")]
+#[test]
+fn the_generated_rust_compensation_agrees_with_the_library() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("tables");
+    let baked = std::process::Command::new(env!("CARGO_BIN_EXE_kiln"))
+        .args(["compensation", "--bake"])
+        .arg(&out)
+        .args([
+            "--size", "8", "--walks", "2^10", "--format", "json,rs", "-q",
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        baked.status.success(),
+        "{}",
+        String::from_utf8_lossy(&baked.stderr)
+    );
+    let stem = "ggx-height-correlated-kiln-compensation";
+    let table = kiln::format::compensation::decode(
+        &std::fs::read(out.join(format!("{stem}.json"))).unwrap(),
+        stem,
+    )
+    .unwrap();
+    let points = [
+        (0.0, 0.3, 0.02),
+        (0.013, 0.27, 0.3),
+        (0.2, 0.5, 0.955),
+        (0.37, 0.81, 0.5),
+        (0.5, 1.0, 0.04),
+        (0.92, 0.64, 0.8),
+        (1.0, 0.4, 0.3),
+    ];
+    let s = stem.replace('-', "_");
+    let mut program = std::fs::read_to_string(out.join(format!("{stem}.rs"))).unwrap();
+    program += "\nfn main() {\n";
+    for (mu, r, f0) in points {
+        program += &format!(
+            "    let c = {s}_coefficients({mu:?}, {r:?});\n\
+             let ci = {s}_coefficients(0.61, {r:?});\n\
+             let m = {s}_albedo(c, [{f0:?}, 1.0, 0.5]);\n\
+             let m_avg = {s}_albedo({s}_average({r:?}), [{f0:?}, 1.0, 0.5]);\n\
+             let lobe = {s}_lobe(m, {s}_albedo(ci, [{f0:?}, 1.0, 0.5]), m_avg);\n\
+             for v in c.iter().chain(&m).chain(&m_avg).chain(&lobe) {{ println!(\"{{v:e}}\"); }}\n"
+        );
+    }
+    program += "}\n";
+    let printed = rustc::compile_and_run(dir.path(), "compensation", &program);
+    let mut values = printed.into_iter();
+    for (mu, r, f0) in points {
+        let c = table.lookup(mu, r);
+        let ci = table.lookup(0.61, r);
+        let average = table.lookup_average(r);
+        let f0s = [f0, 1.0, 0.5];
+        let mut expected: Vec<(f64, f64)> = c.coefficients.iter().map(|&v| (v, 2e-6)).collect();
+        expected.extend(f0s.iter().map(|&f| (c.multiple(f), 2e-6)));
+        expected.extend(f0s.iter().map(|&f| (average.multiple(f), 2e-6)));
+        expected.extend(f0s.iter().map(|&f| {
+            let lobe = c.multiple(f) * ci.multiple(f) / (PI * average.multiple(f).max(1e-30));
+            (lobe, 1e-5)
+        }));
+        for (want, tolerance) in expected {
+            let got = values.next().expect("as many numbers as asked for");
+            assert!(
+                (got - want).abs() <= tolerance * (1.0 + want.abs()),
+                "at mu {mu}, r {r}, F0 {f0}: generated {got:e}, library {want:e}"
+            );
+        }
+    }
+    assert!(values.next().is_none());
 }

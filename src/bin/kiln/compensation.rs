@@ -53,13 +53,14 @@ pub struct CompensationArgs {
     bake: Option<std::path::PathBuf>,
     /// With --bake: the files to write, comma-separated: json (the checked document every
     /// audit reads), ktx2 and dds (the coefficients as an RGBA32F texture over the E layout),
-    /// wgsl, glsl and hlsl (the lookup, M(mu, F0) and the lobe).
+    /// wgsl, glsl and hlsl (the texture's lookup, M(mu, F0) and the lobe), rs (the coefficients
+    /// as arrays with the same functions in f32).
     #[arg(
         long,
         value_enum,
         value_delimiter = ',',
         requires = "bake",
-        default_value = "json,ktx2,dds,wgsl,glsl,hlsl"
+        default_value = "json,ktx2,dds,wgsl,glsl,hlsl,rs"
     )]
     format: Vec<CompensationFormat>,
     /// With --bake: the E layout's size (size x size texels, kiln's default layout).
@@ -107,6 +108,7 @@ enum CompensationFormat {
     Wgsl,
     Glsl,
     Hlsl,
+    Rs,
 }
 
 /// `kiln compensation --bake DIR`.
@@ -181,6 +183,10 @@ fn bake(args: &CompensationArgs, out: &std::path::Path) -> kiln::Result<()> {
             CompensationFormat::Hlsl => (
                 "hlsl",
                 encode_compensation(&table, Language::Hlsl, &command).into_bytes(),
+            ),
+            CompensationFormat::Rs => (
+                "rs",
+                kiln::format::rust::encode_compensation(&table, &command).into_bytes(),
             ),
         };
         files.push((format!("{stem}.{extension}"), bytes));
