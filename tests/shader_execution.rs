@@ -467,3 +467,91 @@ fn generated_compensation_shaders_run_and_agree_with_the_library() {
         assert!(values.next().is_none());
     }
 }
+
+/// kiln's compensation as a C/C++ header (`--format h`), compiled and run: the texels
+/// interleaved as the RGBA texture (every coefficient of the document, in f32), `M_avg`'s, and
+/// the basis, albedo and lobe functions against the library's `KilnCompensation::multiple` at
+/// every texel.
+#[test]
+fn the_compensation_header_holds_the_table_and_its_functions() {
+    if cxx::compiler_or_skip("the_compensation_header_holds_the_table_and_its_functions").is_none()
+    {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("tables");
+    let baked = Command::new(env!("CARGO_BIN_EXE_kiln"))
+        .args(["compensation", "--bake"])
+        .arg(&out)
+        .args(["--size", "6", "--walks", "2^10", "--format", "json,h", "-q"])
+        .output()
+        .unwrap();
+    assert!(
+        baked.status.success(),
+        "{}",
+        String::from_utf8_lossy(&baked.stderr)
+    );
+    let stem = "ggx-height-correlated-kiln-compensation";
+    let table = kiln::format::compensation::decode(
+        &std::fs::read(out.join(format!("{stem}.json"))).unwrap(),
+        stem,
+    )
+    .unwrap();
+    let s = stem.replace('-', "_");
+    let c = s.to_uppercase();
+    let n = table.spec.len();
+    let m = table.average_spec.len();
+    let mut source = format!(
+        "#include <cstdio>\n{}\nint main() {{\n",
+        std::fs::read_to_string(out.join(format!("{stem}.h"))).unwrap()
+    );
+    let _ = writeln!(
+        source,
+        "    for (int k = 0; k < {}; ++k) printf(\"%.9g\\n\", {c}[k]);\n    \
+         for (int k = 0; k < {}; ++k) printf(\"%.9g\\n\", {c}_AVERAGE[k]);\n    \
+         for (int k = 0; k < {n}; ++k) {{ const float* t = &{c}[4 * k]; const float* a = \
+         &{c}_AVERAGE[4 * (k / {})];\n        float mo = {s}_albedo(t, 0.3f), mi = {s}_albedo(&{c}[0], \
+         0.3f), ma = {s}_albedo(a, 0.3f);\n        printf(\"%.9g\\n%.9g\\n\", {s}_albedo(t, 0.9f), \
+         {s}_lobe(mo, mi, ma)); }}\n    return 0;\n}}",
+        4 * n,
+        4 * m,
+        table.spec.shape()[1]
+    );
+    let printed = cxx::compile_and_run(dir.path(), "header", &source);
+    let mut values = printed.into_iter();
+    let mut next = || values.next().expect("as many numbers as asked for");
+    for k in 0..n {
+        for j in 0..4 {
+            // %.9g round-trips an f32.
+            assert_eq!(next() as f32, table.coefficients[j][k] as f32, "c_{j}[{k}]");
+        }
+    }
+    for k in 0..m {
+        for j in 0..4 {
+            assert_eq!(
+                next() as f32,
+                table.average[j][k] as f32,
+                "average c_{j}[{k}]"
+            );
+        }
+    }
+    let at =
+        |coefficients: &[Vec<f64>; 4], k: usize| kiln::integrate::compensation::KilnCompensation {
+            coefficients: std::array::from_fn(|j| coefficients[j][k]),
+        };
+    let columns = table.spec.shape()[1];
+    for k in 0..n {
+        let texel = at(&table.coefficients, k);
+        let average = at(&table.average, k / columns);
+        let want_albedo = texel.multiple(0.9);
+        let want_lobe = texel.multiple(0.3) * at(&table.coefficients, 0).multiple(0.3)
+            / (std::f64::consts::PI * average.multiple(0.3).max(1e-30));
+        for (want, tolerance) in [(want_albedo, 2e-6), (want_lobe, 1e-5)] {
+            let got = next();
+            assert!(
+                (got - want).abs() <= tolerance * (1.0 + want.abs()),
+                "texel {k}: header {got:e}, library {want:e}"
+            );
+        }
+    }
+}

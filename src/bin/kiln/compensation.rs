@@ -54,13 +54,14 @@ pub struct CompensationArgs {
     /// With --bake: the files to write, comma-separated: json (the checked document every
     /// audit reads), ktx2 and dds (the coefficients as an RGBA32F texture over the E layout),
     /// wgsl, glsl and hlsl (the texture's lookup, M(mu, F0) and the lobe), rs (the coefficients
-    /// as arrays with the same functions in f32).
+    /// as arrays with the same functions in f32), h (a C/C++ header: the texture's texels and
+    /// M_avg's as arrays, the basis, albedo and lobe functions).
     #[arg(
         long,
         value_enum,
         value_delimiter = ',',
         requires = "bake",
-        default_value = "json,ktx2,dds,wgsl,glsl,hlsl,rs"
+        default_value = "json,ktx2,dds,wgsl,glsl,hlsl,rs,h"
     )]
     format: Vec<CompensationFormat>,
     /// With --bake: the E layout's size (size x size texels, kiln's default layout).
@@ -109,6 +110,7 @@ enum CompensationFormat {
     Glsl,
     Hlsl,
     Rs,
+    H,
 }
 
 /// `kiln compensation --bake DIR`.
@@ -187,6 +189,10 @@ fn bake(args: &CompensationArgs, out: &std::path::Path) -> kiln::Result<()> {
             CompensationFormat::Rs => (
                 "rs",
                 kiln::format::rust::encode_compensation(&table, &command).into_bytes(),
+            ),
+            CompensationFormat::H => (
+                "h",
+                kiln::format::c_header::encode_compensation(&table, &command).into_bytes(),
             ),
         };
         files.push((format!("{stem}.{extension}"), bytes));
