@@ -500,7 +500,7 @@ fn uv_function(
 }
 
 /// kiln's compensation (issue 60, [`CompensationTable`]) as shader code: the texture
-/// coordinate of its RGBA texture (the `E` layout's, [`uv_function`]), the coefficients' lookup,
+/// coordinate of its RGBA texture (the `E` layout's, as the `E` table's `_uv`), the coefficients' lookup,
 /// `M_avg`'s coefficients as arrays with their interpolation over the roughness, the basis in
 /// `F0` ([`KilnCompensation::basis`]), the albedo `M(mu, F0)` per channel and the lobe
 /// `M(mu_o) M(mu_i) / (pi M_avg)` ([`crate::table::compensation`]). `command` made the table.
