@@ -1,4 +1,7 @@
-//! The committed Rust tables compile when `include!`d, and hold the JSON sidecar's values.
+//! The committed Rust tables compile when `include!`d, hold the JSON sidecar's values, and their
+//! generated lookup is within the error the sidecar states of the tests' own quadrature.
+
+mod common;
 
 #[allow(dead_code)] // the f_ms_norm file's ONE_MINUS, STD_ERROR and axis constants are not read here
 mod ggx {
@@ -123,4 +126,50 @@ fn generated_normalisation_lookup_matches_the_library() {
             "r {r}: {got} vs {want}"
         );
     }
+}
+
+/// The committed `E` table's generated lookup against the tests' own quadrature of `E`
+/// (tests/common, accurate to 1e-9 for mu >= 0.02 and alpha >= 0.05), at every twentieth point
+/// `verify` audits there: never further than the lookup error the sidecar states
+/// (`lookup_fit.lookup_max_error`), plus f32's few 1e-7. The statement "never smaller than the
+/// truth", checked by an integrator kiln does not use (the comparison with the JSON above only
+/// shows that two of kiln's encoders agree).
+#[test]
+fn the_generated_lookup_is_within_its_stated_error_of_an_independent_integral() {
+    let e = sidecar("ggx-height-correlated-E");
+    let stated = e
+        .metadata
+        .lookup_fit
+        .as_ref()
+        .expect("the default table is fitted")
+        .lookup_max_error;
+    let path = format!(
+        "{}/tables/ggx-height-correlated-E.json",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let table = read_kiln(std::path::Path::new(&path)).unwrap().unwrap();
+    let points = lookup_coordinates(&table.spec, &AuditSettings::default());
+    let mut worst = 0.0f64;
+    let mut checked = 0;
+    for kiln::verify::Coordinates { alpha, mu, .. } in points.into_iter().step_by(20) {
+        let mu = mu.unwrap();
+        if mu < 0.02 || alpha < 0.05 {
+            continue;
+        }
+        let r = alpha.sqrt();
+        let got = f64::from(ggx::ggx_height_correlated_e_lookup(
+            &ggx::GGX_HEIGHT_CORRELATED_E,
+            mu as f32,
+            r as f32,
+        ));
+        let truth = common::reference_e(table.spec.model, alpha, mu);
+        worst = worst.max((got - truth).abs());
+        checked += 1;
+    }
+    assert!(checked > 100, "{checked} points");
+    eprintln!("generated lookup: {worst:.3e} from the independent integral (stated {stated:.3e})");
+    assert!(
+        worst <= stated + 1e-6,
+        "{worst:e} beyond the stated {stated:e}"
+    );
 }
