@@ -5,6 +5,9 @@
 //! reference `E` for the first order at other roughness; the visible-normal density below the
 //! horizon by quadrature; and the walk's own promises (height distributions, thread counts).
 
+#[cfg(feature = "cli")]
+#[path = "common/compensation_bake.rs"]
+mod compensation_bake;
 #[path = "common/rng.rs"]
 mod rng;
 #[cfg(feature = "cli")]
@@ -112,6 +115,14 @@ fn chain(
     }
 }
 
+/// The mean of batch means and its standard error (written here, not kiln's estimator).
+fn batch_stats(means: &[f64]) -> (f64, f64) {
+    let r = means.len() as f64;
+    let mean = means.iter().sum::<f64>() / r;
+    let var = means.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (r * (r - 1.0));
+    (mean, var.sqrt())
+}
+
 /// The chain's orders and albedo over `n` walks, with standard errors from 16 batches.
 fn chain_estimates(mu: f64, f0: f64, orders: usize, n: usize) -> (Vec<(f64, f64)>, (f64, f64)) {
     let batches = 16;
@@ -129,15 +140,9 @@ fn chain_estimates(mu: f64, f0: f64, orders: usize, n: usize) -> (Vec<(f64, f64)
         }
         albedo_means.push(albedo / (n / batches) as f64);
     }
-    let stats = |m: &[f64]| {
-        let r = m.len() as f64;
-        let mean = m.iter().sum::<f64>() / r;
-        let var = m.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (r * (r - 1.0));
-        (mean, var.sqrt())
-    };
     (
-        order_means.iter().map(|m| stats(m)).collect(),
-        stats(&albedo_means),
+        order_means.iter().map(|m| batch_stats(m)).collect(),
+        batch_stats(&albedo_means),
     )
 }
 
@@ -705,15 +710,7 @@ fn chain_lobe(mu: f64, f0: f64, exits: &[f64], n: usize) -> Vec<(f64, f64)> {
             m.push(s / (n / batches) as f64);
         }
     }
-    means
-        .iter()
-        .map(|m| {
-            let r = m.len() as f64;
-            let mean = m.iter().sum::<f64>() / r;
-            let var = m.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (r * (r - 1.0));
-            (mean, var.sqrt())
-        })
-        .collect()
+    means.iter().map(|m| batch_stats(m)).collect()
 }
 
 fn lobe(alpha: f64, mu: f64, grid: &LobeGrid, walks: u64) -> LobeEstimate {
@@ -993,25 +990,8 @@ fn the_lobe_with_fresnel_is_the_chain() {
 fn the_generated_rust_compensation_agrees_with_the_library() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("tables");
-    let baked = std::process::Command::new(env!("CARGO_BIN_EXE_kiln"))
-        .args(["compensation", "--bake"])
-        .arg(&out)
-        .args([
-            "--size", "8", "--walks", "2^10", "--format", "json,rs", "-q",
-        ])
-        .output()
-        .unwrap();
-    assert!(
-        baked.status.success(),
-        "{}",
-        String::from_utf8_lossy(&baked.stderr)
-    );
-    let stem = "ggx-height-correlated-kiln-compensation";
-    let table = kiln::format::compensation::decode(
-        &std::fs::read(out.join(format!("{stem}.json"))).unwrap(),
-        stem,
-    )
-    .unwrap();
+    let table = compensation_bake::bake(&out, "8", "2^10", &["--format", "json,rs"]);
+    let stem = compensation_bake::STEM;
     let points = [
         (0.0, 0.3, 0.02),
         (0.013, 0.27, 0.3),

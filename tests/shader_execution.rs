@@ -21,6 +21,8 @@ use std::fmt::Write as _;
 use std::path::Path;
 use std::process::Command;
 
+#[path = "common/compensation_bake.rs"]
+mod compensation_bake;
 #[path = "common/cxx.rs"]
 mod cxx;
 #[path = "common/external.rs"]
@@ -378,20 +380,8 @@ fn generated_compensation_shaders_run_and_agree_with_the_library() {
     }
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("tables");
-    let baked = Command::new(env!("CARGO_BIN_EXE_kiln"))
-        .args(["compensation", "--bake"])
-        .arg(&out)
-        .args(["--size", "8", "--walks", "2^10", "-q"])
-        .output()
-        .unwrap();
-    assert!(
-        baked.status.success(),
-        "{}",
-        String::from_utf8_lossy(&baked.stderr)
-    );
-    let stem = "ggx-height-correlated-kiln-compensation";
-    let bytes = std::fs::read(out.join(format!("{stem}.json"))).unwrap();
-    let table = kiln::format::compensation::decode(&bytes, stem).unwrap();
+    let table = compensation_bake::bake(&out, "8", "2^10", &[]);
+    let stem = compensation_bake::STEM;
     let [rows, columns] = table.spec.shape()[..] else {
         unreachable!()
     };
@@ -480,23 +470,8 @@ fn the_compensation_header_holds_the_table_and_its_functions() {
     }
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("tables");
-    let baked = Command::new(env!("CARGO_BIN_EXE_kiln"))
-        .args(["compensation", "--bake"])
-        .arg(&out)
-        .args(["--size", "6", "--walks", "2^10", "--format", "json,h", "-q"])
-        .output()
-        .unwrap();
-    assert!(
-        baked.status.success(),
-        "{}",
-        String::from_utf8_lossy(&baked.stderr)
-    );
-    let stem = "ggx-height-correlated-kiln-compensation";
-    let table = kiln::format::compensation::decode(
-        &std::fs::read(out.join(format!("{stem}.json"))).unwrap(),
-        stem,
-    )
-    .unwrap();
+    let table = compensation_bake::bake(&out, "6", "2^10", &["--format", "json,h"]);
+    let stem = compensation_bake::STEM;
     let s = stem.replace('-', "_");
     let c = s.to_uppercase();
     let n = table.spec.len();

@@ -170,6 +170,19 @@ pub fn audit_compensations(
     })
 }
 
+/// The largest and the smallest of `all` by `deviation`, and the root mean square deviation;
+/// `None` for no points.
+fn spread<T: Copy>(all: &[T], deviation: impl Fn(&T) -> f64) -> Option<(T, T, f64)> {
+    let highest = *all
+        .iter()
+        .max_by(|a, b| deviation(a).total_cmp(&deviation(b)))?;
+    let lowest = *all
+        .iter()
+        .min_by(|a, b| deviation(a).total_cmp(&deviation(b)))?;
+    let rms = (all.iter().map(|e| deviation(e).powi(2)).sum::<f64>() / all.len() as f64).sqrt();
+    Some((highest, lowest, rms))
+}
+
 fn summarise(
     points: &[CompensationPoint],
     k: usize,
@@ -186,16 +199,7 @@ fn summarise(
         }
     };
     let all: Vec<Extreme> = points.iter().map(extreme).collect();
-    let highest = *all
-        .iter()
-        .max_by(|a, b| a.deviation.total_cmp(&b.deviation))
-        .expect("a grid has points");
-    let lowest = *all
-        .iter()
-        .min_by(|a, b| a.deviation.total_cmp(&b.deviation))
-        .expect("a grid has points");
-    let rms =
-        (all.iter().map(|e| e.deviation * e.deviation).sum::<f64>() / all.len() as f64).sqrt();
+    let (highest, lowest, rms) = spread(&all, |e| e.deviation).expect("a grid has points");
     CompensationSummary {
         compensation,
         highest,
@@ -476,19 +480,7 @@ pub fn audit_lobes(
                 }
             })
             .collect();
-        if all.is_empty() {
-            return None;
-        }
-        let highest = *all
-            .iter()
-            .max_by(|a, b| a.deviation.total_cmp(&b.deviation))
-            .expect("not empty");
-        let lowest = *all
-            .iter()
-            .min_by(|a, b| a.deviation.total_cmp(&b.deviation))
-            .expect("not empty");
-        let rms =
-            (all.iter().map(|e| e.deviation * e.deviation).sum::<f64>() / all.len() as f64).sqrt();
+        let (highest, lowest, rms) = spread(&all, |e| e.deviation)?;
         let widest_confidence = all.iter().map(|e| e.confidence).fold(0.0, f64::max);
         Some(LobeFigures {
             highest,

@@ -113,15 +113,42 @@ enum CompensationFormat {
     H,
 }
 
+/// The model the walk is written for (GGX, height-correlated masking).
+const MODEL: Model = Model {
+    ndf: Ndf::Ggx,
+    masking: Masking::HeightCorrelated,
+};
+
+impl CompensationArgs {
+    /// The walks' settings: `--walks` (or `default_walks`) and `--seed`, checked.
+    fn walk_settings(&self, default_walks: u64) -> kiln::Result<WalkSettings> {
+        let settings = WalkSettings {
+            walks: self.walks.unwrap_or(default_walks),
+            seed: self.seed,
+            ..WalkSettings::default()
+        };
+        settings.validate()?;
+        Ok(settings)
+    }
+
+    /// The slope-space roughness of `--roughness` (or of `default`, perceptual).
+    fn alphas(&self, default: &[f64]) -> Vec<f64> {
+        let roughness = if self.roughness.is_empty() {
+            default
+        } else {
+            &self.roughness
+        };
+        roughness
+            .iter()
+            .map(|&r| RoughnessConvention::Perceptual.to_alpha(r))
+            .collect()
+    }
+}
+
 /// `kiln compensation --bake DIR`.
 fn bake(args: &CompensationArgs, out: &std::path::Path) -> kiln::Result<()> {
     use kiln::table::compensation::CompensationTable;
-    let settings = WalkSettings {
-        walks: args.walks.unwrap_or(1 << 17),
-        seed: args.seed,
-        ..WalkSettings::default()
-    };
-    settings.validate()?;
+    let settings = args.walk_settings(1 << 17)?;
     kiln::format::check_output_dir(out)?;
     let options = kiln::BakeOptions {
         quantities: vec![kiln::Quantity::E, kiln::Quantity::EAvg],
@@ -156,8 +183,13 @@ fn bake(args: &CompensationArgs, out: &std::path::Path) -> kiln::Result<()> {
     use kiln::format::shader::{Language, encode_compensation};
     let stem = kiln::format::compensation::stem(&table).replace('_', "-");
     let mut files = Vec::new();
-    let mut formats = args.format.clone();
-    formats.dedup();
+    // Each format once, in the order given (`--format json,h,json` writes two files).
+    let mut formats: Vec<CompensationFormat> = Vec::new();
+    for &format in &args.format {
+        if !formats.contains(&format) {
+            formats.push(format);
+        }
+    }
     for format in formats {
         let texture = || kiln::format::compensation::texture(&table);
         let (extension, bytes) = match format {
@@ -229,22 +261,13 @@ pub fn run(args: CompensationArgs) -> kiln::Result<()> {
         args.f0.clone()
     };
     let table = read_table(args.table.as_deref())?;
-    let walks = args.walks.unwrap_or(1 << 20);
     let compensations = if args.compensation.is_empty() {
         Compensation::ALL.to_vec()
     } else {
         args.compensation.clone()
     };
-    let roughness = if args.roughness.is_empty() {
-        vec![0.25, 0.5, 0.75, 1.0]
-    } else {
-        args.roughness.clone()
-    };
     let grid = CompensationGrid {
-        alphas: roughness
-            .iter()
-            .map(|&r| RoughnessConvention::Perceptual.to_alpha(r))
-            .collect(),
+        alphas: args.alphas(&[0.25, 0.5, 0.75, 1.0]),
         mus: args.mu.clone(),
         f0s: f0,
         f90: args.f90,
@@ -252,16 +275,9 @@ pub fn run(args: CompensationArgs) -> kiln::Result<()> {
     if !(0.0..=1.0).contains(&args.f90) {
         return Err(kiln::integrate::walk::WalkError::F90(args.f90).into());
     }
-    let settings = WalkSettings {
-        walks,
-        seed: args.seed,
-        ..WalkSettings::default()
-    };
-    settings.validate()?;
-    let model = Model {
-        ndf: Ndf::Ggx,
-        masking: Masking::HeightCorrelated,
-    };
+    let settings = args.walk_settings(1 << 20)?;
+    let walks = settings.walks;
+    let model = MODEL;
     let views = (grid.alphas.len() * grid.mus.len()) as u64;
     if !args.quiet {
         // About 0.5 s a view per 2^20 walks on two cores, walks and references (measured
@@ -342,13 +358,9 @@ fn read_table(
     };
     let bytes = kiln::format::read_file(path)?;
     let table = kiln::format::compensation::decode(&bytes, &kiln::error::escaped_path(path))?;
-    let model = Model {
-        ndf: Ndf::Ggx,
-        masking: Masking::HeightCorrelated,
-    };
-    if table.spec.model != model {
+    if table.spec.model != MODEL {
         return Err(kiln::Error::InvalidInput(format!(
-            "--table holds kiln's compensation for {}; the walk is {model}",
+            "--table holds kiln's compensation for {}; the walk is {MODEL}",
             table.spec.model
         )));
     }
@@ -369,16 +381,8 @@ fn lobes(args: &CompensationArgs) -> kiln::Result<()> {
     } else {
         args.compensation.clone()
     };
-    let roughness = if args.roughness.is_empty() {
-        vec![0.5, 0.75, 1.0]
-    } else {
-        args.roughness.clone()
-    };
     let grid = LobeAuditGrid {
-        alphas: roughness
-            .iter()
-            .map(|&r| RoughnessConvention::Perceptual.to_alpha(r))
-            .collect(),
+        alphas: args.alphas(&[0.5, 0.75, 1.0]),
         views: args.mu.clone(),
         exits: if args.exit.is_empty() {
             args.mu.clone()
@@ -392,16 +396,8 @@ fn lobes(args: &CompensationArgs) -> kiln::Result<()> {
             args.f0.clone()
         },
     };
-    let settings = WalkSettings {
-        walks: args.walks.unwrap_or(1 << 20),
-        seed: args.seed,
-        ..WalkSettings::default()
-    };
-    settings.validate()?;
-    let model = Model {
-        ndf: Ndf::Ggx,
-        masking: Masking::HeightCorrelated,
-    };
+    let settings = args.walk_settings(1 << 20)?;
+    let model = MODEL;
     let svg = crate::verify::plot_kind_of(args.plot.as_deref())?;
     let panels = grid.alphas.len() * grid.views.len();
     if svg.is_some() && panels > 12 {

@@ -209,18 +209,24 @@ pub fn walk<N: MicrofacetDistribution>(
             let lambda = ndf.lambda(w);
             // At the very top (a grazing entry that met the surface at once) every upward
             // direction leaves; `inf * 0` would say otherwise.
-            let mut escape = if log_c1 == 0.0 || mirror {
+            let probability = if log_c1 == 0.0 || mirror {
                 1.0
             } else {
                 (lambda * log_c1).exp()
             };
-            // The analog walk: leave with everything, or stay with everything.
-            let stays = asked.escape == super::Escape::Sampled
-                && escape < 1.0
-                && random.uniform() >= escape;
-            if asked.escape == super::Escape::Sampled {
-                escape = if stays { 0.0 } else { 1.0 };
-            }
+            // What is tallied as leaving: the probability itself, or (the analog walk) all of
+            // the throughput or none of it.
+            let escape = match asked.escape {
+                super::Escape::Expected => probability,
+                super::Escape::Sampled if probability >= 1.0 => 1.0,
+                super::Escape::Sampled => {
+                    if random.uniform() < probability {
+                        1.0
+                    } else {
+                        0.0
+                    }
+                }
+            };
             if vertex <= tallied {
                 tallies.orders[vertex as usize - 1] += plain * escape;
             } else {
@@ -246,13 +252,8 @@ pub fn walk<N: MicrofacetDistribution>(
             }
             // A hit below h given no escape: C1(h') = C1(h) / (1 - u (1 - P))^(1 / Lambda),
             // with P the escape's probability (also when the escape was drawn).
-            let p = if stays {
-                (lambda * log_c1).exp()
-            } else {
-                escape
-            };
             let u = random.uniform();
-            h = heights.height(log_c1 - (-u * (1.0 - p)).ln_1p() / lambda);
+            h = heights.height(log_c1 - (-u * (1.0 - probability)).ln_1p() / lambda);
         } else {
             h = heights.height(log_c1 + random.uniform().ln() / (1.0 + ndf.lambda(w)));
         }
