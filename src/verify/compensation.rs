@@ -172,7 +172,7 @@ pub fn audit_compensations(
 
 /// The largest and the smallest of `all` by `deviation`, and the root mean square deviation;
 /// `None` for no points.
-fn spread<T: Copy>(all: &[T], deviation: impl Fn(&T) -> f64) -> Option<(T, T, f64)> {
+pub(crate) fn spread<T: Copy>(all: &[T], deviation: impl Fn(&T) -> f64) -> Option<(T, T, f64)> {
     let highest = *all
         .iter()
         .max_by(|a, b| deviation(a).total_cmp(&deviation(b)))?;

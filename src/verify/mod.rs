@@ -6,6 +6,7 @@ pub mod compensation;
 pub mod error_map;
 pub mod fit;
 pub mod furnace;
+pub mod glass_compensation;
 pub mod input;
 pub mod verdict;
 

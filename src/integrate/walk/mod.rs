@@ -16,6 +16,7 @@
 //! of threads.
 
 pub mod conductor;
+pub mod dielectric;
 pub mod heights;
 pub mod lobe;
 pub mod random;
@@ -150,6 +151,8 @@ pub enum WalkError {
     Directions(usize),
     /// kiln's lobe asked for without the table its `M_avg` comes from.
     KilnLobeTable,
+    /// A dielectric's relative index not in `[0.01, 100]` (or NaN).
+    Eta(f64),
 }
 
 impl std::fmt::Display for WalkError {
@@ -216,6 +219,12 @@ impl std::fmt::Display for WalkError {
                 "{n} exit directions a vertex: take 1 to {} (exit cosines times azimuths and \
                  strata)",
                 lobe::LobeGrid::MAX_DIRECTIONS
+            ),
+            WalkError::Eta(eta) => write!(
+                f,
+                "relative index {} is out of range [0.01, 100] (n_inside / n_outside: 1.5 is \
+                 glass seen from air, 1 / 1.5 the same glass seen from inside)",
+                shown(*eta)
             ),
             WalkError::Model(model) => write!(
                 f,
@@ -482,6 +491,83 @@ pub fn walk_lobe(
     })
 }
 
+/// Where the light of a dielectric walk comes from.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum View {
+    /// One direction, at the cosine `mu` in `[0, 1]`.
+    Mu(f64),
+    /// Every direction above the interface, cosine-weighted (`mu = sqrt(u)`, the walk's first
+    /// number): the walk then measures the hemispherical averages `2 ∫ x(mu) mu dmu`.
+    CosineWeighted,
+}
+
+/// What [`walk_dielectric`] measured: energies (fractions of the incident power), each
+/// `[reflected, transmitted]`, with standard errors.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct DielectricEstimate {
+    /// What leaves after the first vertex: the Smith microsurface's single scattering.
+    pub single: [Measured; 2],
+    /// What leaves after any number of vertices.
+    pub all: [Measured; 2],
+    /// What the vertex cap set aside, per walk (0 unless a walk reached it).
+    pub dropped: f64,
+    /// Walks run.
+    pub walks: u64,
+    /// Mean vertices per walk.
+    pub mean_vertices: f64,
+}
+
+/// Walks `settings.walks` times from `view` into a rough dielectric interface of relative
+/// index `eta = n_inside / n_outside` (the light arrives from outside; `eta < 1` is light
+/// leaving a denser medium) with the microsurface of `model` at roughness `alpha` (GGX), and
+/// measures the energy reflected and transmitted ([`dielectric`]).
+pub fn walk_dielectric(
+    model: Model,
+    alpha: f64,
+    view: View,
+    eta: f64,
+    settings: &WalkSettings,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<DielectricEstimate, WalkError> {
+    settings.validate()?;
+    let mu = match view {
+        View::Mu(mu) => mu,
+        View::CosineWeighted => 0.5,
+    };
+    check_inputs(model, alpha, mu, 0)?;
+    if !(0.01..=100.0).contains(&eta) {
+        return Err(WalkError::Eta(eta));
+    }
+    let ndf = Ggx { alpha };
+    let replicates = scrambled(
+        settings,
+        &dielectric::DielectricTallies::default,
+        &|random, tallies| {
+            let wi = match view {
+                View::Mu(mu) => Vec3::from_mu(mu),
+                View::CosineWeighted => Vec3::from_mu(random.uniform().sqrt()),
+            };
+            dielectric::walk(&ndf, wi, eta, random, tallies)
+        },
+        dielectric::DielectricTallies::add,
+        progress,
+    )
+    .ok_or(WalkError::Unresolved { alpha, mu })?;
+    let per_scramble = (settings.walks / u64::from(settings.scrambles)) as f64;
+    let measure = |get: &dyn Fn(&dielectric::DielectricTallies) -> f64| {
+        let means: Vec<f64> = replicates.iter().map(|t| get(t) / per_scramble).collect();
+        Measured::from_replicates(&means)
+    };
+    Ok(DielectricEstimate {
+        single: std::array::from_fn(|side| measure(&|t| t.single[side])),
+        all: std::array::from_fn(|side| measure(&|t| t.all[side])),
+        dropped: replicates.iter().map(|t| t.dropped).sum::<f64>() / settings.walks as f64,
+        walks: settings.walks,
+        mean_vertices: replicates.iter().map(|t| t.vertices).sum::<u64>() as f64
+            / settings.walks as f64,
+    })
+}
+
 /// Runs the walks and returns each scramble's sums.
 #[allow(clippy::too_many_arguments)]
 fn run(
@@ -512,6 +598,28 @@ fn run(
         lobe: targets.as_ref(),
         escape: settings.escape,
     };
+    let replicates = scrambled(
+        settings,
+        &|| Tallies::new(orders, schlick_f90.is_some(), lobe_slots),
+        &|random, tallies| conductor::walk(&ndf, wi, &asked, settings.heights, random, tallies),
+        Tallies::add,
+        progress,
+    );
+    replicates.ok_or(WalkError::Unresolved { alpha, mu })
+}
+
+/// Runs `settings.walks` walks, each scramble's in fixed chunks, and returns each scramble's
+/// sums in chunk order (the same bits on any number of threads): `walk_once` walks with the
+/// numbers it is given and adds to the chunk's tallies (made by `empty`), returning whether the
+/// walk reached the vertex cap; `None` if any did (the rest need not run). `progress` is told
+/// how many walks are done as chunks finish.
+fn scrambled<T: Clone + Send>(
+    settings: &WalkSettings,
+    empty: &(dyn Fn() -> T + Sync),
+    walk_once: &(dyn Fn(&mut random::WalkRandom<'_>, &mut T) -> bool + Sync),
+    add: fn(&mut T, &T),
+    progress: &(dyn Fn(u64) + Sync),
+) -> Option<Vec<T>> {
     let per_scramble = settings.walks / u64::from(settings.scrambles);
     let chunks = per_scramble.div_ceil(u64::from(CHUNK));
     let tasks: Vec<(u32, u64)> = (0..settings.scrambles)
@@ -519,12 +627,12 @@ fn run(
         .collect();
     let done = std::sync::atomic::AtomicU64::new(0);
     let capped = std::sync::atomic::AtomicBool::new(false);
-    let sums: Vec<Tallies> = tasks
+    let sums: Vec<T> = tasks
         .par_iter()
         .map(|&(s, c)| {
             let seed = mix_seed(&[settings.seed, 0x5741_4c4b, u64::from(s)]);
             let sobol = OwenSobol::new(seed);
-            let mut tallies = Tallies::new(orders, schlick_f90.is_some(), lobe_slots);
+            let mut tallies = empty();
             let start = c * u64::from(CHUNK);
             let end = (start + u64::from(CHUNK)).min(per_scramble);
             for index in start..end {
@@ -534,14 +642,7 @@ fn run(
                 }
                 let sobol = (settings.numbers == Numbers::Sobol).then_some(&sobol);
                 let mut random = random::WalkRandom::new(sobol, seed, index as u32);
-                if conductor::walk(
-                    &ndf,
-                    wi,
-                    &asked,
-                    settings.heights,
-                    &mut random,
-                    &mut tallies,
-                ) {
+                if walk_once(&mut random, &mut tallies) {
                     capped.store(true, std::sync::atomic::Ordering::Relaxed);
                 }
             }
@@ -551,13 +652,11 @@ fn run(
         })
         .collect();
     if capped.into_inner() {
-        return Err(WalkError::Unresolved { alpha, mu });
+        return None;
     }
-    // Each scramble's sums, in chunk order: the same bits on any number of threads.
-    let mut replicates =
-        vec![Tallies::new(orders, schlick_f90.is_some(), lobe_slots); settings.scrambles as usize];
+    let mut replicates = vec![empty(); settings.scrambles as usize];
     for (&(s, _), chunk) in tasks.iter().zip(&sums) {
-        replicates[s as usize].add(chunk);
+        add(&mut replicates[s as usize], chunk);
     }
-    Ok(replicates)
+    Some(replicates)
 }
