@@ -657,6 +657,27 @@ fn the_compensation_table_bakes_reads_back_and_is_audited() {
             }
         }
     }
+    // The EXR: channels c0 to c3 (read by the exr crate), 6 x 6, the same coefficients.
+    let exr = kiln::format::exr::decode(
+        &std::fs::read(out.join("ggx-height-correlated-kiln-compensation.exr")).unwrap(),
+    )
+    .unwrap();
+    assert_eq!((exr.width, exr.height), (6, 6));
+    for j in 0..4 {
+        let (_, values) = exr
+            .channels
+            .iter()
+            .find(|(name, _)| *name == format!("c{j}"))
+            .unwrap_or_else(|| panic!("no channel c{j}: {:?}", exr.channels));
+        for (k, &v) in values.iter().enumerate() {
+            assert_eq!(
+                v,
+                f64::from(table.coefficients[j][k] as f32),
+                "exr c_{j}[{k}]"
+            );
+        }
+    }
+    assert!(exr.metadata.unwrap().contains("kiln-compensation"));
     let audit = run(&[
         "compensation",
         "--table",

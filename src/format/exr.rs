@@ -89,13 +89,52 @@ pub fn encode_planes(
     )
 }
 
+/// Encodes a 2-D texture (kiln's compensation's RGBA coefficients,
+/// [`super::compensation::texture`]) as an EXR image of its shape's width and height, channels
+/// named as the texture names them, in `precision`, the texture's metadata JSON in the `kiln`
+/// attribute and `layer` as the layer's name.
+pub fn encode_texture(
+    texture: &super::texture::Texture,
+    layer: &str,
+    precision: Precision,
+) -> std::result::Result<Vec<u8>, String> {
+    let [rows, columns] = texture.shape[..] else {
+        return Err(format!(
+            "cannot store a texture of shape {:?} as an image",
+            texture.shape
+        ));
+    };
+    write_image(
+        layer,
+        &texture.metadata,
+        (columns, rows),
+        texture
+            .channels
+            .iter()
+            .map(|(name, values)| (name.as_str(), values.as_slice(), precision))
+            .collect(),
+    )
+}
+
 /// Writes channels `(name, values, precision)` of a `width x height` image with kiln's header.
 fn write(
     table: &Table,
+    size: (usize, usize),
+    channels: Vec<(&str, &[f64], Precision)>,
+) -> std::result::Result<Vec<u8>, String> {
+    let metadata = serde_json::to_string(&Metadata::new(table, channels[0].2.name()))
+        .map_err(|e| e.to_string())?;
+    write_image(table.spec.id().as_str(), &metadata, size, channels)
+}
+
+/// Writes channels `(name, values, precision)` of a `width x height` image, the layer named
+/// `layer` and `metadata` (JSON, ASCII) in the `kiln` attribute.
+fn write_image(
+    layer: &str,
+    metadata: &str,
     (width, height): (usize, usize),
     channels: Vec<(&str, &[f64], Precision)>,
 ) -> std::result::Result<Vec<u8>, String> {
-    let precision = channels[0].2;
     let samples = |values: &[f64], precision: Precision| match precision {
         Precision::F32 => FlatSamples::F32(values.iter().map(|&v| v as f32).collect()),
         Precision::F16 => {
@@ -108,13 +147,11 @@ fn write(
             .map(|(name, values, precision)| AnyChannel::new(name, samples(values, precision)))
             .collect(),
     );
-    let metadata = serde_json::to_string(&Metadata::new(table, precision.name()))
-        .map_err(|e| e.to_string())?;
-    let mut attributes = LayerAttributes::named(table.spec.id().as_str());
+    let mut attributes = LayerAttributes::named(layer);
     attributes.software_name = Some(Text::from(format!("kiln {KILN_VERSION}").as_str()));
     attributes.other.insert(
         Text::from(METADATA_ATTRIBUTE),
-        AttributeValue::Text(Text::new_or_none(metadata.as_str()).ok_or("metadata is not ASCII")?),
+        AttributeValue::Text(Text::new_or_none(metadata).ok_or("metadata is not ASCII")?),
     );
     let encoding = Encoding {
         compression: Compression::ZIP16,

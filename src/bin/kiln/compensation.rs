@@ -55,7 +55,8 @@ pub struct CompensationArgs {
     #[arg(long, value_name = "DIR", conflicts_with_all = ["table", "compensation", "roughness", "mu", "f0", "f90", "json"])]
     bake: Option<std::path::PathBuf>,
     /// With --bake: the files to write, comma-separated: json (the checked document every
-    /// audit reads), ktx2 and dds (the coefficients as an RGBA32F texture over the E layout),
+    /// audit reads), exr, ktx2 and dds (the coefficients as an RGBA 32-bit float texture over
+    /// the E layout: channels c0 to c3, x = mu, row 0 at r = 0),
     /// wgsl, glsl and hlsl (the texture's lookup, M(mu, F0) and the lobe), rs (the coefficients
     /// as arrays with the same functions in f32), h (a C/C++ header: the texture's texels and
     /// M_avg's as arrays, the basis, albedo and lobe functions).
@@ -64,7 +65,7 @@ pub struct CompensationArgs {
         value_enum,
         value_delimiter = ',',
         requires = "bake",
-        default_value = "json,ktx2,dds,wgsl,glsl,hlsl,rs,h"
+        default_value = "json,exr,ktx2,dds,wgsl,glsl,hlsl,rs,h"
     )]
     format: Vec<CompensationFormat>,
     /// With --bake: the E layout's size (size x size texels, kiln's default layout).
@@ -115,6 +116,7 @@ pub struct CompensationArgs {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 enum CompensationFormat {
     Json,
+    Exr,
     Ktx2,
     Dds,
     Wgsl,
@@ -207,6 +209,11 @@ fn bake(args: &CompensationArgs, out: &std::path::Path) -> kiln::Result<()> {
             CompensationFormat::Json => {
                 ("json", kiln::format::compensation::encode(&table, &command))
             }
+            CompensationFormat::Exr => (
+                "exr",
+                kiln::format::exr::encode_texture(&texture(), &stem, Precision::F32)
+                    .map_err(kiln::Error::InvalidInput)?,
+            ),
             CompensationFormat::Ktx2 => (
                 "ktx2",
                 kiln::format::ktx2::encode(&texture(), Precision::F32)
