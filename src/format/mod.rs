@@ -13,6 +13,7 @@ pub mod dds;
 pub mod exr;
 pub mod f16;
 pub mod folder_lock;
+pub mod glass_compensation;
 pub mod json;
 pub mod ktx2;
 pub mod metadata;

@@ -4,6 +4,7 @@ pub mod axis;
 pub mod balanced_layout;
 pub mod check;
 pub mod compensation;
+pub mod glass_compensation;
 pub mod glass_layout;
 pub mod lookup_fit;
 pub mod normalisation;

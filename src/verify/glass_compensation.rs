@@ -23,6 +23,7 @@ use crate::integrate::walk::{
     dielectric::TRANSMITTED, walk_dielectric,
 };
 use crate::model::Model;
+use crate::table::glass_compensation::GlassCompensationTable;
 use serde::Serialize;
 
 /// Where to measure.
@@ -49,6 +50,8 @@ pub struct GlassPoint {
     pub single: [f64; 2],
     /// Turquin's compensation, `[R / E, T / E]` with `E = R + T` of `single`.
     pub turquin: [f64; 2],
+    /// kiln's, from its table's lookup (`[k_R R, k_T T]`), when a table is measured.
+    pub kiln: Option<[f64; 2]>,
 }
 
 impl GlassPoint {
@@ -63,6 +66,19 @@ impl GlassPoint {
         }
         let ratio = self.turquin[side] / walk.value;
         (ratio - 1.0, 1.96 * ratio * walk.std_error / walk.value)
+    }
+
+    /// kiln's energy on `side` over the walk's, less 1, and its 95 % confidence half-width,
+    /// when a table is measured.
+    #[must_use]
+    pub fn kiln_deviation(&self, side: usize) -> Option<(f64, f64)> {
+        let kiln = self.kiln?;
+        let walk = self.walk.all[side];
+        if walk.value == 0.0 && kiln[side] == 0.0 {
+            return Some((0.0, 0.0));
+        }
+        let ratio = kiln[side] / walk.value;
+        Some((ratio - 1.0, 1.96 * ratio * walk.std_error / walk.value))
     }
 
     /// Turquin's reflected energy less the walk's (a fraction of the incident power; the
@@ -117,6 +133,9 @@ pub struct GlassSummary {
     pub reflected_energy: SideSummary,
     /// The renderer's single-scattering transmission less the walk's first order, absolute.
     pub single_transmission: SideSummary,
+    /// kiln's reflected and transmitted energy against the walk's, relative, when a table is
+    /// measured.
+    pub kiln: Option<[SideSummary; 2]>,
 }
 
 /// The audit: every point, and a summary per relative index.
@@ -129,11 +148,13 @@ pub struct GlassAudit {
 }
 
 /// Measures Turquin's glass compensation against the dielectric walk over `grid` (GGX,
-/// height-correlated). `progress` hears the number of views done.
+/// height-correlated), and kiln's as `table`'s lookup where one is given (at its own index:
+/// `grid.etas` are then its `eta` and `1 / eta`). `progress` hears the number of views done.
 pub fn audit_glass(
     model: Model,
     grid: &GlassGrid,
     settings: &WalkSettings,
+    table: Option<&GlassCompensationTable>,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Result<GlassAudit, WalkError> {
     let views: Vec<(f64, f64, f64)> = grid
@@ -155,6 +176,12 @@ pub fn audit_glass(
             let parts = [single.reflection, single.transmission];
             let energy = parts[REFLECTED] + parts[TRANSMITTED];
             let turquin = parts.map(|p| if energy > 0.0 { p / energy } else { 0.0 });
+            let kiln = table.map(|t| {
+                let inside = (eta - t.eta).abs() > (eta - 1.0 / t.eta).abs();
+                let roughness = t.spec.roughness_convention().from_alpha(alpha);
+                let [k_r, k_t] = t.lookup(mu, roughness, inside);
+                [k_r * parts[REFLECTED], k_t * parts[TRANSMITTED]]
+            });
             progress(done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1);
             Ok(GlassPoint {
                 eta,
@@ -163,6 +190,7 @@ pub fn audit_glass(
                 walk,
                 single: parts,
                 turquin,
+                kiln,
             })
         })
         .collect::<Result<Vec<_>, WalkError>>()?;
@@ -171,7 +199,7 @@ pub fn audit_glass(
         .iter()
         .map(|&eta| {
             let at: Vec<&GlassPoint> = points.iter().filter(|p| p.eta == eta).collect();
-            let side = |deviation: &dyn Fn(&GlassPoint) -> (f64, f64)| {
+            let side = |deviation: &dyn Fn(&GlassPoint) -> (f64, f64)| -> SideSummary {
                 let all: Vec<GlassExtreme> = at
                     .iter()
                     .map(|p| {
@@ -198,6 +226,11 @@ pub fn audit_glass(
                 transmitted: side(&|p| p.deviation(TRANSMITTED)),
                 reflected_energy: side(&GlassPoint::reflected_energy_deviation),
                 single_transmission: side(&GlassPoint::single_transmission_deviation),
+                kiln: table.map(|_| {
+                    [REFLECTED, TRANSMITTED].map(|lobe| {
+                        side(&|p| p.kiln_deviation(lobe).expect("a table was measured"))
+                    })
+                }),
             }
         })
         .collect();

@@ -54,19 +54,14 @@ pub struct CompensationArgs {
     /// averages over mu, as one JSON file (NDF-MASKING-kiln-compensation.json).
     #[arg(long, value_name = "DIR", conflicts_with_all = ["table", "compensation", "roughness", "mu", "f0", "f90", "json"])]
     bake: Option<std::path::PathBuf>,
-    /// With --bake: the files to write, comma-separated: json (the checked document every
-    /// audit reads), exr, ktx2 and dds (the coefficients as an RGBA 32-bit float texture over
-    /// the E layout: channels c0 to c3, x = mu, row 0 at r = 0),
+    /// With --bake: the files to write, comma-separated [default: all; with --ior json,exr]:
+    /// json (the checked document every audit reads), exr, ktx2 and dds (the coefficients as an
+    /// RGBA 32-bit float texture over the E layout: channels c0 to c3, x = mu, row 0 at r = 0;
+    /// for glass kR_outside, kT_outside, kR_inside, kT_inside),
     /// wgsl, glsl and hlsl (the texture's lookup, M(mu, F0) and the lobe), rs (the coefficients
     /// as arrays with the same functions in f32), h (a C/C++ header: the texture's texels and
     /// M_avg's as arrays, the basis, albedo and lobe functions).
-    #[arg(
-        long,
-        value_enum,
-        value_delimiter = ',',
-        requires = "bake",
-        default_value = "json,exr,ktx2,dds,wgsl,glsl,hlsl,rs,h"
-    )]
+    #[arg(long, value_enum, value_delimiter = ',', requires = "bake")]
     format: Vec<CompensationFormat>,
     /// With --bake: the E layout's size (size x size texels, kiln's default layout).
     #[arg(long, default_value_t = 32, requires = "bake", value_parser = crate::args::parse_size)]
@@ -98,8 +93,11 @@ pub struct CompensationArgs {
     /// the same glass seen from inside). Prints where the light goes, reflected or
     /// transmitted, by the dielectric walk (every order; no energy is lost), beside the
     /// renderer's single-scattering BSDF and Turquin's compensation (the BSDF divided by its
-    /// energy albedo R + T, kiln's e-dielectric table: Cycles' glass since Blender 4.0).
-    #[arg(long, value_delimiter = ',', value_parser = crate::args::parse_number, allow_negative_numbers = true, conflicts_with_all = ["bake", "lobe", "table", "compensation", "f0", "f90"])]
+    /// energy albedo R + T, kiln's e-dielectric table: Cycles' glass albedo scaling), and kiln's
+    /// glass compensation with --table. With --bake: bake kiln's glass compensation at this one
+    /// index (scale factors for the BSDF's reflection and transmission lobes, from outside and
+    /// from inside).
+    #[arg(long, value_delimiter = ',', value_parser = crate::args::parse_number, allow_negative_numbers = true, conflicts_with_all = ["lobe", "compensation", "f0", "f90"])]
     ior: Vec<f64>,
     /// Base seed of the walks' scrambles.
     #[arg(long, default_value_t = 0)]
@@ -126,6 +124,21 @@ enum CompensationFormat {
     H,
 }
 
+impl CompensationFormat {
+    /// Every format, in the default order.
+    const ALL: [CompensationFormat; 9] = [
+        CompensationFormat::Json,
+        CompensationFormat::Exr,
+        CompensationFormat::Ktx2,
+        CompensationFormat::Dds,
+        CompensationFormat::Wgsl,
+        CompensationFormat::Glsl,
+        CompensationFormat::Hlsl,
+        CompensationFormat::Rs,
+        CompensationFormat::H,
+    ];
+}
+
 /// The model the walk is written for (GGX, height-correlated masking).
 const MODEL: Model = Model {
     ndf: Ndf::Ggx,
@@ -142,6 +155,21 @@ impl CompensationArgs {
         };
         settings.validate()?;
         Ok(settings)
+    }
+
+    /// The formats of `--format`, each once in the order given, or `default`.
+    fn formats(&self, default: &[CompensationFormat]) -> Vec<CompensationFormat> {
+        let mut formats: Vec<CompensationFormat> = Vec::new();
+        for &format in &self.format {
+            if !formats.contains(&format) {
+                formats.push(format);
+            }
+        }
+        if formats.is_empty() {
+            default.to_vec()
+        } else {
+            formats
+        }
     }
 
     /// The slope-space roughness of `--roughness` (or of `default`, perceptual).
@@ -197,13 +225,7 @@ fn bake(args: &CompensationArgs, out: &std::path::Path) -> kiln::Result<()> {
     let stem = kiln::format::compensation::stem(&table).replace('_', "-");
     let mut files = Vec::new();
     // Each format once, in the order given (`--format json,h,json` writes two files).
-    let mut formats: Vec<CompensationFormat> = Vec::new();
-    for &format in &args.format {
-        if !formats.contains(&format) {
-            formats.push(format);
-        }
-    }
-    for format in formats {
+    for format in args.formats(&CompensationFormat::ALL) {
         let texture = || kiln::format::compensation::texture(&table);
         let (extension, bytes) = match format {
             CompensationFormat::Json => {
@@ -268,6 +290,9 @@ fn bake(args: &CompensationArgs, out: &std::path::Path) -> kiln::Result<()> {
 
 pub fn run(args: CompensationArgs) -> kiln::Result<()> {
     if let Some(out) = &args.bake {
+        if !args.ior.is_empty() {
+            return bake_glass(&args, out);
+        }
         return bake(&args, out);
     }
     if args.lobe {
@@ -370,6 +395,92 @@ fn print(audit: &CompensationAudit, grid: &CompensationGrid) {
     }
 }
 
+/// `kiln compensation --bake DIR --ior ETA`.
+fn bake_glass(args: &CompensationArgs, out: &std::path::Path) -> kiln::Result<()> {
+    use kiln::format::Precision;
+    use kiln::format::glass_compensation as file;
+    use kiln::table::glass_compensation::GlassCompensationTable;
+    let &[eta] = &args.ior[..] else {
+        return Err(kiln::Error::InvalidInput(format!(
+            "--bake bakes glass at one index: give one --ior value, not {}",
+            args.ior.len()
+        )));
+    };
+    if !(0.01..=100.0).contains(&eta) {
+        return Err(kiln::integrate::walk::WalkError::Eta(eta).into());
+    }
+    let formats = args.formats(&[CompensationFormat::Json, CompensationFormat::Exr]);
+    if let Some(other) = formats
+        .iter()
+        .find(|f| !matches!(f, CompensationFormat::Json | CompensationFormat::Exr))
+    {
+        return Err(kiln::Error::InvalidInput(format!(
+            "--format {} is not written for glass yet: take json or exr",
+            clap::ValueEnum::to_possible_value(other)
+                .expect("a format has a name")
+                .get_name()
+        )));
+    }
+    let settings = args.walk_settings(1 << 15)?;
+    kiln::format::check_output_dir(out)?;
+    let options = kiln::BakeOptions {
+        quantities: vec![kiln::Quantity::E],
+        size: args.size,
+        texels: Some(kiln::table::Texels::Nodes),
+        ..kiln::BakeOptions::default()
+    };
+    options.validate()?;
+    let spec = options.resolved().specs().remove(0);
+    let texels = spec.len() as u64;
+    // Two sides a texel, about a second of one core per 2^20 walks each, and the references
+    // (the 32 x 32 table at 2^15: 48 s on two cores, 2026-12-07).
+    crate::announce_cost(
+        texels as f64 * 2.0 * (0.01 + 1.1 * settings.walks as f64 / f64::from(1 << 20)),
+        args.quiet,
+    );
+    let bar = crate::progress_bar(args.quiet, texels, "walking");
+    let table =
+        GlassCompensationTable::bake(MODEL, spec, eta, &settings, &|done| bar.set_position(done))?;
+    bar.finish_and_clear();
+    let command = format!(
+        "kiln compensation --bake {} --ior {eta} --size {} --walks {} --seed {}",
+        out.display(),
+        args.size,
+        settings.walks,
+        settings.seed
+    );
+    let stem = file::stem(&table);
+    let mut files = Vec::new();
+    for format in formats {
+        let (extension, bytes) = match format {
+            CompensationFormat::Exr => (
+                "exr",
+                kiln::format::exr::encode_texture(&file::texture(&table), &stem, Precision::F32)
+                    .map_err(kiln::Error::InvalidInput)?,
+            ),
+            _ => ("json", file::encode(&table, &command)),
+        };
+        files.push((format!("{stem}.{extension}"), bytes));
+    }
+    let written = kiln::format::write_files(out, &files)?;
+    if !args.quiet {
+        println!(
+            "kiln's glass compensation at eta {eta}, {} x {} texels a side, {} walks each, \
+             largest standard error {:.1e}: {}",
+            args.size,
+            args.size,
+            settings.walks,
+            table.max_std_error(),
+            written
+                .iter()
+                .map(|p| kiln::error::escaped_path(p))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
+    Ok(())
+}
+
 /// `kiln compensation --ior ETA`.
 fn glass(args: &CompensationArgs) -> kiln::Result<()> {
     use kiln::verify::glass_compensation::{GlassGrid, SideSummary, audit_glass};
@@ -381,6 +492,28 @@ fn glass(args: &CompensationArgs) -> kiln::Result<()> {
     if let Some(&eta) = grid.etas.iter().find(|e| !(0.01..=100.0).contains(*e)) {
         return Err(kiln::integrate::walk::WalkError::Eta(eta).into());
     }
+    let table = match args.table.as_deref() {
+        None => None,
+        Some(path) => {
+            let bytes = kiln::format::read_file(path)?;
+            let table =
+                kiln::format::glass_compensation::decode(&bytes, &kiln::error::escaped_path(path))?;
+            if let Some(&eta) = grid.etas.iter().find(|&&e| {
+                let near = |x: f64| (e / x - 1.0).abs() < 1e-3;
+                !near(table.eta) && !near(1.0 / table.eta)
+            }) {
+                return Err(kiln::Error::InvalidInput(format!(
+                    "--table holds kiln's glass compensation at eta {}: measure it at --ior {} \
+                     (from outside) or {:.4} (from inside), within 0.1 %, not {}",
+                    table.eta,
+                    table.eta,
+                    1.0 / table.eta,
+                    kiln::error::shown(eta)
+                )));
+            }
+            Some(table)
+        }
+    };
     let settings = args.walk_settings(1 << 20)?;
     let views = (grid.etas.len() * grid.alphas.len() * grid.mus.len()) as u64;
     // About a second of one core a view per 2^20 walks (0.54 s on two cores at r = 0.7,
@@ -390,7 +523,9 @@ fn glass(args: &CompensationArgs) -> kiln::Result<()> {
         args.quiet,
     );
     let bar = crate::progress_bar(args.quiet, views, "walking");
-    let audit = audit_glass(MODEL, &grid, &settings, &|done| bar.set_position(done))?;
+    let audit = audit_glass(MODEL, &grid, &settings, table.as_ref(), &|done| {
+        bar.set_position(done)
+    })?;
     bar.finish_and_clear();
     if args.json {
         println!(
@@ -446,6 +581,10 @@ fn glass(args: &CompensationArgs) -> kiln::Result<()> {
             &summary.single_transmission,
             false,
         );
+        if let Some([reflected, transmitted]) = &summary.kiln {
+            line("kiln R / walk R - 1", reflected, true);
+            line("kiln T / walk T - 1", transmitted, true);
+        }
     }
     println!(
         "  r     mu     walk R    walk T    turquin R turquin T bsdf R_1  walk R_1  bsdf T_1  walk T_1"
