@@ -544,7 +544,8 @@ pub struct VisibleSlopeX {
 }
 
 impl VisibleSlopeX {
-    /// For a view with `cot(theta) = b >= 0` (`+inf` at normal incidence).
+    /// For a view with `cot(theta) = b` (`+inf` at normal incidence; below 0 for a view below
+    /// the horizon, whose visible slopes are those below `b < 0`).
     #[must_use]
     pub fn new(b: f64) -> Self {
         let theta = b.recip().atan();
@@ -743,8 +744,9 @@ impl VisibleSlopeX {
         }
         let guess = self.guess(u);
         let target = u * self.total;
-        // Below -9 the CDF is < 1e-36 of any attainable total: nothing to resolve there.
-        let (mut lo, mut hi) = ((-9.0_f64).min(b), b);
+        // Below -9 the CDF is < 1e-36 of any attainable total: nothing to resolve there (below
+        // the horizon, b < -8, the slopes lie within 1 below b).
+        let (mut lo, mut hi) = ((-9.0_f64).min(b - 1.0), b);
         let mut x = guess.clamp(lo, hi);
         let mut steps = 0;
         while steps < 100 {
@@ -770,7 +772,12 @@ impl VisibleSlopeX {
             steps += 1;
             // Halley converges cubically: after a step of 1e-5 the error is ~1e-15. A bisection
             // step of 1e-5 leaves an error of 1e-5: there only the bracket says when to stop.
-            if (halley && step <= 1e-5 * (1.0 + x.abs())) || hi - lo <= 1e-13 {
+            // Below the horizon (b < 0: a ray travelling up, in the microsurface walk) Jakob's
+            // fit is no guess, and from a start where the density nearly vanishes (just below
+            // the end b) Halley's correction shrinks the step to nothing far from the root:
+            // there the Newton step must be small too.
+            let small = |s: f64| s <= 1e-5 * (1.0 + x.abs());
+            if (halley && small(step) && (b >= 0.0 || small(newton.abs()))) || hi - lo <= 1e-13 {
                 break;
             }
         }

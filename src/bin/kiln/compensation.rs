@@ -99,6 +99,10 @@ pub struct CompensationArgs {
     /// from inside).
     #[arg(long, value_delimiter = ',', value_parser = crate::args::parse_number, allow_negative_numbers = true, conflicts_with_all = ["lobe", "compensation", "f0", "f90"])]
     ior: Vec<f64>,
+    /// The normal distribution of the microsurface (its masking is the walk's own,
+    /// height-correlated).
+    #[arg(long, value_enum, default_value = "ggx")]
+    ndf: Ndf,
     /// Base seed of the walks' scrambles.
     #[arg(long, default_value_t = 0)]
     seed: u64,
@@ -139,13 +143,15 @@ impl CompensationFormat {
     ];
 }
 
-/// The model the walk is written for (GGX, height-correlated masking).
-const MODEL: Model = Model {
-    ndf: Ndf::Ggx,
-    masking: Masking::HeightCorrelated,
-};
-
 impl CompensationArgs {
+    /// The model walked: `--ndf` with the walk's own masking (height-correlated).
+    fn model(&self) -> Model {
+        Model {
+            ndf: self.ndf,
+            masking: Masking::HeightCorrelated,
+        }
+    }
+
     /// The walks' settings: `--walks` (or `default_walks`) and `--seed`, checked.
     fn walk_settings(&self, default_walks: u64) -> kiln::Result<WalkSettings> {
         let settings = WalkSettings {
@@ -192,6 +198,7 @@ fn bake(args: &CompensationArgs, out: &std::path::Path) -> kiln::Result<()> {
     let settings = args.walk_settings(1 << 17)?;
     kiln::format::check_output_dir(out)?;
     let options = kiln::BakeOptions {
+        ndfs: vec![args.ndf],
         quantities: vec![kiln::Quantity::E, kiln::Quantity::EAvg],
         size: args.size,
         texels: Some(kiln::table::Texels::Nodes),
@@ -306,7 +313,7 @@ pub fn run(args: CompensationArgs) -> kiln::Result<()> {
     } else {
         args.f0.clone()
     };
-    let table = read_table(args.table.as_deref())?;
+    let table = read_table(args.table.as_deref(), args.model())?;
     let compensations = if args.compensation.is_empty() {
         Compensation::ALL.to_vec()
     } else {
@@ -323,7 +330,7 @@ pub fn run(args: CompensationArgs) -> kiln::Result<()> {
     }
     let settings = args.walk_settings(1 << 20)?;
     let walks = settings.walks;
-    let model = MODEL;
+    let model = args.model();
     let views = (grid.alphas.len() * grid.mus.len()) as u64;
     if !args.quiet {
         // About 0.5 s a view per 2^20 walks on two cores, walks and references (measured
@@ -358,15 +365,15 @@ pub fn run(args: CompensationArgs) -> kiln::Result<()> {
             serde_json::to_string(&audit).expect("the audit serialises")
         );
     } else {
-        print(&audit, &grid);
+        print(&audit, &grid, model);
     }
     Ok(())
 }
 
-fn print(audit: &CompensationAudit, grid: &CompensationGrid) {
+fn print(audit: &CompensationAudit, grid: &CompensationGrid, model: Model) {
     println!(
-        "against the microsurface walk (ggx height-correlated, Schlick F90 {}), {} walks a view, \
-         {} points: {} roughness x {} mu x {} F0",
+        "against the microsurface walk ({model}, Schlick F90 {}), {} walks a view, {} points: {} \
+         roughness x {} mu x {} F0",
         audit.f90,
         audit.walks,
         audit.points.len(),
@@ -424,6 +431,7 @@ fn bake_glass(args: &CompensationArgs, out: &std::path::Path) -> kiln::Result<()
     let settings = args.walk_settings(1 << 15)?;
     kiln::format::check_output_dir(out)?;
     let options = kiln::BakeOptions {
+        ndfs: vec![args.ndf],
         quantities: vec![kiln::Quantity::E],
         size: args.size,
         texels: Some(kiln::table::Texels::Nodes),
@@ -439,8 +447,9 @@ fn bake_glass(args: &CompensationArgs, out: &std::path::Path) -> kiln::Result<()
         args.quiet,
     );
     let bar = crate::progress_bar(args.quiet, texels, "walking");
-    let table =
-        GlassCompensationTable::bake(MODEL, spec, eta, &settings, &|done| bar.set_position(done))?;
+    let table = GlassCompensationTable::bake(args.model(), spec, eta, &settings, &|done| {
+        bar.set_position(done)
+    })?;
     bar.finish_and_clear();
     let command = format!(
         "kiln compensation --bake {} --ior {eta} --size {} --walks {} --seed {}",
@@ -523,7 +532,7 @@ fn glass(args: &CompensationArgs) -> kiln::Result<()> {
         args.quiet,
     );
     let bar = crate::progress_bar(args.quiet, views, "walking");
-    let audit = audit_glass(MODEL, &grid, &settings, table.as_ref(), &|done| {
+    let audit = audit_glass(args.model(), &grid, &settings, table.as_ref(), &|done| {
         bar.set_position(done)
     })?;
     bar.finish_and_clear();
@@ -535,8 +544,9 @@ fn glass(args: &CompensationArgs) -> kiln::Result<()> {
         return Ok(());
     }
     println!(
-        "glass against the dielectric microsurface walk (ggx height-correlated, energy), {} \
-         walks a view, {} roughness x {} mu at each index",
+        "glass against the dielectric microsurface walk ({}, energy), {} walks a view, {} \
+         roughness x {} mu at each index",
+        args.model(),
         audit.walks,
         grid.alphas.len(),
         grid.mus.len()
@@ -611,15 +621,16 @@ fn glass(args: &CompensationArgs) -> kiln::Result<()> {
 /// kiln's compensation table from `--table`, checked, if given.
 fn read_table(
     path: Option<&std::path::Path>,
+    model: Model,
 ) -> kiln::Result<Option<kiln::table::compensation::CompensationTable>> {
     let Some(path) = path else {
         return Ok(None);
     };
     let bytes = kiln::format::read_file(path)?;
     let table = kiln::format::compensation::decode(&bytes, &kiln::error::escaped_path(path))?;
-    if table.spec.model != MODEL {
+    if table.spec.model != model {
         return Err(kiln::Error::InvalidInput(format!(
-            "--table holds kiln's compensation for {}; the walk is {MODEL}",
+            "--table holds kiln's compensation for {}; the walk is {model} (--ndf)",
             table.spec.model
         )));
     }
@@ -629,7 +640,7 @@ fn read_table(
 /// `kiln compensation --lobe`.
 fn lobes(args: &CompensationArgs) -> kiln::Result<()> {
     use kiln::verify::compensation::{LobeAuditGrid, LobeExtreme, audit_lobes};
-    let table = read_table(args.table.as_deref())?;
+    let table = read_table(args.table.as_deref(), args.model())?;
     // kiln's lobe needs its table's M_avg; at F = 1 it is Kulla-Conty's anyway.
     let compensations = if args.compensation.is_empty() {
         let mut all = vec![Compensation::KullaConty, Compensation::Turquin];
@@ -656,7 +667,7 @@ fn lobes(args: &CompensationArgs) -> kiln::Result<()> {
         },
     };
     let settings = args.walk_settings(1 << 20)?;
-    let model = MODEL;
+    let model = args.model();
     let svg = crate::verify::plot_kind_of(args.plot.as_deref())?;
     let panels = grid.alphas.len() * grid.views.len();
     if svg.is_some() && panels > 12 {
@@ -743,7 +754,7 @@ fn lobes(args: &CompensationArgs) -> kiln::Result<()> {
         )
     };
     println!(
-        "the lobe added {fresnel} against the walk's orders 2 and later (ggx height-correlated), \
+        "the lobe added {fresnel} against the walk's orders 2 and later ({model}), \
          {} walks a view: {} roughness x {} views x {} exits, averaged over the azimuth and at \
          {} azimuths",
         audit.walks,

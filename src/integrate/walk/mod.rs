@@ -26,7 +26,7 @@ pub use heights::Heights;
 
 use crate::integrate::sobol::{OwenSobol, mix_seed};
 use crate::model::fresnel::Fresnel;
-use crate::model::ndf::Ggx;
+use crate::model::ndf::{Beckmann, Ggx};
 use crate::model::vector::Vec3;
 use crate::model::{Masking, Model, Ndf};
 use rayon::prelude::*;
@@ -228,8 +228,9 @@ impl std::fmt::Display for WalkError {
             ),
             WalkError::Model(model) => write!(
                 f,
-                "the microsurface walk is written for GGX (its masking is the walk's own, \
-                 height-correlated); {} {} is not in this version",
+                "the microsurface walk's masking is its own, height-correlated (uncorrelated \
+                 heights and normals, Smith's assumption); {} {} has no walk: take --masking \
+                 height-correlated",
                 model.ndf, model.masking
             ),
         }
@@ -281,9 +282,26 @@ pub struct WalkEstimate {
     pub mean_vertices: f64,
 }
 
+/// Runs `$body` with `$ndf` bound to the distribution of `$model` at `$alpha` (GGX or
+/// Beckmann): each arm is compiled for its distribution.
+macro_rules! on_surface {
+    ($model:expr, $alpha:expr, |$ndf:ident| $body:expr) => {
+        match $model.ndf {
+            Ndf::Ggx => {
+                let $ndf = &Ggx { alpha: $alpha };
+                $body
+            }
+            Ndf::Beckmann => {
+                let $ndf = &Beckmann { alpha: $alpha };
+                $body
+            }
+        }
+    };
+}
+
 /// Checks a walk's inputs.
 pub fn check_inputs(model: Model, alpha: f64, mu: f64, orders: usize) -> Result<(), WalkError> {
-    if model.ndf != Ndf::Ggx || model.masking != Masking::HeightCorrelated {
+    if model.masking != Masking::HeightCorrelated {
         return Err(WalkError::Model(model));
     }
     if !(0.0..=1000.0).contains(&alpha) {
@@ -538,8 +556,7 @@ pub fn walk_dielectric(
     if !(0.01..=100.0).contains(&eta) {
         return Err(WalkError::Eta(eta));
     }
-    let ndf = Ggx { alpha };
-    let replicates = scrambled(
+    let replicates = on_surface!(model, alpha, |ndf| scrambled(
         settings,
         &dielectric::DielectricTallies::default,
         &|random, tallies| {
@@ -547,11 +564,11 @@ pub fn walk_dielectric(
                 View::Mu(mu) => Vec3::from_mu(mu),
                 View::CosineWeighted => Vec3::from_mu(random.uniform().sqrt()),
             };
-            dielectric::walk(&ndf, wi, eta, random, tallies)
+            dielectric::walk(ndf, wi, eta, random, tallies)
         },
         dielectric::DielectricTallies::add,
         progress,
-    )
+    ))
     .ok_or(WalkError::Unresolved { alpha, mu })?;
     let per_scramble = (settings.walks / u64::from(settings.scrambles)) as f64;
     let measure = |get: &dyn Fn(&dielectric::DielectricTallies) -> f64| {
@@ -588,23 +605,24 @@ fn run(
     {
         return Err(WalkError::F90(f90));
     }
-    let ndf = Ggx { alpha };
     let wi = Vec3::from_mu(mu);
-    let targets = lobe.map(|grid| lobe::LobeTargets::new(&ndf, grid, fresnel));
-    let lobe_slots = targets.as_ref().map_or(0, lobe::LobeTargets::slots);
-    let asked = conductor::Asked {
-        fresnel,
-        schlick_f90,
-        lobe: targets.as_ref(),
-        escape: settings.escape,
-    };
-    let replicates = scrambled(
-        settings,
-        &|| Tallies::new(orders, schlick_f90.is_some(), lobe_slots),
-        &|random, tallies| conductor::walk(&ndf, wi, &asked, settings.heights, random, tallies),
-        Tallies::add,
-        progress,
-    );
+    let replicates = on_surface!(model, alpha, |ndf| {
+        let targets = lobe.map(|grid| lobe::LobeTargets::new(ndf, grid, fresnel));
+        let lobe_slots = targets.as_ref().map_or(0, lobe::LobeTargets::slots);
+        let asked = conductor::Asked {
+            fresnel,
+            schlick_f90,
+            lobe: targets.as_ref(),
+            escape: settings.escape,
+        };
+        scrambled(
+            settings,
+            &|| Tallies::new(orders, schlick_f90.is_some(), lobe_slots),
+            &|random, tallies| conductor::walk(ndf, wi, &asked, settings.heights, random, tallies),
+            Tallies::add,
+            progress,
+        )
+    });
     replicates.ok_or(WalkError::Unresolved { alpha, mu })
 }
 
