@@ -32,7 +32,7 @@ pub struct BakeOptions {
     /// QMC evaluations per `E` texel (a power of two).
     pub samples: u64,
     /// QMC evaluations per `E_avg` entry (a power of two); `E_avg` integrates over `mu` as well,
-    /// and 32 entries are cheap, so the default is 16 times `samples`.
+    /// and 32 entries are cheap, so the default is [`QmcSettings::AVERAGE_FACTOR`] times `samples`.
     pub average_samples: u64,
     /// Independent scrambles per estimate (for the standard error).
     pub scrambles: u32,
@@ -86,7 +86,7 @@ impl Default for BakeOptions {
             quantities: Self::DEFAULT_QUANTITIES.to_vec(),
             size: Self::DEFAULT_SIZE,
             samples: QmcSettings::DEFAULT_SAMPLES,
-            average_samples: 16 * QmcSettings::DEFAULT_SAMPLES,
+            average_samples: QmcSettings::average_samples_for(QmcSettings::DEFAULT_SAMPLES),
             scrambles: QmcSettings::DEFAULT_SCRAMBLES,
             seed: 0,
             roughness_convention: RoughnessConvention::Perceptual,
@@ -406,7 +406,7 @@ impl BakeOptions {
             let samples = needed.next_power_of_two().max(64);
             options.method = Method::Qmc;
             options.samples = samples;
-            options.average_samples = 16 * samples;
+            options.average_samples = QmcSettings::average_samples_for(samples);
         } else {
             options.method = Method::Reference;
         }
@@ -728,14 +728,8 @@ impl BakeOptions {
             }
             if spec.quantity == Quantity::FMsNorm {
                 // Derived from the lookup of the E table baked (or reused) just before it.
-                let source = spec.lookup_of.as_deref();
-                let e = report
-                    .tables
-                    .iter()
-                    .find(|t| Some(&t.spec) == source)
-                    .expect("validate() requires E, and quantities() orders it first");
-                let table = crate::table::normalisation::derive(e, command);
-                check_computed(&table)?;
+                let table =
+                    crate::table::normalisation::derive_from(&spec, &report.tables, command)?;
                 if let Some(cache) = cache {
                     cache.store(&key, &table)?;
                 }
@@ -816,7 +810,7 @@ impl BakeOptions {
         terms: Option<&[(f64, bool)]>,
         progress: &(dyn Fn(u64) + Sync),
     ) -> Result<Table> {
-        check_computed(&table)?;
+        table.check_computed()?;
         table.requested_max_error = self.max_error;
         table.node_errors = terms.map(crate::verify::summarise_node_errors);
         if let Some(measured) = table.node_errors
@@ -845,7 +839,7 @@ impl BakeOptions {
             // The fit moved every texel by what the reference said at its points: the same
             // checks again, so that a value the fit could not make (not a number) is refused
             // by name before anything is written.
-            check_computed(&table)?;
+            table.check_computed()?;
         }
         Ok(table)
     }
@@ -1061,7 +1055,7 @@ pub fn estimate_texel(spec: &TableSpec, index: usize) -> Estimate {
                 value: r.value,
                 one_minus_value: r.one_minus_value,
                 // A quadrature that ran out of budget has no error bound: its texel says so
-                // (infinite), and the bake refuses it (`check_computed`).
+                // (infinite), and the bake refuses it (`Table::check_computed`).
                 std_error: if r.converged { r.error } else { f64::INFINITY },
                 samples: r.evaluations,
             }
@@ -1071,74 +1065,6 @@ pub fn estimate_texel(spec: &TableSpec, index: usize) -> Estimate {
 
 /// The top of an IOR axis kiln accepts ([`crate::model::fresnel::MAX_INDEX`]).
 pub const MAX_IOR: f64 = crate::model::fresnel::MAX_INDEX;
-
-/// Checks a computed table before anything is written or claimed about it: every value and
-/// one-minus value finite, every error estimate finite and not negative (an infinite one marks
-/// a quadrature that did not converge, [`estimate_texel`]), and then everything a reader
-/// checks ([`Table::check`]: values in `[0, 1]`, value and one-minus value adding up to 1).
-/// The error names the first texel that fails, where it is and what to do.
-///
-/// # Errors
-/// As above.
-pub fn check_computed(table: &Table) -> Result<()> {
-    let spec = &table.spec;
-    let place = |k: usize| {
-        let (alpha, mu, eta) = spec.texel_point(k);
-        let mut at = format!("texel {k} (alpha {alpha:e}");
-        if let Some(mu) = mu {
-            at += &format!(", mu {mu:e}");
-        }
-        if let Some(eta) = eta {
-            at += &format!(", eta {eta:e}");
-        }
-        at + ")"
-    };
-    let lengths = [
-        table.value.len(),
-        table.one_minus_value.len(),
-        table.std_error.len(),
-    ];
-    if lengths.iter().any(|&n| n != spec.len()) {
-        return Err(Error::InvalidInput(format!(
-            "{}: {lengths:?} values, one-minus values and errors for {} texels",
-            spec.id(),
-            spec.len()
-        )));
-    }
-    for k in 0..spec.len() {
-        let (v, w, e) = (table.value[k], table.one_minus_value[k], table.std_error[k]);
-        if !v.is_finite() || !w.is_finite() {
-            return Err(Error::InvalidInput(format!(
-                "{}: the computed value at {} is {v} (1 - value {w}): the model gives no finite \
-                 number there; nothing was written. Check the inputs (IOR, eta, k) for values \
-                 outside what the physics allows",
-                spec.id(),
-                place(k)
-            )));
-        }
-        if e == f64::INFINITY {
-            return Err(Error::InvalidInput(format!(
-                "{}: the quadrature did not converge at {} within its evaluation budget, so \
-                 the value {v} has no error bound; nothing was written. Ask for fewer digits \
-                 (a larger --max-error) or use --method qmc",
-                spec.id(),
-                place(k)
-            )));
-        }
-        if !(e >= 0.0 && e.is_finite()) {
-            return Err(Error::InvalidInput(format!(
-                "{}: the error estimate at {} is {e}; nothing was written",
-                spec.id(),
-                place(k)
-            )));
-        }
-    }
-    // What every reader checks (spec, ranges, sums): a table no reader would take is never
-    // written, whether baked here or merged from shards.
-    table.check().map_err(|message| {
-        Error::InvalidInput(format!("{}: {message}; nothing was written", spec.id()))
-    })
-}
 
 /// The estimated cost of baking `spec`, in seconds of one core (divide by the threads): for
 /// `kiln plan` and for `kiln bake` to say how long it will take before it starts.

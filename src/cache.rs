@@ -12,7 +12,7 @@
 //! digest (FNV-1a of the key's and the table's canonical JSON) that proves the entry whole. A
 //! hit requires the stored key to equal the wanted one (so a hash collision is a miss, never a
 //! wrong table), the digest to hold, and the table to be the key's spec with finite values
-//! ([`crate::bake::check_computed`]); an entry that fails is reported as damaged, and the
+//! ([`Table::check_computed`](crate::table::Table::check_computed)); an entry that fails is reported as damaged, and the
 //! bake integrates the table again and replaces it. Entries are written to a temporary file and
 //! renamed into place.
 
@@ -150,7 +150,7 @@ impl Cache {
         if entry.table.spec != key.spec {
             return Lookup::Damaged("its table is of another spec".into());
         }
-        if let Err(e) = crate::bake::check_computed(&entry.table) {
+        if let Err(e) = entry.table.check_computed() {
             return Lookup::Damaged(e.to_string());
         }
         Lookup::Hit(Box::new(entry.table))

@@ -518,13 +518,7 @@ pub fn merge(shards: &[(PathBuf, ShardFile)]) -> Result<(ShardedBake, Vec<Table>
     for spec in options.specs() {
         let command = first.bake.options.command_for(spec.model);
         if spec.quantity == Quantity::FMsNorm {
-            let source = spec.lookup_of.as_deref();
-            let e = tables
-                .iter()
-                .find(|t| Some(&t.spec) == source)
-                .expect("validate() requires E, and specs() orders it first");
-            let table = crate::table::normalisation::derive(e, command);
-            crate::bake::check_computed(&table)?;
+            let table = crate::table::normalisation::derive_from(&spec, &tables, command)?;
             tables.push(table);
             continue;
         }

@@ -2,7 +2,6 @@
 //! that ran out of budget is never stored as if it had converged, and a computed table that is
 //! not finite is never written.
 
-use kiln::bake::check_computed;
 use kiln::verify::{Against, AuditSettings, audit, node_errors_at};
 use kiln::{BakeOptions, Quantity, Table};
 
@@ -44,7 +43,7 @@ fn a_nan_texel_is_never_a_zero_error() {
     );
     assert!(report.node_max_error.is_nan() && report.lookup_max_error.is_nan());
     // And the bake's check refuses the table before anything is written.
-    let message = check_computed(&table).unwrap_err().to_string();
+    let message = table.check_computed().unwrap_err().to_string();
     assert!(
         message.contains("texel 5") && message.contains("NaN"),
         "{message}"
@@ -59,13 +58,13 @@ fn a_nan_texel_is_never_a_zero_error() {
 fn an_unconverged_texel_is_refused_by_name() {
     let mut table = small_e_table();
     table.std_error[7] = f64::INFINITY;
-    let message = check_computed(&table).unwrap_err().to_string();
+    let message = table.check_computed().unwrap_err().to_string();
     assert!(
         message.contains("did not converge") && message.contains("texel 7"),
         "{message}"
     );
     table.std_error[7] = -1e-9;
-    assert!(check_computed(&table).is_err());
+    assert!(table.check_computed().is_err());
 }
 
 /// The confirmation's reference can run out of budget too: its error is then the difference

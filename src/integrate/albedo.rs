@@ -55,6 +55,17 @@ impl QmcSettings {
     /// Eight scrambles: the standard error then has 7 degrees of freedom.
     pub const DEFAULT_SCRAMBLES: u32 = 8;
 
+    /// How many times a directional estimate's evaluations an average over `mu` (`E_avg`)
+    /// takes by default: it integrates over `mu` as well, and its tables are 1-D and cheap.
+    pub const AVERAGE_FACTOR: u64 = 16;
+
+    /// The default evaluations of an average for `samples` per directional estimate
+    /// ([`QmcSettings::AVERAGE_FACTOR`] times, saturating).
+    #[must_use]
+    pub fn average_samples_for(samples: u64) -> u64 {
+        samples.saturating_mul(Self::AVERAGE_FACTOR)
+    }
+
     /// The most points one scramble takes (its Sobol index is 32 bits).
     pub const MAX_POINTS_PER_SCRAMBLE: u64 = 1 << 32;
 

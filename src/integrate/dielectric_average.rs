@@ -28,7 +28,7 @@
 //! as the nested reference does. With `s_R + s_T + s_L = 1` the three parts add up to 1 (`(1 /
 //! pi) ∫ mu_o dω_o`), which the tests check along with agreement with the nested reference.
 
-use super::dielectric::DielectricReference;
+use super::dielectric_reference::DielectricReference;
 use super::gauss_kronrod::{KRONROD_NODES, integrate_pieces, integrate_pieces_batch};
 use super::reference::{ReferenceSettings, ladder, s_of_x, t_of_s};
 use crate::model::dielectric::{TransmissionConvention, scatterings_at_cos};

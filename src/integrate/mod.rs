@@ -5,6 +5,7 @@ pub mod average_quadrature;
 pub mod compensation;
 pub mod dielectric;
 pub mod dielectric_average;
+pub mod dielectric_reference;
 pub mod estimate;
 pub mod grazing;
 pub mod quantity;

@@ -3,6 +3,7 @@
 //! The reflection BRDF (`docs/physics.md`) is `f(o, i) = F(o.h) D(h) G2(o, i) / (4 |n.i| |n.o|)`;
 //! the tables here are for `F = 1`.
 
+pub mod beckmann_sampling;
 pub mod dielectric;
 pub mod disney_diffuse;
 pub mod fresnel;

@@ -144,6 +144,77 @@ impl TableSpec {
 }
 
 impl Table {
+    /// Checks a computed table before anything is written or claimed about it: every value and
+    /// one-minus value finite, every error estimate finite and not negative (an infinite one marks
+    /// a quadrature that did not converge, `crate::bake::estimate_texel`), and then everything a reader
+    /// checks ([`Table::check`]: values in `[0, 1]`, value and one-minus value adding up to 1).
+    /// The error names the first texel that fails, where it is and what to do.
+    ///
+    /// # Errors
+    /// As above.
+    pub fn check_computed(&self) -> crate::error::Result<()> {
+        let table = self;
+        let spec = &table.spec;
+        let place = |k: usize| {
+            let (alpha, mu, eta) = spec.texel_point(k);
+            let mut at = format!("texel {k} (alpha {alpha:e}");
+            if let Some(mu) = mu {
+                at += &format!(", mu {mu:e}");
+            }
+            if let Some(eta) = eta {
+                at += &format!(", eta {eta:e}");
+            }
+            at + ")"
+        };
+        let lengths = [
+            table.value.len(),
+            table.one_minus_value.len(),
+            table.std_error.len(),
+        ];
+        if lengths.iter().any(|&n| n != spec.len()) {
+            return Err(crate::error::Error::InvalidInput(format!(
+                "{}: {lengths:?} values, one-minus values and errors for {} texels",
+                spec.id(),
+                spec.len()
+            )));
+        }
+        for k in 0..spec.len() {
+            let (v, w, e) = (table.value[k], table.one_minus_value[k], table.std_error[k]);
+            if !v.is_finite() || !w.is_finite() {
+                return Err(crate::error::Error::InvalidInput(format!(
+                    "{}: the computed value at {} is {v} (1 - value {w}): the model gives no finite \
+                     number there; nothing was written. Check the inputs (IOR, eta, k) for values \
+                     outside what the physics allows",
+                    spec.id(),
+                    place(k)
+                )));
+            }
+            if e == f64::INFINITY {
+                return Err(crate::error::Error::InvalidInput(format!(
+                    "{}: the quadrature did not converge at {} within its evaluation budget, so \
+                     the value {v} has no error bound; nothing was written. Ask for fewer digits \
+                     (a larger --max-error) or use --method qmc",
+                    spec.id(),
+                    place(k)
+                )));
+            }
+            if !(e >= 0.0 && e.is_finite()) {
+                return Err(crate::error::Error::InvalidInput(format!(
+                    "{}: the error estimate at {} is {e}; nothing was written",
+                    spec.id(),
+                    place(k)
+                )));
+            }
+        }
+        // What every reader checks (spec, ranges, sums): a table no reader would take is never
+        // written, whether baked here or merged from shards.
+        table.check().map_err(|message| {
+            crate::error::Error::InvalidInput(format!(
+                "{}: {message}; nothing was written",
+                spec.id()
+            ))
+        })
+    }
     /// Checks the spec ([`TableSpec::check`]) and the channels: each as long as the spec's
     /// texels, every value and one-minus value finite and within [`RANGE_TOLERANCE`] of
     /// `[0, 1]`, value and one-minus value adding up to 1 within twice that, every error estimate

@@ -242,6 +242,30 @@ pub fn size_of(e: &TableSpec, refined_start: Option<RefinedStart>) -> usize {
     }
 }
 
+/// The normalisation table of `spec` (an `f_ms_norm` spec) derived from the E table it is the
+/// lookup of (`spec.lookup_of`), found among `tables`, and checked
+/// ([`Table::check_computed`]): the one path of the bake and of the merge of shards.
+///
+/// # Errors
+/// The derived table fails its checks.
+///
+/// # Panics
+/// If `tables` holds no E table of `spec.lookup_of` (callers bake or merge it first).
+pub fn derive_from(
+    spec: &TableSpec,
+    tables: &[Table],
+    command: String,
+) -> crate::error::Result<Table> {
+    let source = spec.lookup_of.as_deref();
+    let e = tables
+        .iter()
+        .find(|t| Some(&t.spec) == source)
+        .expect("validate() requires E, and specs() orders it first");
+    let table = derive(e, command);
+    table.check_computed()?;
+    Ok(table)
+}
+
 /// The normalisation table of the E table `e` (see the module docs); `command` is recorded in
 /// it. Its `std_error` holds the quadrature's error estimate divided by `x`.
 #[must_use]

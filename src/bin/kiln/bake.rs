@@ -285,7 +285,7 @@ pub fn run(args: BakeArgs) -> kiln::Result<()> {
                 seed: 0,
             }
             .sample_range();
-            samples.saturating_mul(16).min(most)
+            QmcSettings::average_samples_for(samples).min(most)
         }),
         scrambles,
         seed: args.seed.unwrap_or(0),

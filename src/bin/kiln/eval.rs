@@ -204,7 +204,7 @@ pub fn run(args: EvalArgs) -> kiln::Result<()> {
             let samples = args.samples.unwrap_or(if quantity.has_mu() {
                 QmcSettings::DEFAULT_SAMPLES
             } else {
-                16 * QmcSettings::DEFAULT_SAMPLES
+                QmcSettings::average_samples_for(QmcSettings::DEFAULT_SAMPLES)
             });
             let settings = QmcSettings {
                 samples,
@@ -460,7 +460,7 @@ fn dielectric(
                 samples: args.samples.unwrap_or(if mu.is_some() {
                     QmcSettings::DEFAULT_SAMPLES
                 } else {
-                    16 * QmcSettings::DEFAULT_SAMPLES
+                    QmcSettings::average_samples_for(QmcSettings::DEFAULT_SAMPLES)
                 }),
                 scrambles: args.scrambles.unwrap_or(QmcSettings::DEFAULT_SCRAMBLES),
                 seed: args.seed,
