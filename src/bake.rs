@@ -1,8 +1,11 @@
 //! Baking: from options to table specs, and from a spec to a table, texels in parallel.
 //!
-//! Each texel is one QMC estimate ([`crate::integrate::albedo`](mod@crate::integrate::albedo)), a pure function of the spec and
-//! the texel's coordinates, summed in a fixed order inside one thread. Rayon spreads texels over
-//! cores and collects them in index order, so a table is byte-identical for any thread count.
+//! Each texel is one value of the spec's integral at the texel's point by the method the options
+//! chose ([`crate::integrate::value`]: the deterministic reference, or a QMC estimate summed in a
+//! fixed order inside one thread), a pure function of the spec and the texel's coordinates; a
+//! fitted table then moves its texels for the lookup ([`crate::table::lookup_fit`]). Rayon spreads
+//! texels over cores and collects them in index order, so a table is byte-identical for any thread
+//! count.
 
 use crate::cache::{Cache, CacheKey};
 use crate::error::{Error, Result};

@@ -1061,14 +1061,14 @@ impl BeckmannView {
     fn new(alpha: f64, mu: f64) -> Self {
         let ndf = Beckmann { alpha };
         let o = Vec3::from_mu(mu);
-        let untabulated = BeckmannVisibleNormals::new(ndf, o);
+        let untabulated = BeckmannVisibleNormals::new(ndf.alpha, o);
         // The stretched view's cot(theta): the visible x-slopes end there.
         let grazing = mu <= 0.0
             || (untabulated.slope_x().end() < GRAZING_COT && alpha < GRAZING_LADDER_MAX_ALPHA);
         let far_end = (1.0 + sin_from_cos(mu)) / (mu * alpha);
         let (visible, sampling) = if grazing {
             // The ladder solves for slopes at every point: start it from a table.
-            let visible = BeckmannVisibleNormals::tabulated(ndf, o);
+            let visible = BeckmannVisibleNormals::tabulated(ndf.alpha, o);
             let strata = beckmann_strata(&visible, alpha, mu);
             (visible, BeckmannSampling::Ladder(strata))
         } else if far_end < REFLECTION_MAX_FAR_END {
@@ -1097,7 +1097,7 @@ impl BeckmannView {
             ndf,
             o,
             lambda_o: ndf.lambda(o),
-            visible: BeckmannVisibleNormals::tabulated(ndf, o),
+            visible: BeckmannVisibleNormals::tabulated(ndf.alpha, o),
             sampling: BeckmannSampling::Ladder(two_sided_ladder(floor)),
         }
     }

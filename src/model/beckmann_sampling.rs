@@ -4,7 +4,6 @@
 //! Gaussian, for views above the horizon and below it (a ray travelling up in the microsurface
 //! walk). Its own file beside [`super::ndf`], which holds the distributions' formulas.
 
-use super::ndf::Beckmann;
 use super::special::{FRAC_1_SQRT_PI, erf_inv_uniform, erfc};
 use super::vector::Vec3;
 
@@ -19,10 +18,11 @@ pub struct BeckmannVisibleNormals {
 }
 
 impl BeckmannVisibleNormals {
-    /// Prepares sampling for the unit view direction `o`.
+    /// Prepares sampling for the unit view direction `o` on a Beckmann surface of slope-space
+    /// roughness `alpha`.
     #[must_use]
-    pub fn new(ndf: Beckmann, o: Vec3) -> Self {
-        let a = ndf.alpha;
+    pub fn new(alpha: f64, o: Vec3) -> Self {
+        let a = alpha;
         let v = Vec3::new(a * o.x, a * o.y, o.z).normalize();
         let sin_theta = (v.x * v.x + v.y * v.y).sqrt();
         let (cos_phi, sin_phi) = if sin_theta > 0.0 {
@@ -42,8 +42,8 @@ impl BeckmannVisibleNormals {
     /// As [`BeckmannVisibleNormals::new`], with a table of starting points for the slope
     /// inversion ([`VisibleSlopeX::with_guess_table`]): for a view sampled many times.
     #[must_use]
-    pub fn tabulated(ndf: Beckmann, o: Vec3) -> Self {
-        let mut this = Self::new(ndf, o);
+    pub fn tabulated(alpha: f64, o: Vec3) -> Self {
+        let mut this = Self::new(alpha, o);
         this.slope_x = this.slope_x.with_guess_table(1025);
         this
     }

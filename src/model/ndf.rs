@@ -399,7 +399,7 @@ impl MicrofacetDistribution for Beckmann {
     /// Mitsuba and pbrt-v3), which is continuous in `u`; the paper's fitted inversion has
     /// discontinuities that hurt QMC. See [`beckmann_visible_slope_x`].
     fn sample_visible_normal(&self, o: Vec3, u: [f64; 2]) -> Vec3 {
-        BeckmannVisibleNormals::new(*self, o).sample(u)
+        BeckmannVisibleNormals::new(self.alpha, o).sample(u)
     }
 }
 
