@@ -9,14 +9,9 @@ use kiln::integrate::reference::{ReferenceSettings, reference_albedo, reference_
 use kiln::{Fresnel, Masking, Model, Ndf, QmcSettings, Quantity, RoughnessConvention};
 use std::time::Instant;
 
-/// How to evaluate.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum Method {
-    /// Quasi-Monte Carlo (VNDF sampling, Owen-scrambled Sobol), as `kiln bake` uses.
-    Qmc,
-    /// The deterministic reference: nested adaptive Gauss-Kronrod quadrature, error <= 1e-10.
-    Reference,
-}
+/// How to evaluate: the methods a table is baked by (`kiln bake` picks one per table from
+/// --max-error; `eval` does not pick).
+pub use kiln::table::Method;
 
 /// What `kiln eval` evaluates.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -82,7 +77,8 @@ pub struct EvalArgs {
     quantity: EvalQuantity,
     #[command(flatten)]
     fresnel: FresnelArgs,
-    /// How to evaluate it.
+    /// How to evaluate it. `kiln bake` picks its method from --max-error (the reference below
+    /// 1e-3, as for its default tables); `eval` uses the one given here.
     #[arg(long, value_enum, default_value = "qmc")]
     method: Method,
     /// For --quantity e-dielectric|e-avg-dielectric: whose albedo. single-scattering: a
@@ -237,10 +233,7 @@ pub fn run(args: EvalArgs) -> kiln::Result<()> {
         }
     };
     let seconds = start.elapsed().as_secs_f64();
-    let method = match args.method {
-        Method::Qmc => "qmc",
-        Method::Reference => "reference",
-    };
+    let method = args.method.name();
     let symbol = quantity.symbol();
     if args.json {
         let object = serde_json::json!({
@@ -397,10 +390,7 @@ fn fresnel_weighted(
     let samples: u64 = channels.iter().map(|c| c.2).sum();
     let converged = channels.iter().all(|c| c.3);
     let uniform = values[0] == values[1] && values[1] == values[2];
-    let method = match args.method {
-        Method::Qmc => "qmc",
-        Method::Reference => "reference",
-    };
+    let method = args.method.name();
     if args.json {
         let object = serde_json::json!({
             "quantity": "E_F",
@@ -516,10 +506,7 @@ fn dielectric(
     } else {
         "E_avg_dielectric"
     };
-    let method = match args.method {
-        Method::Qmc => "qmc",
-        Method::Reference => "reference",
-    };
+    let method = args.method.name();
     if args.json {
         let mut object = serde_json::json!({
             "quantity": symbol,
