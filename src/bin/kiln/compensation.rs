@@ -14,8 +14,8 @@ use kiln::{Masking, Model, Ndf, RoughnessConvention};
     long_about = "Measure how far the albedo of single scattering plus an energy compensation \
                   (Kulla-Conty's lobe with its colour term, Turquin's scaling, kiln's own fitted \
                   to walks of another seed) is from the albedo \
-                  of every order of scattering on the microsurface, by the random walk (GGX, \
-                  height-correlated, Schlick's Fresnel at every bounce). Prints, per \
+                  of every order of scattering on the microsurface, by the random walk (GGX, or \
+                  Beckmann with --ndf; height-correlated; Schlick's Fresnel at every bounce). Prints, per \
                   compensation, the largest deviation of each sign with its 95 % confidence \
                   half-width and where it is, and the RMS over the grid; --json prints every \
                   point. The compensations are computed from kiln's reference (E, E_avg, E_F, \
