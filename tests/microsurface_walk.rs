@@ -1213,6 +1213,8 @@ fn the_dielectric_walks_first_order_is_the_smith_microsurfaces() {
         assert!((t.value - 1.0).abs() <= 4.0 * t.std_error + 1e-12, "{t:?}");
     }
     let smooth = glass_walk(0.0, View::Mu(0.6), 1.5, 1 << 14);
+    // A smooth interface scatters each walk exactly once.
+    assert_eq!(smooth.mean_vertices, 1.0);
     let f = fresnel_dielectric(1.5, 0.6);
     assert!(
         (smooth.single[REFLECTED].value - f).abs() < 1e-3 * f,

@@ -14,7 +14,7 @@
 //! always hits, at `ln C1(h') = ln C1(h) + ln(u) / (1 + Lambda(-w))` (`Lambda(w) = -1 -
 //! Lambda(-w)` for a downward `w`, section 4.1).
 
-use super::heights::Heights;
+use super::heights::{Heights, log_c1_of_hit_above, log_c1_of_hit_below};
 use super::lobe::LobeTargets;
 use super::random::WalkRandom;
 use crate::model::fresnel::{Fresnel, Rgb};
@@ -148,7 +148,7 @@ pub fn walk<N: MicrofacetDistribution>(
     let mut coloured: Rgb = [1.0; 3];
     // The first hit, travelling down from above the surface (ln C1 = 0).
     let mut w = Vec3::new(-wi.x, -wi.y, -wi.z);
-    let mut h = heights.height(random.uniform().ln() / (1.0 + ndf.lambda(wi)));
+    let mut h = heights.height(log_c1_of_hit_below(0.0, ndf.lambda(wi), random.uniform()));
     let mut vertex = 0;
     loop {
         vertex += 1;
@@ -253,9 +253,9 @@ pub fn walk<N: MicrofacetDistribution>(
             // A hit below h given no escape: C1(h') = C1(h) / (1 - u (1 - P))^(1 / Lambda),
             // with P the escape's probability (also when the escape was drawn).
             let u = random.uniform();
-            h = heights.height(log_c1 - (-u * (1.0 - probability)).ln_1p() / lambda);
+            h = heights.height(log_c1_of_hit_above(log_c1, lambda, probability, u));
         } else {
-            h = heights.height(log_c1 + random.uniform().ln() / (1.0 + ndf.lambda(w)));
+            h = heights.height(log_c1_of_hit_below(log_c1, ndf.lambda(w), random.uniform()));
         }
         if !to_the_end && vertex == tallied {
             tallies.beyond += plain;

@@ -32,6 +32,7 @@
 //! `2 B(2, 2) = 1/3`, the renderers' form `2/3`.
 
 use super::conductor::ROULETTE;
+use super::heights::{log_c1_of_hit_above, log_c1_of_hit_below};
 use super::random::WalkRandom;
 use crate::model::dielectric::refract;
 use crate::model::fresnel::dielectric as fresnel;
@@ -50,8 +51,6 @@ pub struct DielectricTallies {
     pub single: [f64; 2],
     /// The energy that left after any number of vertices, on each side.
     pub all: [f64; 2],
-    /// The throughput set aside by [`super::conductor::MAX_VERTICES`].
-    pub dropped: f64,
     /// Vertices visited, over all walks.
     pub vertices: u64,
 }
@@ -63,7 +62,6 @@ impl DielectricTallies {
             self.single[side] += other.single[side];
             self.all[side] += other.all[side];
         }
-        self.dropped += other.dropped;
         self.vertices += other.vertices;
     }
 }
@@ -89,7 +87,7 @@ fn turned_over(l: f64) -> f64 {
 /// Walks once from the incident direction `wi` (unit, `wi.z > 0`) through an interface of
 /// relative index `eta = n_inside / n_outside` (the light arrives from outside; `eta < 1` is
 /// light leaving a denser medium) and adds what leaves to `tallies`. Returns whether the walk
-/// reached [`super::conductor::MAX_VERTICES`].
+/// reached [`super::conductor::MAX_VERTICES`] (the caller then refuses the point).
 pub fn walk<N: MicrofacetDistribution>(
     ndf: &N,
     wi: Vec3,
@@ -102,7 +100,7 @@ pub fn walk<N: MicrofacetDistribution>(
     let mut relative = eta;
     let mut throughput = 1.0;
     let mut w = Vec3::new(-wi.x, -wi.y, -wi.z);
-    let mut l = (random.uniform().ln() / (1.0 + ndf.lambda(wi))).min(TOP);
+    let mut l = log_c1_of_hit_below(0.0, ndf.lambda(wi), random.uniform()).min(TOP);
     let mut vertex: u32 = 0;
     loop {
         vertex += 1;
@@ -144,12 +142,12 @@ pub fn walk<N: MicrofacetDistribution>(
             throughput *= 1.0 - escape;
             // A hit above l given no escape (as the conductor's walk).
             let u = random.uniform();
-            l = (l - (-u * (1.0 - escape)).ln_1p() / lambda).min(TOP);
+            l = log_c1_of_hit_above(l, lambda, escape, u).min(TOP);
         } else {
-            l = (l + random.uniform().ln() / (1.0 + ndf.lambda(w))).min(TOP);
+            l = log_c1_of_hit_below(l, ndf.lambda(w), random.uniform()).min(TOP);
         }
+        // A walk this long refuses its point (`WalkError::Unresolved`): nothing is set aside.
         if vertex >= super::conductor::MAX_VERTICES {
-            tallies.dropped += throughput;
             return true;
         }
         if throughput < ROULETTE {

@@ -63,6 +63,26 @@ impl Heights {
     }
 }
 
+/// `ln C1` of the next hit of a ray travelling down from `log_c1` (0 at the top of the surface):
+/// it always hits, with `ln C1' = ln C1 + ln(u) / (1 + Lambda(-w))` for a uniform `u`
+/// (`lambda_down` is `Lambda` of the direction reversed, i.e. of `|w|`; Heitz, Hanika, d'Eon and
+/// Dachsbacher 2016, section 4.1). Both walks step down by it.
+#[must_use]
+#[inline]
+pub fn log_c1_of_hit_below(log_c1: f64, lambda_down: f64, u: f64) -> f64 {
+    log_c1 + u.ln() / (1.0 + lambda_down)
+}
+
+/// `ln C1` of the next hit of a ray travelling up from `log_c1` with `Lambda(w) = lambda` that
+/// did not escape (which it does with probability `escape = C1^Lambda`): `C1' = C1 / (1 - u (1
+/// - escape))^(1 / Lambda)` for a uniform `u` (section 4.2, conditioned on no escape). Both
+/// walks step up by it.
+#[must_use]
+#[inline]
+pub fn log_c1_of_hit_above(log_c1: f64, lambda: f64, escape: f64, u: f64) -> f64 {
+    log_c1 - (-u * (1.0 - escape)).ln_1p() / lambda
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

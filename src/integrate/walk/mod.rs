@@ -527,8 +527,6 @@ pub struct DielectricEstimate {
     pub single: [Measured; 2],
     /// What leaves after any number of vertices.
     pub all: [Measured; 2],
-    /// What the vertex cap set aside, per walk (0 unless a walk reached it).
-    pub dropped: f64,
     /// Walks run.
     pub walks: u64,
     /// Mean vertices per walk.
@@ -578,7 +576,6 @@ pub fn walk_dielectric(
     Ok(DielectricEstimate {
         single: std::array::from_fn(|side| measure(&|t| t.single[side])),
         all: std::array::from_fn(|side| measure(&|t| t.all[side])),
-        dropped: replicates.iter().map(|t| t.dropped).sum::<f64>() / settings.walks as f64,
         walks: settings.walks,
         mean_vertices: replicates.iter().map(|t| t.vertices).sum::<u64>() as f64
             / settings.walks as f64,
