@@ -74,9 +74,9 @@ pub fn log_c1_of_hit_below(log_c1: f64, lambda_down: f64, u: f64) -> f64 {
 }
 
 /// `ln C1` of the next hit of a ray travelling up from `log_c1` with `Lambda(w) = lambda` that
-/// did not escape (which it does with probability `escape = C1^Lambda`): `C1' = C1 / (1 - u (1
-/// - escape))^(1 / Lambda)` for a uniform `u` (section 4.2, conditioned on no escape). Both
-/// walks step up by it.
+/// did not escape (which it does with probability `escape = C1^Lambda`):
+/// `C1' = C1 / (1 - u (1 - escape))^(1 / Lambda)` for a uniform `u` (section 4.2, conditioned on
+/// no escape). Both walks step up by it.
 #[must_use]
 #[inline]
 pub fn log_c1_of_hit_above(log_c1: f64, lambda: f64, escape: f64, u: f64) -> f64 {
