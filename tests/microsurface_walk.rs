@@ -381,14 +381,19 @@ fn the_f0_polynomial_is_the_albedo_at_every_f0() {
     );
 }
 
-/// `kiln` on the command line.
+/// `kiln ARGS`, run to its end.
+#[cfg(feature = "cli")]
+fn run(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_kiln"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+/// `kiln ARGS --json`, which must succeed, its output parsed.
 #[cfg(feature = "cli")]
 fn kiln_json(args: &[&str]) -> serde_json::Value {
-    let output = std::process::Command::new(env!("CARGO_BIN_EXE_kiln"))
-        .args(args)
-        .arg("--json")
-        .output()
-        .unwrap();
+    let output = run(&[args, &["--json"]].concat());
     assert!(
         output.status.success(),
         "{args:?}: {}",
@@ -634,12 +639,6 @@ fn kilns_compensation_fits_its_basis_and_matches_independent_walks() {
 fn the_compensation_table_bakes_reads_back_and_is_audited() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("tables");
-    let run = |args: &[&str]| {
-        std::process::Command::new(env!("CARGO_BIN_EXE_kiln"))
-            .args(args)
-            .output()
-            .unwrap()
-    };
     let baked = run(&[
         "compensation",
         "--bake",
@@ -1354,12 +1353,6 @@ fn the_command_line_measures_glass() {
 fn the_glass_compensation_bakes_and_matches_independent_walks() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("glass");
-    let run = |args: &[&str]| {
-        std::process::Command::new(env!("CARGO_BIN_EXE_kiln"))
-            .args(args)
-            .output()
-            .unwrap()
-    };
     let baked = run(&[
         "compensation",
         "--bake",

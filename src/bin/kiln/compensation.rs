@@ -276,15 +276,31 @@ fn bake(args: &CompensationArgs, out: &std::path::Path) -> kiln::Result<()> {
         };
         files.push((format!("{stem}.{extension}"), bytes));
     }
-    let written = kiln::format::write_files(out, &files)?;
+    let what = format!("kiln's compensation at {0} x {0} texels", args.size);
+    write_and_say(
+        args,
+        out,
+        &files,
+        &what,
+        settings.walks,
+        table.max_std_error(),
+    )
+}
+
+/// Writes a bake's `files` into `out` (atomically, [`kiln::format::write_files`]) and, unless
+/// `--quiet`, says `what` was written, with its walks and largest standard error.
+fn write_and_say(
+    args: &CompensationArgs,
+    out: &std::path::Path,
+    files: &[(String, Vec<u8>)],
+    what: &str,
+    walks: u64,
+    max_std_error: f64,
+) -> kiln::Result<()> {
+    let written = kiln::format::write_files(out, files)?;
     if !args.quiet {
         println!(
-            "kiln's compensation at {} x {} texels, {} walks each, largest standard error \
-             {:.1e}: {}",
-            args.size,
-            args.size,
-            settings.walks,
-            table.max_std_error(),
+            "{what}, {walks} walks each, largest standard error {max_std_error:.1e}: {}",
             written
                 .iter()
                 .map(|p| kiln::error::escaped_path(p))
@@ -471,23 +487,18 @@ fn bake_glass(args: &CompensationArgs, out: &std::path::Path) -> kiln::Result<()
         };
         files.push((format!("{stem}.{extension}"), bytes));
     }
-    let written = kiln::format::write_files(out, &files)?;
-    if !args.quiet {
-        println!(
-            "kiln's glass compensation at eta {eta}, {} x {} texels a side, {} walks each, \
-             largest standard error {:.1e}: {}",
-            args.size,
-            args.size,
-            settings.walks,
-            table.max_std_error(),
-            written
-                .iter()
-                .map(|p| kiln::error::escaped_path(p))
-                .collect::<Vec<_>>()
-                .join(", ")
-        );
-    }
-    Ok(())
+    let what = format!(
+        "kiln's glass compensation at eta {eta}, {0} x {0} texels a side",
+        args.size
+    );
+    write_and_say(
+        args,
+        out,
+        &files,
+        &what,
+        settings.walks,
+        table.max_std_error(),
+    )
 }
 
 /// `kiln compensation --ior ETA`.

@@ -26,6 +26,16 @@ use crate::model::vector::Vec3;
 /// Unbiased; the tail beyond it is at most a thousandth of the energy.
 pub const ROULETTE: f64 = 1e-3;
 
+/// Russian roulette for a walk whose throughput `t` fell below [`ROULETTE`]: `Some` of its
+/// probability of going on, `t / ROULETTE`, when it goes on (the caller raises its throughput
+/// to [`ROULETTE`], dividing what it carries beside by that probability), `None` when it ends.
+/// Both walks play it.
+#[inline]
+pub(super) fn survives(t: f64, random: &mut WalkRandom<'_>) -> Option<f64> {
+    let survive = t / ROULETTE;
+    (random.uniform() < survive).then_some(survive)
+}
+
 /// The most vertices a walk may have: far beyond any walk that ends (at `alpha = 1000` and
 /// normal incidence walks average 3,100 vertices and none of 2^18 reached 2^16, `kiln eval
 /// --quantity e-multiple --f0 1 --alpha 1000 --mu 1 --walks 2^18`, 2026-12-07; Russian roulette
@@ -271,10 +281,9 @@ pub fn walk<N: MicrofacetDistribution>(
             return true;
         }
         if plain < ROULETTE {
-            let survive = plain / ROULETTE;
-            if random.uniform() >= survive {
+            let Some(survive) = survives(plain, random) else {
                 return false;
-            }
+            };
             plain = ROULETTE;
             for c in &mut coloured {
                 *c /= survive;

@@ -31,7 +31,7 @@
 //! (`eta = 1`, every ray straight through) with `Lambda = 1` the walk's first order transmits
 //! `2 B(2, 2) = 1/3`, the renderers' form `2/3`.
 
-use super::conductor::ROULETTE;
+use super::conductor::{ROULETTE, survives};
 use super::heights::{log_c1_of_hit_above, log_c1_of_hit_below};
 use super::random::WalkRandom;
 use crate::model::dielectric::refract;
@@ -151,8 +151,7 @@ pub fn walk<N: MicrofacetDistribution>(
             return true;
         }
         if throughput < ROULETTE {
-            let survive = throughput / ROULETTE;
-            if random.uniform() >= survive {
+            if survives(throughput, random).is_none() {
                 return false;
             }
             throughput = ROULETTE;

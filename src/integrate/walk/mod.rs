@@ -262,6 +262,14 @@ impl Measured {
     }
 }
 
+/// The mean per walk of what `get` reads from each scramble's sums, with its standard error
+/// ([`Measured::from_replicates`]): how every walk's estimate is read from its replicates.
+fn per_walk<T>(replicates: &[T], settings: &WalkSettings, get: impl Fn(&T) -> f64) -> Measured {
+    let per_scramble = (settings.walks / u64::from(settings.scrambles)) as f64;
+    let means: Vec<f64> = replicates.iter().map(|t| get(t) / per_scramble).collect();
+    Measured::from_replicates(&means)
+}
+
 /// What [`walk_albedo`] measured at one view.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct WalkEstimate {
@@ -332,11 +340,7 @@ pub fn walk_albedo(
     let replicates = run(
         model, alpha, mu, fresnel, None, None, orders, settings, progress,
     )?;
-    let per_scramble = (settings.walks / u64::from(settings.scrambles)) as f64;
-    let measure = |get: &dyn Fn(&Tallies) -> f64| {
-        let means: Vec<f64> = replicates.iter().map(|t| get(t) / per_scramble).collect();
-        Measured::from_replicates(&means)
-    };
+    let measure = |get: &dyn Fn(&Tallies) -> f64| per_walk(&replicates, settings, get);
     let with_fresnel = *fresnel != Fresnel::None;
     let albedo = std::array::from_fn(|j| {
         if with_fresnel {
@@ -488,15 +492,8 @@ pub fn walk_lobe(
         settings,
         progress,
     )?;
-    let per_scramble = (settings.walks / u64::from(settings.scrambles)) as f64;
     let slots = grid.slots();
-    let measure = |slot: usize| {
-        let means: Vec<f64> = replicates
-            .iter()
-            .map(|t| t.lobe[slot] / per_scramble)
-            .collect();
-        Measured::from_replicates(&means)
-    };
+    let measure = |slot: usize| per_walk(&replicates, settings, |t| t.lobe[slot]);
     let fixed = grid.mus.len() * grid.azimuths.len();
     Ok(LobeEstimate {
         mu,
@@ -568,11 +565,8 @@ pub fn walk_dielectric(
         progress,
     ))
     .ok_or(WalkError::Unresolved { alpha, mu })?;
-    let per_scramble = (settings.walks / u64::from(settings.scrambles)) as f64;
-    let measure = |get: &dyn Fn(&dielectric::DielectricTallies) -> f64| {
-        let means: Vec<f64> = replicates.iter().map(|t| get(t) / per_scramble).collect();
-        Measured::from_replicates(&means)
-    };
+    let measure =
+        |get: &dyn Fn(&dielectric::DielectricTallies) -> f64| per_walk(&replicates, settings, get);
     Ok(DielectricEstimate {
         single: std::array::from_fn(|side| measure(&|t| t.single[side])),
         all: std::array::from_fn(|side| measure(&|t| t.all[side])),
