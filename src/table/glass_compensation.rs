@@ -70,9 +70,7 @@ impl GlassCompensationTable {
         progress: &(dyn Fn(u64) + Sync),
     ) -> Result<Self, WalkError> {
         settings.validate()?;
-        if !(0.01..=100.0).contains(&eta) {
-            return Err(WalkError::Eta(eta));
-        }
+        crate::integrate::walk::check_eta(eta)?;
         let reference = ReferenceSettings::default();
         let done = std::sync::atomic::AtomicU64::new(0);
         // Per texel: [k_R, k_T] per side, and the standard error.
@@ -147,12 +145,12 @@ impl GlassCompensationTable {
         if self.spec.quantity != Quantity::E || self.spec.ior.is_some() {
             return Err("spec is not an E layout over (roughness, mu)".into());
         }
-        if !(0.01..=100.0).contains(&self.eta) {
-            return Err(format!(
+        crate::integrate::walk::check_eta(self.eta).map_err(|_| {
+            format!(
                 "eta {} is out of range [0.01, 100]",
                 crate::error::shown(self.eta)
-            ));
-        }
+            )
+        })?;
         let n = self.spec.len();
         let channels = [
             ("reflection (outside)", &self.reflection[0]),

@@ -429,9 +429,7 @@ fn bake_glass(args: &CompensationArgs, out: &std::path::Path) -> kiln::Result<()
             args.ior.len()
         )));
     };
-    if !(0.01..=100.0).contains(&eta) {
-        return Err(kiln::integrate::walk::WalkError::Eta(eta).into());
-    }
+    kiln::integrate::walk::check_eta(eta)?;
     let formats = args.formats(&[CompensationFormat::Json, CompensationFormat::Exr]);
     if let Some(other) = formats
         .iter()
@@ -509,8 +507,8 @@ fn glass(args: &CompensationArgs) -> kiln::Result<()> {
         alphas: args.alphas(&[0.25, 0.5, 0.75, 1.0]),
         mus: args.mu.clone(),
     };
-    if let Some(&eta) = grid.etas.iter().find(|e| !(0.01..=100.0).contains(*e)) {
-        return Err(kiln::integrate::walk::WalkError::Eta(eta).into());
+    for &eta in &grid.etas {
+        kiln::integrate::walk::check_eta(eta)?;
     }
     let table = match args.table.as_deref() {
         None => None,

@@ -307,6 +307,15 @@ macro_rules! on_surface {
     };
 }
 
+/// Checks a dielectric's relative index: in `[0.01, 100]` (the range `kiln bake --ior` takes).
+pub fn check_eta(eta: f64) -> Result<(), WalkError> {
+    if (0.01..=100.0).contains(&eta) {
+        Ok(())
+    } else {
+        Err(WalkError::Eta(eta))
+    }
+}
+
 /// Checks a walk's inputs.
 pub fn check_inputs(model: Model, alpha: f64, mu: f64, orders: usize) -> Result<(), WalkError> {
     if model.masking != Masking::HeightCorrelated {
@@ -548,9 +557,7 @@ pub fn walk_dielectric(
         View::CosineWeighted => 0.5,
     };
     check_inputs(model, alpha, mu, 0)?;
-    if !(0.01..=100.0).contains(&eta) {
-        return Err(WalkError::Eta(eta));
-    }
+    check_eta(eta)?;
     let replicates = on_surface!(model, alpha, |ndf| scrambled(
         settings,
         &dielectric::DielectricTallies::default,
