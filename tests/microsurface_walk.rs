@@ -1426,6 +1426,20 @@ fn the_glass_compensation_bakes_and_matches_independent_walks() {
     let message = String::from_utf8_lossy(&refused.stderr);
     assert_eq!(refused.status.code(), Some(2), "{message}");
     assert!(message.contains("at eta 1.5"), "{message}");
+    // A table walked on GGX is not measured against Beckmann's walk.
+    let refused = run(&[
+        "compensation",
+        "--ndf",
+        "beckmann",
+        "--ior",
+        "1.5",
+        "--table",
+        file.to_str().unwrap(),
+        "-q",
+    ]);
+    let message = String::from_utf8_lossy(&refused.stderr);
+    assert_eq!(refused.status.code(), Some(2), "{message}");
+    assert!(message.contains("the walk is beckmann"), "{message}");
     // Glass has no shader code yet: asked for, refused by name.
     let refused = run(&[
         "compensation",

@@ -510,28 +510,27 @@ fn glass(args: &CompensationArgs) -> kiln::Result<()> {
     for &eta in &grid.etas {
         kiln::integrate::walk::check_eta(eta)?;
     }
-    let table = match args.table.as_deref() {
-        None => None,
-        Some(path) => {
-            let bytes = kiln::format::read_file(path)?;
-            let table =
-                kiln::format::glass_compensation::decode(&bytes, &kiln::error::escaped_path(path))?;
-            if let Some(&eta) = grid.etas.iter().find(|&&e| {
-                let near = |x: f64| (e / x - 1.0).abs() < 1e-3;
-                !near(table.eta) && !near(1.0 / table.eta)
-            }) {
-                return Err(kiln::Error::InvalidInput(format!(
-                    "--table holds kiln's glass compensation at eta {}: measure it at --ior {} \
+    let table = read_checked(
+        args.table.as_deref(),
+        args.model(),
+        kiln::format::glass_compensation::decode,
+        |t| t.spec.model,
+    )?;
+    if let Some(table) = &table
+        && let Some(&eta) = grid.etas.iter().find(|&&e| {
+            let near = |x: f64| (e / x - 1.0).abs() < 1e-3;
+            !near(table.eta) && !near(1.0 / table.eta)
+        })
+    {
+        return Err(kiln::Error::InvalidInput(format!(
+            "--table holds kiln's glass compensation at eta {}: measure it at --ior {} \
                      (from outside) or {:.4} (from inside), within 0.1 %, not {}",
-                    table.eta,
-                    table.eta,
-                    1.0 / table.eta,
-                    kiln::error::shown(eta)
-                )));
-            }
-            Some(table)
-        }
-    };
+            table.eta,
+            table.eta,
+            1.0 / table.eta,
+            kiln::error::shown(eta)
+        )));
+    }
     let settings = args.walk_settings(1 << 20)?;
     let views = (grid.etas.len() * grid.alphas.len() * grid.mus.len()) as u64;
     // About a second of one core a view per 2^20 walks (0.54 s on two cores at r = 0.7,
@@ -632,15 +631,28 @@ fn read_table(
     path: Option<&std::path::Path>,
     model: Model,
 ) -> kiln::Result<Option<kiln::table::compensation::CompensationTable>> {
+    read_checked(path, model, kiln::format::compensation::decode, |t| {
+        t.spec.model
+    })
+}
+
+/// A table of kiln's from `--table`, decoded by `decode` (which checks it) and refused unless
+/// it was walked on `model` (`model_of` reads its own), if a path is given.
+fn read_checked<T>(
+    path: Option<&std::path::Path>,
+    model: Model,
+    decode: fn(&[u8], &str) -> kiln::Result<T>,
+    model_of: fn(&T) -> Model,
+) -> kiln::Result<Option<T>> {
     let Some(path) = path else {
         return Ok(None);
     };
     let bytes = kiln::format::read_file(path)?;
-    let table = kiln::format::compensation::decode(&bytes, &kiln::error::escaped_path(path))?;
-    if table.spec.model != model {
+    let table = decode(&bytes, &kiln::error::escaped_path(path))?;
+    if model_of(&table) != model {
         return Err(kiln::Error::InvalidInput(format!(
             "--table holds kiln's compensation for {}; the walk is {model} (--ndf)",
-            table.spec.model
+            model_of(&table)
         )));
     }
     Ok(Some(table))
