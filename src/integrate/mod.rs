@@ -1,6 +1,7 @@
 //! Integration: Owen-scrambled Sobol points and the QMC albedo estimators.
 
 pub mod albedo;
+pub mod anisotropic;
 pub mod average_quadrature;
 pub mod compensation;
 pub mod dielectric;

@@ -3,6 +3,7 @@
 //! The reflection BRDF (`docs/physics.md`) is `f(o, i) = F(o.h) D(h) G2(o, i) / (4 |n.i| |n.o|)`;
 //! the tables here are for `F = 1`.
 
+pub mod anisotropic_ggx;
 pub mod beckmann_sampling;
 pub mod dielectric;
 pub mod disney_diffuse;
@@ -16,6 +17,7 @@ pub mod vector;
 
 use serde::{Deserialize, Serialize};
 
+pub use anisotropic_ggx::{AnisotropicGgx, AnisotropyConvention, IsotropicReading};
 pub use fresnel::Fresnel;
 pub use masking::Masking;
 pub use ndf::{Beckmann, Ggx, MicrofacetDistribution, Polar};

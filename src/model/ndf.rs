@@ -258,18 +258,32 @@ impl Ggx {
     /// computed without cancellation, so the tail keeps its precision when `t` is tiny.
     #[must_use]
     pub fn visible_normal_on_cap(&self, o: Vec3, u0: f64, t: f64) -> Vec3 {
-        let a = self.alpha;
-        let v = Vec3::new(a * o.x, a * o.y, o.z).normalize();
-        let phi = 2.0 * PI * u0;
-        let hz = t * (1.0 + v.z);
-        let one_minus_vz = (v.x * v.x + v.y * v.y) / (1.0 + v.z);
-        let s = ((1.0 + v.z) * (1.0 - t) * (one_minus_vz + hz))
-            .max(0.0)
-            .sqrt();
-        let (sin_phi, cos_phi) = phi.sin_cos();
-        let h = Vec3::new(s * cos_phi + v.x, s * sin_phi + v.y, hz);
-        Vec3::new(a * h.x, a * h.y, h.z).normalize()
+        visible_normal_on_stretched_cap(self.alpha, self.alpha, o, u0, t)
     }
+}
+
+/// [`Ggx::visible_normal_on_cap`] for the anisotropic GGX of roughness `alpha_x` along x and
+/// `alpha_y` along y (Dupuy & Benyoub 2023 stretch each axis by its own `alpha`): with
+/// `alpha_x = alpha_y` the same operations, bit for bit.
+#[must_use]
+#[inline(always)]
+pub(crate) fn visible_normal_on_stretched_cap(
+    alpha_x: f64,
+    alpha_y: f64,
+    o: Vec3,
+    u0: f64,
+    t: f64,
+) -> Vec3 {
+    let v = Vec3::new(alpha_x * o.x, alpha_y * o.y, o.z).normalize();
+    let phi = 2.0 * PI * u0;
+    let hz = t * (1.0 + v.z);
+    let one_minus_vz = (v.x * v.x + v.y * v.y) / (1.0 + v.z);
+    let s = ((1.0 + v.z) * (1.0 - t) * (one_minus_vz + hz))
+        .max(0.0)
+        .sqrt();
+    let (sin_phi, cos_phi) = phi.sin_cos();
+    let h = Vec3::new(s * cos_phi + v.x, s * sin_phi + v.y, hz);
+    Vec3::new(alpha_x * h.x, alpha_y * h.y, h.z).normalize()
 }
 
 /// Beckmann-Spizzichino.

@@ -1,5 +1,6 @@
 //! `kiln eval`.
 
+mod anisotropic;
 mod walk;
 
 use crate::args::{SEE_CONVENTIONS, parse_alpha, parse_mu, parse_roughness, parse_samples};
@@ -77,6 +78,8 @@ pub struct EvalArgs {
     quantity: EvalQuantity,
     #[command(flatten)]
     fresnel: FresnelArgs,
+    #[command(flatten)]
+    anisotropy: anisotropic::AnisotropyArgs,
     /// How to evaluate it. `kiln bake` picks its method from --max-error (the reference below
     /// 1e-3, as for its default tables); `eval` uses the one given here.
     #[arg(long, value_enum, default_value = "qmc")]
@@ -117,8 +120,11 @@ pub struct EvalArgs {
 }
 
 pub fn run(args: EvalArgs) -> kiln::Result<()> {
-    let fresnel = args.fresnel.model()?;
     args.flags_of_their_quantities()?;
+    if args.anisotropy.given() {
+        return anisotropic::run(&args);
+    }
+    let fresnel = args.fresnel.model()?;
     if matches!(
         args.quantity,
         EvalQuantity::EOrder | EvalQuantity::EMultiple | EvalQuantity::ECompensated
