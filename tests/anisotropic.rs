@@ -254,3 +254,71 @@ fn bad_anisotropic_input_is_refused_with_the_range() {
         &["--quantity e-avg"],
     );
 }
+
+/// The audit of an engine's reading at the lobe: Disney's convention at `alpha = 0.3`
+/// and `a = 8 / 9 / 0.9` (`aspect = 1/3`) is `alpha = (0.9, 0.1)`, read at the geometric mean
+/// 0.3. The audit's truth is the independent integrator's, its read value kiln's isotropic `E`,
+/// and the error their difference (0.27 along x, 0.29 along y, the worst).
+#[test]
+fn the_audit_compares_the_lobe_with_the_isotropic_value_the_engine_reads() {
+    use kiln::model::AnisotropyConvention;
+    use kiln::verify::anisotropy::{AnisotropyGrid, audit_anisotropy};
+    let grid = AnisotropyGrid {
+        roughness: vec![0.3f64.sqrt()],
+        anisotropy: vec![8.0 / 9.0 / 0.9],
+        mu: vec![0.9],
+        phi: vec![0.0, PI / 2.0],
+    };
+    let audit = audit_anisotropy(AnisotropyConvention::Disney, &grid).unwrap();
+    assert_eq!(audit.points, 2);
+    let (isotropic, _) = kiln_e(&[
+        "eval",
+        "--alpha",
+        "0.3",
+        "--mu",
+        "0.9",
+        "--method",
+        "reference",
+        "--json",
+    ]);
+    for p in &audit.compared {
+        assert!(
+            (p.alpha_x - 0.9).abs() < 1e-12 && (p.alpha_y - 0.1).abs() < 1e-12,
+            "{p:?}"
+        );
+        let truth = independent_e(0.9, 0.1, 0.9, p.phi);
+        assert!((p.truth - truth).abs() < 1e-7, "{p:?} vs {truth}");
+        assert!((p.read - isotropic).abs() < 1e-9, "{p:?}");
+        assert_eq!(p.error, p.read - p.truth);
+    }
+    assert!(
+        (audit.max_error - (isotropic - 0.578_363_4)).abs() < 1e-6,
+        "{audit:?}"
+    );
+    assert_eq!(audit.worst.phi, PI / 2.0);
+    assert!((audit.max_azimuthal_spread - (0.594_323_5 - 0.578_363_4)).abs() < 1e-6);
+}
+
+/// `kiln verify --anisotropy-convention` refuses what it does not audit.
+#[test]
+fn the_anisotropy_audit_refuses_other_models() {
+    command::refused(
+        &[
+            "verify",
+            "--anisotropy-convention",
+            "rms",
+            "--ndf",
+            "beckmann",
+        ],
+        &["--anisotropy-convention", "--ndf"],
+    );
+    command::refused(
+        &[
+            "verify",
+            "--anisotropy-convention",
+            "rms",
+            "tables/ggx_E.exr",
+        ],
+        &["--anisotropy-convention"],
+    );
+}

@@ -90,17 +90,21 @@ pub enum AnisotropyConvention {
     /// Kulla & Conty 2017 (Imageworks): `alpha_x = alpha (1 + a)`, `alpha_y = alpha (1 - a)`,
     /// `a` in [0, 1) (a negative `a` swaps the axes). Filament, Unreal; engines read their
     /// isotropic table at `alpha`, the arithmetic mean.
+    #[cfg_attr(feature = "cli", value(alias = "arithmetic-mean"))]
     KullaConty,
     /// Burley 2012 (Disney): `aspect = sqrt(1 - 0.9 a)`, `alpha_x = alpha / aspect`,
     /// `alpha_y = alpha aspect`, `a` in [0, 1]. Cycles, Enterprise PBR; read at `alpha`, the
     /// geometric mean.
+    #[cfg_attr(feature = "cli", value(alias = "geometric-mean"))]
     Disney,
     /// glTF `KHR_materials_anisotropy`: `alpha_x = alpha + (1 - alpha) a^2`, `alpha_y = alpha`,
     /// `a` in [0, 1]; read at `alpha`, the bitangent's (the smaller) roughness.
+    #[cfg_attr(feature = "cli", value(alias = "minimum"))]
     Gltf,
     /// OpenPBR 1.0 (`specular_roughness_anisotropy`): `alpha_x = alpha sqrt(2 / (1 + (1 -
     /// a)^2))`, `alpha_y = (1 - a) alpha_x`, `a` in [0, 1]; read at `alpha`, the root mean
     /// square.
+    #[cfg_attr(feature = "cli", value(alias = "rms"))]
     Openpbr,
 }
 
@@ -214,6 +218,17 @@ impl IsotropicReading {
             IsotropicReading::GeometricMean => "geometric-mean",
             IsotropicReading::ArithmeticMean => "arithmetic-mean",
             IsotropicReading::Rms => "rms",
+            IsotropicReading::Minimum => "minimum",
+        }
+    }
+
+    /// The average in words: `geometric mean`, `arithmetic mean`, `root mean square`, `minimum`.
+    #[must_use]
+    pub fn describe(self) -> &'static str {
+        match self {
+            IsotropicReading::GeometricMean => "geometric mean",
+            IsotropicReading::ArithmeticMean => "arithmetic mean",
+            IsotropicReading::Rms => "root mean square",
             IsotropicReading::Minimum => "minimum",
         }
     }

@@ -11,6 +11,7 @@ use kiln::verify::{Against, AuditSettings, Point, Progress, audit};
 use kiln::{Axis, Grid, Masking, Model, MuMapping, Ndf, Quantity, RoughnessConvention, Table};
 use std::path::{Path, PathBuf};
 
+mod anisotropy;
 mod fit;
 
 /// Audit a table (or a texture-free fit, --fit) against the deterministic reference (or another table).
@@ -32,8 +33,19 @@ pub struct VerifyArgs {
     /// The table to audit: a kiln output, a text file of numbers (whitespace or commas, '#'
     /// comments), raw little-endian floats (--dtype) or an EXR channel (--channel). Not with
     /// --fit, which audits a formula instead of a file of numbers.
-    #[arg(required_unless_present = "fit")]
+    #[arg(required_unless_present_any = ["fit", "anisotropy_convention"])]
     file: Option<PathBuf>,
+    /// Audit how an engine compensates an anisotropic GGX lobe with its isotropic E table,
+    /// read at one roughness: kulla-conty (Filament, Unreal: the arithmetic mean of alpha_x
+    /// and alpha_y; alias arithmetic-mean), disney (Cycles, Enterprise PBR: the geometric mean;
+    /// alias geometric-mean), gltf (KHR_materials_anisotropy: the bitangent's roughness; alias
+    /// minimum), openpbr (the root mean square; alias rms). Compares the isotropic reference
+    /// with the anisotropic lobe's over r, anisotropy, mu and the view's azimuth, and reports
+    /// the maximum error and where (--plot: a map per anisotropy).
+    #[arg(long, value_enum, conflicts_with_all = ["file", "fit", "furnace", "preset", "shape",
+        "channel", "dtype", "order", "grid", "roughness_axis", "mu_axis", "roughness_spacing",
+        "texels", "quantity", "average", "clamp_min", "density", "only", "form", "against"])]
+    anisotropy_convention: Option<kiln::model::AnisotropyConvention>,
     /// Audit a texture-free fit instead of a table: karis (UE4 mobile EnvBRDFApprox), materialx
     /// (mx_ggx_dir_albedo_analytic), unreal (UE5's analytic GGXEnergyLookup), or a formula
     /// file (TOML: name = "...", optional define = ["k = max(r, 1e-3)", ...], and formulas
@@ -693,6 +705,9 @@ fn json_report(
 pub fn run(args: VerifyArgs) -> kiln::Result<bool> {
     if let Some(fit) = &args.fit {
         return fit::run(&args, fit);
+    }
+    if let Some(convention) = args.anisotropy_convention {
+        return anisotropy::run(&args, convention);
     }
     if let Some(preset) = args.preset {
         let bytes = kiln::format::read_file(args.file())?;
