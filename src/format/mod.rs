@@ -4,6 +4,7 @@
 //! directory and renamed into place only after all of them were written. A failure part-way
 //! removes the temporaries; a reader never sees a half-written table.
 
+pub mod anisotropic;
 pub mod binary;
 pub mod c_header;
 pub mod comment;

@@ -168,6 +168,41 @@ impl AnisotropyConvention {
         }
     }
 
+    /// The coordinate of anisotropy `a` on a table's axis ending at `max` (both in `[0, max]`
+    /// of the convention): uniform in the logarithm of the aspect ratio `alpha_x / alpha_y` where
+    /// it depends on `a` alone (Kulla-Conty `atanh(a)`, Disney `-ln(1 - 0.9 a)`, OpenPBR `-ln(1 -
+    /// a)`, each over its value at `max`), and `(a / max)^2` for glTF's, whose `alpha_x - alpha_y`
+    /// grows as `a^2`. Linear in `a` itself, the bitangent's roughness `alpha (1 - a)` halves
+    /// within the last interval of 16 samples at `a = 0.95`, and lookups there were 3.5e-3 off
+    /// (measured while designing, 2026-12-07).
+    #[must_use]
+    pub fn anisotropy_coordinate(self, a: f64, max: f64) -> f64 {
+        if max <= 0.0 {
+            return 0.0;
+        }
+        let f = |a: f64| match self {
+            AnisotropyConvention::KullaConty => a.atanh(),
+            AnisotropyConvention::Disney => -(-0.9 * a).ln_1p(),
+            AnisotropyConvention::Openpbr => -(-a).ln_1p(),
+            AnisotropyConvention::Gltf => a * a,
+        };
+        (f(a.clamp(0.0, max)) / f(max)).clamp(0.0, 1.0)
+    }
+
+    /// The anisotropy at coordinate `w` of an axis ending at `max` (the inverse of
+    /// [`AnisotropyConvention::anisotropy_coordinate`]).
+    #[must_use]
+    pub fn anisotropy_at(self, w: f64, max: f64) -> f64 {
+        let w = w.clamp(0.0, 1.0);
+        match self {
+            AnisotropyConvention::KullaConty => (w * max.atanh()).tanh(),
+            AnisotropyConvention::Disney => -(w * (-0.9 * max).ln_1p()).exp_m1() / 0.9,
+            AnisotropyConvention::Openpbr => -(w * (-max).ln_1p()).exp_m1(),
+            AnisotropyConvention::Gltf => max * w.sqrt(),
+        }
+        .min(max)
+    }
+
     /// The average by which the convention's engines read an isotropic table.
     #[must_use]
     pub fn reading(self) -> IsotropicReading {
@@ -343,6 +378,17 @@ mod tests {
             AnisotropyConvention::Openpbr.alphas(0.25, 0.5),
             (0.316_227_766_016_837_94, 0.158_113_883_008_418_97),
         );
+        // The anisotropy coordinate and its inverse.
+        for convention in AnisotropyConvention::ALL {
+            for w in [0.0, 0.3, 0.77, 1.0] {
+                let a = convention.anisotropy_at(w, 0.9);
+                let back = convention.anisotropy_coordinate(a, 0.9);
+                assert!(
+                    (back - w).abs() < 1e-12,
+                    "{convention}: {w} -> {a} -> {back}"
+                );
+            }
+        }
         // Each convention's reading gives back its alpha.
         for convention in AnisotropyConvention::ALL {
             let (x, y) = convention.alphas(0.25, 0.5);

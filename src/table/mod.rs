@@ -1,5 +1,6 @@
 //! Tables: what was computed (the spec), the values with their errors, and how to look them up.
 
+pub mod anisotropic;
 pub mod axis;
 pub mod balanced_layout;
 pub mod check;

@@ -2,6 +2,7 @@
 //! the coordinates it says it was computed at, and what a renderer's bilinear lookup of it returns
 //! between those coordinates.
 
+pub mod anisotropic_table;
 pub mod anisotropy;
 pub mod compensation;
 pub mod error_map;

@@ -1,5 +1,6 @@
 //! The `kiln` command: parses, calls the library, prints. No maths here.
 
+mod anisotropic;
 mod args;
 mod bake;
 mod compensation;
@@ -44,6 +45,7 @@ enum Command {
     Merge(merge::MergeArgs),
     Fit(fit::FitArgs),
     Compensation(compensation::CompensationArgs),
+    Anisotropic(anisotropic::AnisotropicArgs),
 }
 
 /// A progress bar on stderr, drawn only when stderr is a terminal; hidden with `quiet`.
@@ -207,6 +209,7 @@ fn main() -> ExitCode {
         Command::Merge(args) => merge::run(args).map(|()| true),
         Command::Fit(args) => fit::run(args).map(|()| true),
         Command::Compensation(args) => compensation::run(args).map(|()| true),
+        Command::Anisotropic(args) => anisotropic::run(args),
     };
     match result {
         Ok(true) => ExitCode::SUCCESS,
