@@ -363,6 +363,7 @@ fn help_texts_are_true() {
         "study",
         "merge",
         "compensation",
+        "anisotropic",
     ] {
         let text = help(command);
         assert!(!text.contains("[`"), "{command} --help shows rustdoc links");

@@ -18,7 +18,7 @@ pub const LOOKUP: &str = "E(mu, phi; r, a) for anisotropic GGX (height-correlate
     (mu (1 + 4 alpha_phi) / (mu + 4 alpha_phi))^0.4, v = ln(alpha_x / alpha_phi) / \
     ln(alpha_x / alpha_y) (sin^2 phi when alpha_x = alpha_y), r, and the anisotropy's coordinate w (kulla-conty atanh(a) / atanh(max), disney ln(1 - 0.9 a) / ln(1 - 0.9 max), openpbr ln(1 - a) / ln(1 - max), gltf (a / max)^2), each \
     in [0, 1] with samples on both ends; interpolate linearly in each. Values are stored t \
-    fastest, then v, r, w; average (E_avg, the average of the lookup over the hemisphere) r fastest, then w: interpolate ln(1 - E_avg) linearly in ln(max(r, 1e-3)) and in w";
+    fastest, then v, r, w; average (E_avg, the average of the lookup over the hemisphere) r fastest, then w: read 1 - E_avg = alpha^2 c with c = (1 - E_avg) / alpha^2 interpolated linearly in r and w (alpha = max(r, 1e-3)^2)";
 
 /// The file: the table and what it is.
 #[derive(Serialize, Deserialize)]
@@ -30,6 +30,12 @@ struct Document {
     max_node_error: f64,
     furnace: Option<MeasuredFurnace>,
     table: AnisotropicTable,
+}
+
+impl super::document::Kinded for Document {
+    fn kind(&self) -> &str {
+        &self.kind
+    }
 }
 
 /// The name stem of `table`'s files: `ggx-anisotropic-kulla-conty-E`.
@@ -75,18 +81,13 @@ pub fn f32_bytes(values: &[f64]) -> Vec<u8> {
 /// Not such a document, or a table a lookup cannot trust.
 pub fn decode(bytes: &[u8], name: &str) -> Result<AnisotropicTable> {
     let bad = |message: String| Error::InvalidInput(format!("{name}: {message}"));
-    let document: Document = serde_json::from_slice(bytes).map_err(|e| {
-        bad(format!(
-            "not a kiln anisotropic albedo file ({}); `kiln anisotropic --bake DIR` writes them",
-            crate::error::quoted(&e.to_string())
-        ))
-    })?;
-    if document.kind != KIND {
-        return Err(bad(format!(
-            "its kind is {}, not {KIND}",
-            crate::error::quoted(&document.kind)
-        )));
-    }
+    let document: Document = super::document::decode_kind(
+        bytes,
+        name,
+        KIND,
+        "kiln anisotropic albedo file",
+        "kiln anisotropic --bake DIR",
+    )?;
     let table = document.table;
     table.check().map_err(bad)?;
     Ok(table)

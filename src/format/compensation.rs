@@ -26,6 +26,12 @@ struct Document {
     table: CompensationTable,
 }
 
+impl super::document::Kinded for Document {
+    fn kind(&self) -> &str {
+        &self.kind
+    }
+}
+
 /// The file name of `table`'s document: `NDF-MASKING-kiln-compensation.json`.
 #[must_use]
 pub fn file_name(table: &CompensationTable) -> String {
@@ -133,18 +139,13 @@ pub fn encode(table: &CompensationTable, command: &str) -> Vec<u8> {
 /// Not such a document, or a table a lookup cannot trust.
 pub fn decode(bytes: &[u8], name: &str) -> Result<CompensationTable> {
     let bad = |message: String| Error::InvalidInput(format!("{name}: {message}"));
-    let document: Document = serde_json::from_slice(bytes).map_err(|e| {
-        bad(format!(
-            "not a kiln compensation file ({}); `kiln compensation --bake DIR` writes them",
-            crate::error::quoted(&e.to_string())
-        ))
-    })?;
-    if document.kind != KIND {
-        return Err(bad(format!(
-            "its kind is {}, not {KIND}",
-            crate::error::quoted(&document.kind)
-        )));
-    }
+    let document: Document = super::document::decode_kind(
+        bytes,
+        name,
+        KIND,
+        "kiln compensation file",
+        "kiln compensation --bake DIR",
+    )?;
     if document.pole != KILN_POLE {
         return Err(bad(format!(
             "its basis has the pole {}, not this kiln's {KILN_POLE}: bake it again",

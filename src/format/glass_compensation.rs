@@ -28,6 +28,12 @@ struct Document {
     table: GlassCompensationTable,
 }
 
+impl super::document::Kinded for Document {
+    fn kind(&self) -> &str {
+        &self.kind
+    }
+}
+
 /// The name stem of `table`'s files: `ggx-height-correlated-kiln-glass-compensation-ior-1.5`.
 #[must_use]
 pub fn stem(table: &GlassCompensationTable) -> String {
@@ -93,19 +99,13 @@ pub fn encode(table: &GlassCompensationTable, command: &str) -> Vec<u8> {
 /// Not such a document, or a table a lookup cannot trust.
 pub fn decode(bytes: &[u8], name: &str) -> Result<GlassCompensationTable> {
     let bad = |message: String| Error::InvalidInput(format!("{name}: {message}"));
-    let document: Document = serde_json::from_slice(bytes).map_err(|e| {
-        bad(format!(
-            "not a kiln glass compensation file ({}); `kiln compensation --bake DIR --ior ETA` \
-             writes them",
-            crate::error::quoted(&e.to_string())
-        ))
-    })?;
-    if document.kind != KIND {
-        return Err(bad(format!(
-            "its kind is {}, not {KIND}",
-            crate::error::quoted(&document.kind)
-        )));
-    }
+    let document: Document = super::document::decode_kind(
+        bytes,
+        name,
+        KIND,
+        "kiln glass compensation file",
+        "kiln compensation --bake DIR --ior ETA",
+    )?;
     let table = document.table;
     table.check().map_err(bad)?;
     Ok(table)

@@ -11,6 +11,7 @@ pub mod comment;
 pub mod compensation;
 #[cfg(feature = "containers")]
 pub mod dds;
+pub mod document;
 pub mod exr;
 pub mod f16;
 pub mod folder_lock;

@@ -397,6 +397,26 @@ mod tests {
         }
     }
 
+    /// The azimuth's range is `[-2 pi, 2 pi]`, its ends included, and `E` has period `pi` in it
+    /// (`D` is symmetric under `x -> -x` and `y -> -y`).
+    #[test]
+    fn azimuths_of_a_whole_turn_either_way_are_accepted() {
+        for phi in [-2.0 * PI, -6.2, 6.2, 2.0 * PI] {
+            assert!(check_azimuth(phi).is_ok(), "{phi}");
+        }
+        for phi in [-6.3, 6.3, f64::NAN] {
+            assert!(check_azimuth(phi).is_err(), "{phi}");
+        }
+        let ndf = AnisotropicGgx {
+            alpha_x: 0.6,
+            alpha_y: 0.2,
+        };
+        let settings = ReferenceSettings::default();
+        let e = |phi| reference_anisotropic_albedo(ndf, 0.4, phi, &settings).value;
+        assert!((e(6.0) - e(6.0 - 2.0 * PI)).abs() < 1e-10);
+        assert!((e(2.5) - e(2.5 - PI)).abs() < 1e-10);
+    }
+
     /// With equal axes the anisotropic reference is kiln's isotropic `E` (another
     /// parametrisation and another code), at every azimuth.
     #[test]

@@ -87,23 +87,20 @@ impl AnisotropicGgx {
 #[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum AnisotropyConvention {
-    /// Kulla & Conty 2017 (Imageworks): `alpha_x = alpha (1 + a)`, `alpha_y = alpha (1 - a)`,
-    /// `a` in [0, 1) (a negative `a` swaps the axes). Filament, Unreal; engines read their
-    /// isotropic table at `alpha`, the arithmetic mean.
+    /// Kulla & Conty 2017 (Imageworks): alpha_x = alpha (1 + a), alpha_y = alpha (1 - a), a in
+    /// [0, 0.99]. Filament, Unreal; their isotropic table read at alpha, the arithmetic mean.
     #[cfg_attr(feature = "cli", value(alias = "arithmetic-mean"))]
     KullaConty,
-    /// Burley 2012 (Disney): `aspect = sqrt(1 - 0.9 a)`, `alpha_x = alpha / aspect`,
-    /// `alpha_y = alpha aspect`, `a` in [0, 1]. Cycles, Enterprise PBR; read at `alpha`, the
-    /// geometric mean.
+    /// Burley 2012 (Disney): alpha_x = alpha / s, alpha_y = alpha s, s = sqrt(1 - 0.9 a), a in
+    /// [0, 1]. Cycles, Enterprise PBR; read at alpha, the geometric mean.
     #[cfg_attr(feature = "cli", value(alias = "geometric-mean"))]
     Disney,
-    /// glTF `KHR_materials_anisotropy`: `alpha_x = alpha + (1 - alpha) a^2`, `alpha_y = alpha`,
-    /// `a` in [0, 1]; read at `alpha`, the bitangent's (the smaller) roughness.
+    /// glTF KHR_materials_anisotropy: alpha_x = alpha + (1 - alpha) a^2, alpha_y = alpha, a in
+    /// [0, 1]; read at alpha, the bitangent's (the smaller) roughness.
     #[cfg_attr(feature = "cli", value(alias = "minimum"))]
     Gltf,
-    /// OpenPBR 1.0 (`specular_roughness_anisotropy`): `alpha_x = alpha sqrt(2 / (1 + (1 -
-    /// a)^2))`, `alpha_y = (1 - a) alpha_x`, `a` in [0, 1]; read at `alpha`, the root mean
-    /// square.
+    /// OpenPBR 1.0 (specular_roughness_anisotropy): alpha_x = alpha sqrt(2 / (1 + (1 -
+    /// a)^2)), alpha_y = (1 - a) alpha_x, a in [0, 0.99]; read at alpha, the root mean square.
     #[cfg_attr(feature = "cli", value(alias = "rms"))]
     Openpbr,
 }

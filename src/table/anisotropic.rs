@@ -284,29 +284,39 @@ impl AnisotropicTable {
         value
     }
 
-    /// `E_avg` at `(r, a)`: `ln(1 - E_avg)` interpolated linearly in `ln r` (the row `r = 0`
-    /// standing at [`SMOOTH_R`]) and in the anisotropy's coordinate. Kulla-Conty's lobe adds
-    /// back exactly `1 - E_lookup` where this equals the average of the lookup itself; between
-    /// rows that average falls towards the mirror as a power of `r`, which this reading follows
-    /// (their ratio at most 1.06, at `r = 0.045` with 32 roughness samples), and a reading
-    /// linear in `r` does not (ratio 0.75 there; both measured while designing, 2026-12-07).
+    /// `E_avg` at `(r, a)`: `1 - E_avg = alpha^2 c(r, w)` with `c = (1 - E_avg) / alpha^2` read
+    /// linearly in `r` and the anisotropy's coordinate `w` (`alpha = r^2`, the row `r = 0`
+    /// standing at [`SMOOTH_R`]).
+    ///
+    /// Why: Kulla-Conty's lobe adds back exactly `1 - E_lookup` where `E_avg` is the average
+    /// of the lookup itself, and between rows that average is not linear in `r`. Near the mirror
+    /// the lookup's `mu` scales with `alpha` at a fixed `t` (the adaptive mapping is `mu ~ 4
+    /// alpha_phi t^2.5 / (1 - t^2.5)` there), so the average of a row's values read at another
+    /// roughness is `alpha^2` times a constant of the row, and the average of the interpolated
+    /// lookup is `alpha^2` times the interpolated constants: this reading. Read linearly in
+    /// `E_avg`, the ratio of `1 - A` to `1 - E_avg` was 0.75 at `r = 0.045` (32 roughness
+    /// samples, a furnace 1.9e-2 off), read in `ln(1 - E_avg)` against `ln r` 1.06 (4.7e-3;
+    /// both measured while designing, 2026-12-07).
     #[must_use]
     pub fn lookup_average(&self, r: f64, a: f64) -> f64 {
         let s = &self.sizes;
-        let x = r.clamp(0.0, 1.0) * (s.roughness - 1) as f64;
-        let j = (x.floor() as usize).min(s.roughness - 2);
-        let node = |j: usize| (j as f64 / (s.roughness - 1) as f64).max(SMOOTH_R).ln();
-        let fr = ((r.max(SMOOTH_R).ln() - node(j)) / (node(j + 1) - node(j))).clamp(0.0, 1.0);
-        let w = self
-            .convention
-            .anisotropy_coordinate(a, self.max_anisotropy)
-            * (s.anisotropy - 1) as f64;
-        let l = (w.floor() as usize).min(s.anisotropy - 2);
-        let fa = w - l as f64;
-        let at = |l: usize, j: usize| (1.0 - self.average[l * s.roughness + j]).max(1e-300).ln();
-        let log_lost = (1.0 - fa) * ((1.0 - fr) * at(l, j) + fr * at(l, j + 1))
+        let coordinate = |c: f64, n: usize| {
+            let x = c.clamp(0.0, 1.0) * (n - 1) as f64;
+            let base = (x.floor() as usize).min(n - 2);
+            (base, x - base as f64)
+        };
+        let (j, fr) = coordinate(r, s.roughness);
+        let (l, fa) = coordinate(
+            self.convention
+                .anisotropy_coordinate(a, self.max_anisotropy),
+            s.anisotropy,
+        );
+        let alpha2 = |r: f64| r.max(SMOOTH_R).powi(4);
+        let node_r = |j: usize| j as f64 / (s.roughness - 1) as f64;
+        let at = |l: usize, j: usize| (1.0 - self.average[l * s.roughness + j]) / alpha2(node_r(j));
+        let c = (1.0 - fa) * ((1.0 - fr) * at(l, j) + fr * at(l, j + 1))
             + fa * ((1.0 - fr) * at(l + 1, j) + fr * at(l + 1, j + 1));
-        1.0 - log_lost.exp()
+        1.0 - alpha2(r) * c
     }
 
     /// The largest error estimate over the texels.

@@ -7,6 +7,7 @@ mod compensation;
 mod eval;
 mod fit;
 mod fresnel_args;
+mod gate;
 mod merge;
 mod plan;
 mod plot;

@@ -42,7 +42,7 @@ pub struct VerifyArgs {
     /// minimum), openpbr (the root mean square; alias rms). Compares the isotropic reference
     /// with the anisotropic lobe's over r, anisotropy, mu and the view's azimuth, and reports
     /// the maximum error and where (--plot: a map per anisotropy).
-    #[arg(long, value_enum, conflicts_with_all = ["file", "fit", "furnace", "preset", "shape",
+    #[arg(long, value_enum, hide_possible_values = true, conflicts_with_all = ["file", "fit", "furnace", "preset", "shape",
         "channel", "dtype", "order", "grid", "roughness_axis", "mu_axis", "roughness_spacing",
         "texels", "quantity", "average", "clamp_min", "density", "only", "form", "against"])]
     anisotropy_convention: Option<kiln::model::AnisotropyConvention>,

@@ -36,33 +36,20 @@ pub fn run(args: &VerifyArgs, convention: AnisotropyConvention) -> kiln::Result<
         let maps = anisotropy_maps(&audit, &grid);
         write_plot(path, svg, crate::plot::error_map_plot(&title, &maps))?;
     }
-    let passed = args.max_error.is_none_or(|bound| audit.max_error <= bound);
-    if args.json {
-        let mut object = serde_json::to_value(&audit).expect("a report serialises");
-        if let Some(bound) = args.max_error {
-            object["max_error_bound"] = bound.into();
-            object["passed"] = passed.into();
-        }
-        println!("{object}");
-    } else if args.quiet {
-        if let (false, Some(bound)) = (passed, args.max_error) {
-            eprintln!(
-                "kiln: --anisotropy-convention {convention}: max error {:.2e} exceeds \
-                 --max-error {bound:e}",
-                audit.max_error
-            );
-        }
-    } else {
-        print!("{}", text(&audit, &grid));
-        if let Some(bound) = args.max_error {
-            println!(
-                "{}: max error {:.2e} {} --max-error {bound:e}",
-                if passed { "PASSED" } else { "FAILED" },
-                audit.max_error,
-                if passed { "within" } else { "exceeds" }
-            );
-        }
-    }
+    let gate = crate::gate::Gate {
+        json: args.json,
+        quiet: args.quiet,
+        bound: args.max_error,
+        bound_field: "max_error_bound",
+    };
+    let subject = format!("--anisotropy-convention {convention}");
+    let passed = gate.print(
+        &audit,
+        || text(&audit, &grid),
+        audit.max_error,
+        "max error",
+        &subject,
+    );
     Ok(passed)
 }
 

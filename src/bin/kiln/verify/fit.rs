@@ -67,31 +67,14 @@ pub fn run(args: &VerifyArgs, name: &str) -> kiln::Result<bool> {
         write_plot(path, svg, crate::plot::error_map_plot(&title, &maps))?;
     }
     let worst = kiln::stats::max_or_nan(report.quantities.iter().map(|q| q.max_error));
-    let passed = args.max_error.is_none_or(|bound| worst <= bound);
-    if args.json {
-        let mut object = serde_json::to_value(&report).expect("a report serialises");
-        if let Some(bound) = args.max_error {
-            object["max_error"] = bound.into();
-            object["passed"] = passed.into();
-        }
-        println!("{object}");
-    } else if args.quiet {
-        if let (false, Some(bound)) = (passed, args.max_error) {
-            eprintln!(
-                "kiln: --fit {}: max error {worst:.2e} exceeds --max-error {bound:e}",
-                kiln::error::escaped(&report.fit)
-            );
-        }
-    } else {
-        print!("{}", text(&report));
-        if let Some(bound) = args.max_error {
-            println!(
-                "{}: max error {worst:.2e} {} --max-error {bound:e}",
-                if passed { "PASSED" } else { "FAILED" },
-                if passed { "within" } else { "exceeds" }
-            );
-        }
-    }
+    let gate = crate::gate::Gate {
+        json: args.json,
+        quiet: args.quiet,
+        bound: args.max_error,
+        bound_field: "max_error",
+    };
+    let subject = format!("--fit {}", kiln::error::escaped(&report.fit));
+    let passed = gate.print(&report, || text(&report), worst, "max error", &subject);
     Ok(passed)
 }
 
