@@ -137,6 +137,12 @@ impl AnisotropyConvention {
     /// [`AnisotropyConvention::alphas`] after checking `a` against the convention's range
     /// (`[0, max_anisotropy]`).
     pub fn checked_alphas(self, alpha: f64, a: f64) -> Result<(f64, f64), String> {
+        self.check_anisotropy(a)?;
+        Ok(self.alphas(alpha, a))
+    }
+
+    /// Checks an anisotropy against the convention's range, `[0, max_anisotropy]`.
+    pub fn check_anisotropy(self, a: f64) -> Result<(), String> {
         let max = self.max_anisotropy();
         if !(0.0..=max).contains(&a) {
             return Err(format!(
@@ -144,7 +150,7 @@ impl AnisotropyConvention {
                  tangent and bitangent for the other direction)"
             ));
         }
-        Ok(self.alphas(alpha, a))
+        Ok(())
     }
 
     /// `(alpha_x, alpha_y)` for roughness `alpha` and anisotropy `a` (see each convention).

@@ -187,7 +187,7 @@ impl AnisotropicTable {
         progress: &(dyn Fn(u64) + Sync),
     ) -> Result<Self, String> {
         sizes.check()?;
-        convention.checked_alphas(0.5, max_anisotropy)?;
+        convention.check_anisotropy(max_anisotropy)?;
         if !(1e-10..=1e-2).contains(&tolerance) {
             return Err(format!("tolerance {tolerance:e} is outside [1e-10, 1e-2]"));
         }
@@ -262,9 +262,7 @@ impl AnisotropicTable {
         let mut base = [0usize; 4];
         let mut frac = [0.0; 4];
         for d in 0..4 {
-            let x = c[d] * (sizes[d] - 1) as f64;
-            base[d] = (x.floor() as usize).min(sizes[d] - 2);
-            frac[d] = x - base[d] as f64;
+            (base[d], frac[d]) = cell(c[d], sizes[d]);
         }
         let mut value = 0.0;
         for corner in 0..16usize {
@@ -300,13 +298,8 @@ impl AnisotropicTable {
     #[must_use]
     pub fn lookup_average(&self, r: f64, a: f64) -> f64 {
         let s = &self.sizes;
-        let coordinate = |c: f64, n: usize| {
-            let x = c.clamp(0.0, 1.0) * (n - 1) as f64;
-            let base = (x.floor() as usize).min(n - 2);
-            (base, x - base as f64)
-        };
-        let (j, fr) = coordinate(r, s.roughness);
-        let (l, fa) = coordinate(
+        let (j, fr) = cell(r, s.roughness);
+        let (l, fa) = cell(
             self.convention
                 .anisotropy_coordinate(a, self.max_anisotropy),
             s.anisotropy,
@@ -333,7 +326,7 @@ impl AnisotropicTable {
     /// A sentence naming what does not fit.
     pub fn check(&self) -> Result<(), String> {
         self.sizes.check()?;
-        self.convention.checked_alphas(0.5, self.max_anisotropy)?;
+        self.convention.check_anisotropy(self.max_anisotropy)?;
         if !(self.max_error >= 0.0 && self.max_error.is_finite()) {
             return Err(format!(
                 "max_error {} is not a finite number >= 0",
@@ -355,6 +348,14 @@ impl AnisotropicTable {
         }
         Ok(())
     }
+}
+
+/// The cell of coordinate `c` (clamped to `[0, 1]`) on an axis of `n >= 2` node-centred samples:
+/// the lower sample's index and the fraction of the way to the next.
+fn cell(c: f64, n: usize) -> (usize, f64) {
+    let x = c.clamp(0.0, 1.0) * (n - 1) as f64;
+    let base = (x.floor() as usize).min(n - 2);
+    (base, x - base as f64)
 }
 
 /// `E_avg = (2 / pi) ∫_0^{pi/2} ∫_0^1 2 mu E(mu, phi) dmu dphi` of a function `e(mu, phi)`
@@ -405,13 +406,8 @@ pub fn slice_average(values: &[f64], ndf: AnisotropicGgx, sizes: &AnisotropicSiz
     let (n_t, n_v) = (sizes.mu, sizes.azimuth);
     let (alpha_x, alpha_y) = (ndf.alpha_x, ndf.alpha_y);
     let e = |mu: f64, phi: f64| {
-        let t = t_of_mu(mu, projected_roughness(alpha_x, alpha_y, phi)) * (n_t - 1) as f64;
-        let v = azimuth_coordinate(alpha_x, alpha_y, phi) * (n_v - 1) as f64;
-        let (i, k) = (
-            (t.floor() as usize).min(n_t - 2),
-            (v.floor() as usize).min(n_v - 2),
-        );
-        let (s, f) = (t - i as f64, v - k as f64);
+        let (i, s) = cell(t_of_mu(mu, projected_roughness(alpha_x, alpha_y, phi)), n_t);
+        let (k, f) = cell(azimuth_coordinate(alpha_x, alpha_y, phi), n_v);
         let at = |i: usize, k: usize| values[k * n_t + i];
         let row = |k: usize| (1.0 - s) * at(i, k) + s * at(i + 1, k);
         (1.0 - f) * row(k) + f * row(k + 1)

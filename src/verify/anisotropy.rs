@@ -145,7 +145,7 @@ pub fn audit_anisotropy(
         }
     }
     for &a in &grid.anisotropy {
-        convention.checked_alphas(0.5, a)?;
+        convention.check_anisotropy(a)?;
     }
     let reading = convention.reading();
     let settings = ReferenceSettings {
@@ -238,6 +238,8 @@ pub fn anisotropy_maps(audit: &AnisotropyAudit, grid: &AnisotropyGrid) -> Vec<Er
     let (columns, rows) = (grid.mu.len(), grid.roughness.len());
     let per_row = columns * grid.phi.len();
     let per_map = rows * per_row;
+    let ends = |v: &[f64]| (v[0], v[v.len() - 1]);
+    let (mu_range, r_range) = (ends(&grid.mu), ends(&grid.roughness));
     audit
         .compared
         .chunks(per_map)
@@ -261,8 +263,11 @@ pub fn anisotropy_maps(audit: &AnisotropyAudit, grid: &AnisotropyGrid) -> Vec<Er
                 cells,
                 worst,
                 eta: None,
-                x_axis: format!("mu (0.02 to 1, denser at grazing), a = {a}"),
-                y_axis: "r (0.1 to 1)".into(),
+                x_axis: format!(
+                    "mu ({} to {}, denser at grazing), a = {a}",
+                    mu_range.0, mu_range.1
+                ),
+                y_axis: format!("r ({} to {})", r_range.0, r_range.1),
             }
         })
         .collect()

@@ -86,7 +86,7 @@ pub fn run(args: AnisotropicArgs) -> kiln::Result<bool> {
     if let Some(out) = &args.bake {
         sizes.check().map_err(invalid)?;
         args.convention
-            .checked_alphas(0.5, args.max_anisotropy)
+            .check_anisotropy(args.max_anisotropy)
             .map_err(invalid)?;
         kiln::format::check_output_dir(out)?;
         crate::announce_cost(sizes.len() as f64 * SECONDS_PER_TEXEL, quiet);

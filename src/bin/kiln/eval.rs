@@ -153,15 +153,11 @@ pub fn run(args: EvalArgs) -> kiln::Result<()> {
         masking: args.masking,
     };
     model.validate().map_err(kiln::Error::InvalidInput)?;
-    let alpha = match (args.alpha, args.roughness) {
-        (Some(alpha), _) => alpha,
-        (None, Some(r)) => RoughnessConvention::Perceptual.to_alpha(r),
-        (None, None) => {
-            return Err(kiln::Error::InvalidInput(format!(
-                "--quantity {} needs --alpha A or --roughness R",
-                quantity.cli_name()
-            )));
-        }
+    let Some(alpha) = args.alpha_given()? else {
+        return Err(kiln::Error::InvalidInput(format!(
+            "--quantity {} needs --alpha A or --roughness R",
+            quantity.cli_name()
+        )));
     };
     let mu = match (quantity, args.mu) {
         (q, None) if q.has_mu() => {

@@ -8,7 +8,7 @@ use kiln::integrate::anisotropic::{
     reference_anisotropic_fourier,
 };
 use kiln::integrate::reference::ReferenceSettings;
-use kiln::model::{AnisotropicGgx, Masking, Ndf, RoughnessConvention};
+use kiln::model::{AnisotropicGgx, Masking, Ndf};
 use std::time::Instant;
 
 /// The flags of an anisotropic lobe.
@@ -79,15 +79,10 @@ pub fn run(args: &EvalArgs) -> kiln::Result<()> {
     let (alpha_x, alpha_y) = match (lobe.alpha_x, lobe.alpha_y, lobe.anisotropy) {
         (Some(x), Some(y), _) => (x, y),
         (_, _, Some(a)) => {
-            let alpha = match (args.alpha, args.roughness) {
-                (Some(alpha), _) => alpha,
-                (None, Some(r)) => RoughnessConvention::Perceptual.to_alpha(r),
-                (None, None) => {
-                    return Err(invalid(
-                        "--anisotropy needs the lobe's roughness: --alpha A or --roughness R"
-                            .into(),
-                    ));
-                }
+            let Some(alpha) = args.alpha_given()? else {
+                return Err(invalid(
+                    "--anisotropy needs the lobe's roughness: --alpha A or --roughness R".into(),
+                ));
             };
             lobe.anisotropy_convention
                 .checked_alphas(alpha, a)
