@@ -381,3 +381,28 @@ fn an_anisotropic_table_bakes_reads_back_and_refuses_tampering() {
         &["bad.json", "values"],
     );
 }
+
+/// `kiln anisotropic` refuses a bad tolerance, furnace roughness, anisotropy or size before any
+/// work and before making its folder.
+#[test]
+fn an_anisotropic_bake_refuses_bad_settings_before_it_starts() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("new");
+    let o = out.to_str().unwrap();
+    for (flags, words) in [
+        (
+            &["--tolerance", "1"][..],
+            &["tolerance 1e0", "[1e-10, 1e-2]"][..],
+        ),
+        (&["--min-roughness", "2"], &["min roughness 2", "[0, 1)"]),
+        (&["--max-anisotropy", "1"], &["anisotropy 1", "[0, 0.99]"]),
+        (&["--size", "32,16,32"], &["four sample counts"]),
+        (&["--size", "32,1,32,16"], &["azimuth axis has 1 samples"]),
+    ] {
+        let mut args = vec!["anisotropic", "--bake", o];
+        args.extend_from_slice(flags);
+        let message = command::refused(&args, words);
+        assert!(!message.contains("estimated"), "{message}");
+        assert!(!out.exists(), "{flags:?} left {o}");
+    }
+}

@@ -188,9 +188,7 @@ impl AnisotropicTable {
     ) -> Result<Self, String> {
         sizes.check()?;
         convention.check_anisotropy(max_anisotropy)?;
-        if !(1e-10..=1e-2).contains(&tolerance) {
-            return Err(format!("tolerance {tolerance:e} is outside [1e-10, 1e-2]"));
-        }
+        check_tolerance(tolerance)?;
         let settings = ReferenceSettings {
             tolerance,
             ..ReferenceSettings::default()
@@ -347,6 +345,15 @@ impl AnisotropicTable {
             }
         }
         Ok(())
+    }
+}
+
+/// Checks a bake's reference tolerance: in `[1e-10, 1e-2]`.
+pub fn check_tolerance(tolerance: f64) -> Result<(), String> {
+    if (1e-10..=1e-2).contains(&tolerance) {
+        Ok(())
+    } else {
+        Err(format!("tolerance {tolerance:e} is outside [1e-10, 1e-2]"))
     }
 }
 

@@ -81,6 +81,15 @@ pub fn lookup_average(table: &AnisotropicTable, r: f64, a: f64) -> f64 {
     )
 }
 
+/// Checks the furnace's smallest roughness: in `[0, 1)`.
+pub fn check_min_roughness(min_roughness: f64) -> Result<(), String> {
+    if (0.0..1.0).contains(&min_roughness) {
+        Ok(())
+    } else {
+        Err(format!("min roughness {min_roughness} is outside [0, 1)"))
+    }
+}
+
 /// The furnace at `points` points with `r >= min_roughness` (module docs), drawn from `seed`.
 ///
 /// # Errors
@@ -94,9 +103,7 @@ pub fn anisotropic_furnace(
     if points == 0 {
         return Err("the furnace needs at least one point".into());
     }
-    if !(0.0..1.0).contains(&min_roughness) {
-        return Err(format!("min roughness {min_roughness} is outside [0, 1)"));
-    }
+    check_min_roughness(min_roughness)?;
     let settings = ReferenceSettings {
         tolerance: TRUTH_TOLERANCE,
         ..ReferenceSettings::default()

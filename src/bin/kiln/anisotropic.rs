@@ -83,8 +83,10 @@ pub fn run(args: AnisotropicArgs) -> kiln::Result<bool> {
         anisotropy: args.size[3],
     };
     let quiet = args.quiet || args.json;
+    kiln::verify::anisotropic_table::check_min_roughness(args.min_roughness).map_err(invalid)?;
     if let Some(out) = &args.bake {
         sizes.check().map_err(invalid)?;
+        kiln::table::anisotropic::check_tolerance(args.tolerance).map_err(invalid)?;
         args.convention
             .check_anisotropy(args.max_anisotropy)
             .map_err(invalid)?;
