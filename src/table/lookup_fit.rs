@@ -51,6 +51,13 @@ pub struct LookupFitSettings {
     /// Points per cell and axis (each cell of a 2-D table gets `per_cell^2`, the cell edges
     /// shared).
     pub per_cell: usize,
+    /// The roughness axis' first cells, next to the mirror row, that get
+    /// [`LookupFitSettings::per_mirror_cell`] points instead: there `E` at a grazing view falls
+    /// from the mirror's 1 to the grazing layer's value within a cell, and the lookup's worst
+    /// error between sparser points hides from the fit (see [`LookupFitSettings::for_cells`]).
+    pub mirror_cells: usize,
+    /// Points per cell along the roughness axis in the [`LookupFitSettings::mirror_cells`].
+    pub per_mirror_cell: usize,
     /// Lawson iterations.
     pub iterations: usize,
     /// The reference's tolerance at the fit's points.
@@ -61,18 +68,31 @@ pub struct LookupFitSettings {
 }
 
 impl LookupFitSettings {
-    /// Settings for a table of `cells` cells along its longest axis: 6 points per cell and
-    /// axis up to 32 cells, fewer beyond (at least 3), so that the fit's points stay near
-    /// 200 per axis; the truth at those points to about a two-hundredth of the lookup error a
-    /// fit of that size reaches (2e-4 at 31 cells, falling as `cells^-2`): 1e-6 from 31 cells
-    /// down, within `[1e-9, 1e-6]`. At 32 x 32 a truth at 1e-8 instead gave the same fit to
-    /// its audit's three digits (`kiln verify` of the balanced fitted `E`: 2.09e-4 both) and
-    /// took 1.5 times as long (3.0 s against 2.0 s, one run each, 2026-12-05).
+    /// Settings for a table of `cells` cells along its longest axis: `64 / cells` points per
+    /// cell and axis, within `[2, 6]` (2 from 32 cells up: a cell's ends and its middle, where
+    /// the bilinear lookup's error of a smooth function peaks), and 6 per cell in the two
+    /// roughness cells next to the mirror row; the truth at those points to about a
+    /// two-hundredth of the lookup error a fit of that size reaches (2e-4 at 31 cells, falling
+    /// as `cells^-2`): 1e-6 from 31 cells down, within `[1e-9, 1e-6]`. At 32 x 32 a truth at
+    /// 1e-8 instead gave the same fit to its audit's three digits (`kiln verify` of the balanced
+    /// fitted `E`: 2.09e-4 both) and took 1.5 times as long (3.0 s against 2.0 s, one run each,
+    /// 2026-12-05).
+    ///
+    /// The density was 6 per cell everywhere up to 32 cells (46,000 reference evaluations at
+    /// 32 x 32, nearly all of `kiln bake`'s time). Measured on the balanced 32 x 32 `E`
+    /// (2026-12-07, `kiln bake --quantity e` then `kiln verify --density 5` and `--density 7`,
+    /// whose points the fit never saw): 6 everywhere 2.22e-4 and 2.13e-4; 2 everywhere
+    /// 2.74e-4 and 2.35e-4, the worst at `r = 0.0003`, `mu = 1e-6`, in the first roughness
+    /// cell; 2 with 6 in the first two roughness cells 2.16e-4 and 2.12e-4 at 12,400 points
+    /// (6 in the first two `mu` cells instead: 2.74e-4; in the first roughness cell only:
+    /// 2.22e-4). At 16 x 16, 4 a cell: 8.15e-4 and 8.51e-4 (6 everywhere: 8.22e-4, 8.52e-4).
     #[must_use]
     pub fn for_cells(cells: usize) -> Self {
         let shrink = 31.0 / cells.max(1) as f64;
         Self {
-            per_cell: (192 / cells.max(1)).clamp(3, 6),
+            per_cell: (64 / cells.max(1)).clamp(2, 6),
+            mirror_cells: 2,
+            per_mirror_cell: 6,
             iterations: 60,
             tolerance: (1e-6 * shrink * shrink).clamp(1e-9, 1e-6),
             weight_cap: 30.0,
@@ -89,6 +109,8 @@ impl LookupFitSettings {
     pub fn over_ior() -> Self {
         Self {
             per_cell: 2,
+            mirror_cells: 0,
+            per_mirror_cell: 2,
             iterations: 30,
             tolerance: 1e-6,
             weight_cap: 30.0,
@@ -122,25 +144,77 @@ struct FitPoint {
     at: Point,
 }
 
-/// The points over which [`fit_for_lookup`] compares: on each axis of `N` samples, `per_cell`
-/// points per cell between the axis ends `t = 0` and `t = 1` (the half texels a clamped
-/// `centers` lookup reads included), as physical coordinates; with a `mu` axis, every row
-/// also at the grazing probes (`mu` = 0, 1e-12, 1e-6 to 1), where a boundary layer can fall
-/// between texture points.
-fn fit_points(spec: &super::TableSpec, per_cell: usize) -> Vec<FitPoint> {
-    let ts = |axis: Option<super::Axis>| -> Vec<f64> {
-        match axis {
-            None => vec![0.0],
-            Some(axis) => {
-                let cells = match axis.grid() {
-                    super::Grid::Nodes => axis.size().saturating_sub(1).max(1),
-                    super::Grid::Centers => axis.size(),
-                };
-                let n = cells * per_cell;
-                (0..=n).map(|k| k as f64 / n as f64).collect()
-            }
-        }
+/// The cells of an axis of the fit's points: between its ends `t = 0` and `t = 1`, the half
+/// texels a clamped `centers` lookup reads included.
+fn cells_of(axis: super::Axis) -> usize {
+    match axis.grid() {
+        super::Grid::Nodes => axis.size().saturating_sub(1).max(1),
+        super::Grid::Centers => axis.size(),
+    }
+}
+
+/// The coordinates of the fit's points along `axis` (`[0]` without one): `per_cell` points per
+/// cell from `t = 0` to `t = 1`, the first `first_cells` cells `per_first_cell` each.
+fn axis_points(
+    axis: Option<super::Axis>,
+    per_cell: usize,
+    first_cells: usize,
+    per_first_cell: usize,
+) -> Vec<f64> {
+    let Some(axis) = axis else {
+        return vec![0.0];
     };
+    let cells = cells_of(axis);
+    let mut ts = Vec::with_capacity(axis_point_count(
+        Some(axis),
+        per_cell,
+        first_cells,
+        per_first_cell,
+    ));
+    for cell in 0..cells {
+        let k = if cell < first_cells {
+            per_first_cell
+        } else {
+            per_cell
+        };
+        // `(cell k + j) / (cells k)`, exact in the integers: with one density throughout, the
+        // points `j / n` of a uniform ladder, bit for bit.
+        let n = (cells * k) as f64;
+        ts.extend((0..k).map(|j| (cell * k + j) as f64 / n));
+    }
+    ts.push(1.0);
+    ts
+}
+
+/// How many points [`axis_points`] makes, counted without making them (saturating).
+fn axis_point_count(
+    axis: Option<super::Axis>,
+    per_cell: usize,
+    first_cells: usize,
+    per_first_cell: usize,
+) -> usize {
+    axis.map_or(1, |axis| {
+        let cells = cells_of(axis);
+        let first = first_cells.min(cells);
+        first
+            .saturating_mul(per_first_cell)
+            .saturating_add((cells - first).saturating_mul(per_cell))
+            .saturating_add(1)
+    })
+}
+
+/// The points over which [`fit_for_lookup`] compares: on each axis, [`axis_points`] at the
+/// settings' density (the roughness axis' first cells denser, [`LookupFitSettings::mirror_cells`]),
+/// as physical coordinates; with a `mu` axis, every row also at the grazing probes (`mu` = 0,
+/// 1e-12, 1e-6 to 1), where a boundary layer can fall between texture points.
+fn fit_points(spec: &super::TableSpec, settings: &LookupFitSettings) -> Vec<FitPoint> {
+    let ts = |axis: Option<super::Axis>| axis_points(axis, settings.per_cell, 0, 0);
+    let roughness_ts = axis_points(
+        spec.roughness,
+        settings.per_cell,
+        settings.mirror_cells,
+        settings.per_mirror_cell,
+    );
     let convention = spec.roughness_convention();
     let mut points = Vec::new();
     if spec.ior.is_some() {
@@ -148,7 +222,7 @@ fn fit_points(spec: &super::TableSpec, per_cell: usize) -> Vec<FitPoint> {
         // `TableSpec::ior_at`): a glass layout's row `alpha = 0` and slice `eta = 1` hold
         // limits taken at a small `alpha` and `eta - 1`, which the lookup reads there.
         for &t_eta in &ts(spec.ior) {
-            for &t_r in &ts(spec.roughness) {
+            for &t_r in &roughness_ts {
                 let eta_up = spec.ior_at(t_eta, spec.row_alpha(t_r));
                 for &t_mu in &ts(spec.mu) {
                     let (alpha, mu) = spec.point_at(t_r, t_mu, eta_up);
@@ -168,7 +242,7 @@ fn fit_points(spec: &super::TableSpec, per_cell: usize) -> Vec<FitPoint> {
         return points;
     }
     for &t_eta in &ts(spec.ior) {
-        for &t_r in &ts(spec.roughness) {
+        for &t_r in &roughness_ts {
             let roughness = spec
                 .roughness
                 .map_or(t_r, |axis| axis.roughness_at_coordinate(t_r));
@@ -211,7 +285,7 @@ pub fn planned_evaluations(
     settings: &LookupFitSettings,
     extra: usize,
 ) -> usize {
-    fit_point_count(spec, settings.per_cell).saturating_add(extra)
+    fit_point_count(spec, settings).saturating_add(extra)
 }
 
 /// The band of the fit's normal equations: a lookup blends texels up to one step along every
@@ -243,25 +317,21 @@ pub fn memory_bytes(spec: &super::TableSpec, settings: &LookupFitSettings, extra
 }
 
 /// How many points [`fit_points`] makes, counted without making them (saturating).
-fn fit_point_count(spec: &super::TableSpec, per_cell: usize) -> usize {
-    let ts = |axis: Option<super::Axis>| -> usize {
-        axis.map_or(1, |axis| {
-            let cells = match axis.grid() {
-                super::Grid::Nodes => axis.size().saturating_sub(1).max(1),
-                super::Grid::Centers => axis.size(),
-            };
-            cells.saturating_mul(per_cell).saturating_add(1)
-        })
-    };
+fn fit_point_count(spec: &super::TableSpec, settings: &LookupFitSettings) -> usize {
+    let ts = |axis: Option<super::Axis>| axis_point_count(axis, settings.per_cell, 0, 0);
     let mus = match spec.mu {
         Some(_) if spec.ior.is_none() => {
             ts(spec.mu).saturating_add(super::axis::grazing_probes().len())
         }
         _ => ts(spec.mu),
     };
-    ts(spec.ior)
-        .saturating_mul(ts(spec.roughness))
-        .saturating_mul(mus)
+    let roughness = axis_point_count(
+        spec.roughness,
+        settings.per_cell,
+        settings.mirror_cells,
+        settings.per_mirror_cell,
+    );
+    ts(spec.ior).saturating_mul(roughness).saturating_mul(mus)
 }
 
 /// Fits `table`'s texels for its lookup (see the module docs), in place: `value` and
@@ -276,7 +346,7 @@ pub fn fit_for_lookup(
     progress: &(dyn Fn() + Sync),
 ) -> LookupFitReport {
     let convention = table.spec.roughness_convention();
-    let mut points = fit_points(&table.spec, settings.per_cell);
+    let mut points = fit_points(&table.spec, settings);
     points.extend(extra.iter().map(|&at| FitPoint {
         mu: at.mu.unwrap_or(0.0),
         roughness: convention.from_alpha(at.alpha),
@@ -442,17 +512,44 @@ mod tests {
             glass.clone(),
         ] {
             for per_cell in [1, 2, 3, 6] {
-                assert_eq!(
-                    fit_point_count(&spec, per_cell),
-                    fit_points(&spec, per_cell).len(),
-                    "{} per cell {per_cell}",
-                    spec.id()
-                );
+                for (mirror_cells, per_mirror_cell) in [(0, 0), (1, 6), (2, 6), (9, 3)] {
+                    let settings = LookupFitSettings {
+                        per_cell,
+                        mirror_cells,
+                        per_mirror_cell,
+                        ..LookupFitSettings::for_cells(32)
+                    };
+                    let points = fit_points(&spec, &settings);
+                    assert_eq!(
+                        fit_point_count(&spec, &settings),
+                        points.len(),
+                        "{} {settings:?}",
+                        spec.id()
+                    );
+                }
             }
         }
-        // By hand: 3 x 4 nodes at 2 a cell: 5 roughness rungs of 7 mu points and 27 probes.
+        let at = |per_cell, mirror_cells, per_mirror_cell| LookupFitSettings {
+            per_cell,
+            mirror_cells,
+            per_mirror_cell,
+            ..LookupFitSettings::for_cells(32)
+        };
+        // By hand: 3 x 4 nodes at 2 a cell: 5 roughness rungs of 7 mu points and 27 probes;
+        // with the first roughness cell at 6, 6 + 2 + 1 = 9 rungs.
         let spec = test_e_spec(3, 4, Grid::Nodes, MuMapping::Linear);
-        assert_eq!(fit_point_count(&spec, 2), 5 * (7 + 27));
+        assert_eq!(fit_point_count(&spec, &at(2, 0, 0)), 5 * (7 + 27));
+        assert_eq!(fit_point_count(&spec, &at(2, 1, 6)), 9 * (7 + 27));
+        // The rungs of that axis: 0, 1/12, ..., 5/12 in the first cell, 1/2, 3/4 in the
+        // second, and the end; one density throughout gives the uniform ladder bit for bit.
+        let rungs = axis_points(spec.roughness, 2, 1, 6);
+        let by_hand = [0.0, 1.0, 2.0, 3.0, 4.0, 5.0].map(|k| k / 12.0);
+        assert_eq!(rungs[..6], by_hand);
+        assert_eq!(rungs[6..], [0.5, 0.75, 1.0]);
+        assert_eq!(
+            axis_points(spec.roughness, 3, 0, 0),
+            (0..=6).map(|k| f64::from(k) / 6.0).collect::<Vec<_>>()
+        );
         // The band of a 3 x 4 table is a row and one; of a 2 x 3 x 4 one, 12 + 4 + 1.
         assert_eq!(band(&spec), 5);
         assert_eq!(band(&glass), 17);
