@@ -4,7 +4,7 @@
 #   scripts/mutants.sh                 # the whole scope below (hours on 2 cores)
 #   scripts/mutants.sh src/format/f16.rs src/integrate/estimate.rs   # some files
 #   SHARD=0/4 scripts/mutants.sh       # one of four shards of the scope
-#   TARGETS="--lib --test containers" scripts/mutants.sh src/format/f16.rs   # fewer test binaries
+#   TARGETS="--lib --test suite" TESTS="-- containers::" scripts/mutants.sh src/format/f16.rs  # fewer tests
 #   TARGETS=--lib TESTS="-- model::" scripts/mutants.sh src/model/special.rs  # and fewer tests
 #   RE="cody_rational|beckmann_lambda_of_a" scripts/mutants.sh src/model/special.rs   # some functions
 #   EXCLUDE_RE="cody_rational" scripts/mutants.sh src/model/special.rs   # all but some functions
