@@ -1,8 +1,7 @@
 //! kiln's QMC estimates against independent values: closed forms, docs/physics.md's check values and a
 //! deterministic quadrature, within the estimates' own standard errors.
 
-#[path = "common/mod.rs"]
-mod common;
+use crate::common;
 
 use common::{reference_e, reference_e_avg};
 use kiln::{Masking, Model, Ndf, QmcSettings, albedo, average_albedo};

@@ -5,10 +5,8 @@
 //! periodic function); the values the issue measured; a physical identity (`E(mu = 1)` cannot
 //! depend on the azimuth); and the refusals.
 
-#[path = "common/command.rs"]
-mod command;
-#[path = "common/mod.rs"]
-mod common;
+use crate::command;
+use crate::common;
 
 use std::f64::consts::PI;
 

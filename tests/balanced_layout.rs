@@ -13,16 +13,10 @@ use kiln::{BakeOptions, Masking, Model, MuMapping, Ndf, RoughnessSpacing};
 use rayon::prelude::*;
 use std::fmt::Write as _;
 
-#[path = "common/cxx.rs"]
-mod cxx;
-#[path = "common/external.rs"]
-mod external;
-#[path = "common/lookup_audit.rs"]
-mod lookup_audit;
-#[path = "common/rng.rs"]
-mod rng;
-#[path = "common/rustc.rs"]
-mod rustc;
+use crate::cxx;
+use crate::lookup_audit;
+use crate::rng;
+use crate::rustc;
 
 fn bake(size: usize, mu_mapping: MuMapping, roughness_spacing: RoughnessSpacing) -> Table {
     BakeOptions {

@@ -3,15 +3,13 @@
 
 #![cfg(feature = "cli")]
 
-#[path = "common/f16_oracle.rs"]
-mod f16_oracle;
+use crate::f16_oracle;
 
 use kiln::format::{binary, exr, json::Sidecar};
 use std::path::Path;
 use std::process::{Command, Output};
 
-#[path = "common/command.rs"]
-mod command;
+use crate::command;
 use command::kiln;
 
 fn stderr(output: &Output) -> String {

@@ -11,8 +11,7 @@ use serde_json::Value;
 use std::path::Path;
 use std::process::{Command, Output, Stdio};
 
-#[path = "common/command.rs"]
-mod command;
+use crate::command;
 use command::{kiln, refused, stderr};
 
 fn stdout(output: &Output) -> String {

@@ -2,8 +2,7 @@
 //! validates the header, the section bounds, the data format descriptor and the level index),
 //! `ddsfile`, and a C compiler.
 
-#[path = "common/f16_oracle.rs"]
-mod f16_oracle;
+use crate::f16_oracle;
 
 use kiln::format::{Format, Precision, as_stored, encode_all};
 use kiln::{BakeOptions, MuMapping, Quantity, Table};

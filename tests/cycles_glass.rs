@@ -12,10 +12,7 @@ use kiln::preset::Preset;
 use kiln::{BakeOptions, Quantity, Table, TableSpec};
 use std::path::PathBuf;
 
-#[path = "common/cxx.rs"]
-mod cxx;
-#[path = "common/external.rs"]
-mod external;
+use crate::cxx;
 
 fn engine_file(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))

@@ -11,10 +11,8 @@
 use serde_json::Value;
 use std::path::PathBuf;
 
-#[path = "common/command.rs"]
-mod command;
-#[path = "common/external.rs"]
-mod external;
+use crate::command;
+use crate::external;
 use command::kiln;
 
 fn engine_file(path: &str) -> PathBuf {

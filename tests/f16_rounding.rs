@@ -5,8 +5,7 @@
 //! f64 step either side of a tie (where rounding through f32 first rounds twice and can land
 //! on the tie), subnormals and the range's edges.
 
-#[path = "common/f16_oracle.rs"]
-mod f16_oracle;
+use crate::f16_oracle;
 
 use f16_oracle::oracle;
 use kiln::format::f16::{MIN_SUBNORMAL, stored};

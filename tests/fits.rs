@@ -10,12 +10,8 @@ use kiln::integrate::value::{Integral, Point};
 use kiln::verify::fit::{FitAuditSettings, FitReport, audit_fit};
 use std::path::Path;
 
-#[path = "common/cxx.rs"]
-mod cxx;
-#[path = "common/external.rs"]
-mod external;
-#[path = "common/rng.rs"]
-mod rng;
+use crate::cxx;
+use crate::rng;
 use rng::Rng;
 
 /// A number in [0, 1).
@@ -375,8 +371,7 @@ fn emitted_shader_fits_validate() {
 }
 
 #[cfg(feature = "cli")]
-#[path = "common/command.rs"]
-mod command;
+use crate::command;
 
 #[cfg(feature = "cli")]
 mod command_line {

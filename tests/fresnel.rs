@@ -1,8 +1,7 @@
 //! Fresnel-weighted albedo `E_F(mu) = ∫ F(o.h) f mu_i dω_i`: QMC against the reference at
 //! ordinary and grazing points, and the identities that tie the weighted integrals to `E`.
 
-#[path = "common/mod.rs"]
-mod common;
+use crate::common;
 
 use kiln::integrate::albedo::weighted_albedo;
 use kiln::integrate::reference::{ReferenceSettings, reference_albedo, reference_weighted_albedo};

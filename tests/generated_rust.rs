@@ -1,8 +1,7 @@
 //! The committed Rust tables compile when `include!`d, hold the JSON sidecar's values, and their
 //! generated lookup is within the error the sidecar states of the tests' own quadrature.
 
-#[path = "common/mod.rs"]
-mod common;
+use crate::common;
 
 #[allow(dead_code)] // the f_ms_norm file's ONE_MINUS, STD_ERROR and axis constants are not read here
 mod ggx {

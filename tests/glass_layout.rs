@@ -12,10 +12,7 @@ use kiln::{BakeOptions, IorMapping, Quantity, Table};
 use std::fmt::Write as _;
 use std::sync::OnceLock;
 
-#[path = "common/cxx.rs"]
-mod cxx;
-#[path = "common/external.rs"]
-mod external;
+use crate::cxx;
 
 /// One small bake of both dielectric albedos in kiln's glass layout, shared by the tests.
 fn tables() -> &'static [Table] {

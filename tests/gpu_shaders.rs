@@ -17,10 +17,8 @@
 
 #![cfg(feature = "cli")]
 
-#[path = "common/external.rs"]
-mod external;
-#[path = "common/shader_cases.rs"]
-mod shader_cases;
+use crate::external;
+use crate::shader_cases;
 use shader_cases::{Cases, POINT_SETS, TABLE_FILES};
 
 use std::fmt::Write as _;

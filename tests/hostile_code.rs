@@ -18,12 +18,8 @@ use kiln::format::{Format, Precision};
 use kiln::preset::Preset;
 use kiln::{Quantity, Table, TableSpec};
 
-#[path = "common/command.rs"]
-mod command;
-#[path = "common/cxx.rs"]
-mod cxx;
-#[path = "common/external.rs"]
-mod external;
+use crate::command;
+use crate::cxx;
 use command::kiln;
 
 /// Texts that try to leave a comment in each way a language allows, each carrying the word

@@ -7,8 +7,7 @@
 use std::path::Path;
 use std::process::{Command, Stdio};
 
-#[path = "common/command.rs"]
-mod command;
+use crate::command;
 use command::kiln;
 
 fn stderr(output: &std::process::Output) -> String {

@@ -9,8 +9,7 @@ use std::process::{Command, Stdio};
 use std::sync::mpsc;
 use std::time::Duration;
 
-#[path = "common/command.rs"]
-mod command;
+use crate::command;
 use command::{refused, stderr};
 
 /// Starts kiln, waits up to `wait` for the first line it prints on stderr, then kills it: the

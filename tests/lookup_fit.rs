@@ -281,11 +281,9 @@ fn the_glass_tables_fitted_for_their_lookup_read_closer() {
     );
 }
 
-#[path = "common/command.rs"]
-mod command;
+use crate::command;
 #[cfg(feature = "cli")]
-#[path = "common/lookup_audit.rs"]
-mod lookup_audit;
+use crate::lookup_audit;
 
 /// The flag's error with a scene, and `verify --max-error` judging a fitted table by its
 /// lookup.

@@ -2,8 +2,7 @@
 //! here against an independent Gauss-Legendre quadrature (tests/common) where that one is
 //! accurate to 1e-9 (mu >= 0.02, alpha >= 0.05), and against the reference's own node errors.
 
-#[path = "common/mod.rs"]
-mod common;
+use crate::common;
 
 use common::reference_e;
 use kiln::{BakeOptions, Method, Quantity};

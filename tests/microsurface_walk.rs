@@ -6,13 +6,10 @@
 //! horizon by quadrature; and the walk's own promises (height distributions, thread counts).
 
 #[cfg(feature = "cli")]
-#[path = "common/compensation_bake.rs"]
-mod compensation_bake;
-#[path = "common/rng.rs"]
-mod rng;
+use crate::compensation_bake;
+use crate::rng;
 #[cfg(feature = "cli")]
-#[path = "common/rustc.rs"]
-mod rustc;
+use crate::rustc;
 
 use kiln::integrate::dielectric::reference_dielectric_albedo;
 use kiln::integrate::reference::{ReferenceSettings, reference_albedo};

@@ -23,8 +23,7 @@ fn f32_of(v: f64) -> f64 {
     f64::from(v as f32)
 }
 
-#[path = "common/f16_oracle.rs"]
-mod f16_oracle;
+use crate::f16_oracle;
 
 fn f16_of(v: f64) -> f64 {
     // Rounded to nearest even from f64 (the tests' own rounding, not the half crate's, which

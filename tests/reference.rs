@@ -1,8 +1,7 @@
 //! The deterministic reference against closed forms, check values, an independent quadrature,
 //! long QMC runs at hard points, and its own tighter runs.
 
-#[path = "common/mod.rs"]
-mod common;
+use crate::common;
 
 use kiln::integrate::reference::{ReferenceSettings, reference_albedo, reference_average_albedo};
 use kiln::{Masking, Model, Ndf, QmcSettings, albedo};

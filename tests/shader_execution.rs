@@ -21,14 +21,9 @@ use std::fmt::Write as _;
 use std::path::Path;
 use std::process::Command;
 
-#[path = "common/compensation_bake.rs"]
-mod compensation_bake;
-#[path = "common/cxx.rs"]
-mod cxx;
-#[path = "common/external.rs"]
-mod external;
-#[path = "common/shader_cases.rs"]
-mod shader_cases;
+use crate::compensation_bake;
+use crate::cxx;
+use crate::shader_cases;
 use shader_cases::{Cases, POINT_SETS, TABLE_FILES};
 
 /// The vocabulary the three languages share, in C++, with GPU texture sampling.

@@ -14,12 +14,9 @@ use kiln::table::{Quantity, Table, Texels};
 use kiln::{BakeOptions, MuMapping};
 use rayon::prelude::*;
 
-#[path = "common/lookup_audit.rs"]
-mod lookup_audit;
-#[path = "common/rng.rs"]
-mod rng;
-#[path = "common/rustc.rs"]
-mod rustc;
+use crate::lookup_audit;
+use crate::rng;
+use crate::rustc;
 
 /// The 32 x 32 `E_scale` and `E_bias` tables on `mu_mapping`.
 fn bake(mu_mapping: MuMapping, texels: Texels) -> Vec<Table> {

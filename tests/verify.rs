@@ -9,8 +9,7 @@ use kiln::{BakeOptions, Masking, Model, Ndf, RoughnessConvention};
 use serde_json::Value;
 use std::path::Path;
 
-#[path = "common/command.rs"]
-mod command;
+use crate::command;
 use command::kiln;
 
 /// Runs `kiln verify ... --json` and returns its exit status and report.

@@ -1,5 +1,5 @@
 //! xorshift64*: the hostile-input tests' mutants are the same on every run. Included with
-//! `#[path]` by each test that draws them.
+//! the suite (`use crate::rng`) and by the hostile binaries with `#[path]`.
 
 pub struct Rng(pub u64);
 

@@ -12,8 +12,7 @@ use kiln::verify::{AuditSettings, lookup_coordinates};
 use kiln::{Quantity, Table};
 use std::path::{Path, PathBuf};
 
-#[path = "command.rs"]
-mod command;
+use crate::command;
 
 /// The generated files every test loads, by stem.
 pub const TABLE_FILES: [&str; 4] = [
