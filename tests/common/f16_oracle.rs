@@ -4,8 +4,6 @@
 //! above 65504 to 65504, and what would round to zero to `2^-24`). The tests' oracle of what an
 //! f16 file holds.
 
-#![allow(dead_code)] // not every test binary that includes this file uses every function
-
 /// The largest finite f16.
 pub const MAX: f64 = 65504.0;
 /// The smallest positive subnormal f16, `2^-24`.

@@ -4,8 +4,6 @@
 //! every piece is smooth). It shares only `D` and `Lambda` with the code under test, which have
 //! their own identity tests.
 
-#![allow(dead_code)]
-
 use kiln::model::{Beckmann, Ggx, Masking, MicrofacetDistribution, Model, Ndf, Vec3};
 use std::f64::consts::PI;
 
@@ -92,7 +90,6 @@ pub fn reference_e(model: Model, alpha: f64, mu: f64) -> f64 {
 
 /// `E` with the integrand weighted by `weight(o.m)` (a Fresnel factor at the facet's cosine, or
 /// a split-sum weight), by the same quadrature and to the same accuracy as [`reference_e`].
-#[allow(dead_code)] // not every test binary that includes this module weights E
 pub fn reference_weighted_e(model: Model, alpha: f64, mu: f64, weight: &dyn Fn(f64) -> f64) -> f64 {
     match model.ndf {
         Ndf::Ggx => e_quadrature(Ggx { alpha }, model.masking, mu, weight),
