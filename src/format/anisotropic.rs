@@ -69,10 +69,11 @@ pub fn encode(
 /// Little-endian f32 of `values`.
 #[must_use]
 pub fn f32_bytes(values: &[f64]) -> Vec<u8> {
-    values
-        .iter()
-        .flat_map(|&v| (v as f32).to_le_bytes())
-        .collect()
+    let mut out = Vec::with_capacity(4 * values.len());
+    for &v in values {
+        super::Precision::F32.push_le(&mut out, v);
+    }
+    out
 }
 
 /// Reads a document [`encode`] wrote, checking it; `name` names the file in errors.

@@ -181,12 +181,7 @@ pub fn encode(table: &Table, precision: Precision) -> Vec<u8> {
     for (values, dtype) in table.channels().into_iter().zip(dtypes) {
         out.resize(align16(out.len()), 0);
         for &v in values {
-            match dtype {
-                Precision::F32 => out.extend_from_slice(&(v as f32).to_le_bytes()),
-                Precision::F16 => {
-                    out.extend_from_slice(&super::f16::encode(v).0.to_le_bytes());
-                }
-            }
+            dtype.push_le(&mut out, v);
         }
     }
     out.resize(align16(out.len()), 0);

@@ -105,6 +105,15 @@ pub enum Precision {
 }
 
 impl Precision {
+    /// Appends `value` to `out` little-endian in this precision (f16 rounded once, from f64:
+    /// [`f16::encode`]).
+    pub fn push_le(self, out: &mut Vec<u8>, value: f64) {
+        match self {
+            Precision::F32 => out.extend_from_slice(&(value as f32).to_le_bytes()),
+            Precision::F16 => out.extend_from_slice(&f16::encode(value).0.to_le_bytes()),
+        }
+    }
+
     /// `f32` or `f16`.
     #[must_use]
     pub fn name(self) -> &'static str {

@@ -85,12 +85,7 @@ impl Texture {
         let mut out = Vec::with_capacity(self.len() * self.channels.len() * precision.bytes());
         for k in 0..self.len() {
             for (_, values) in &self.channels {
-                match precision {
-                    Precision::F32 => out.extend_from_slice(&(values[k] as f32).to_le_bytes()),
-                    Precision::F16 => {
-                        out.extend_from_slice(&super::f16::encode(values[k]).0.to_le_bytes());
-                    }
-                }
+                precision.push_le(&mut out, values[k]);
             }
         }
         out
