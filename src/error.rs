@@ -15,13 +15,38 @@ pub enum Error {
     },
     /// Encoding or decoding a file format failed.
     Format { path: PathBuf, message: String },
+    /// Bytes or a document that are not what they claim to be, found by a decoder or a check
+    /// that does not know the file ([`Error::in_file`] names it): input the user can replace.
+    Malformed(String),
+    /// A format's encoder could not write a table (a size or a value the format cannot hold):
+    /// [`crate::format::write_files`]'s callers name the file.
+    Encode(String),
+    /// An error in the input read from a file, said with the file.
+    InFile { path: PathBuf, source: Box<Error> },
 }
 
 impl Error {
     /// Whether the error is the user's input (the CLI exits with status 2 for those).
     #[must_use]
     pub fn is_usage(&self) -> bool {
-        matches!(self, Error::InvalidInput(_))
+        match self {
+            Error::InvalidInput(_) | Error::Malformed(_) => true,
+            Error::InFile { source, .. } => source.is_usage(),
+            _ => false,
+        }
+    }
+
+    /// The error said of the file at `path`: an input error or a malformed document is put in
+    /// the file's context, and an error that names its file already is left as it is.
+    #[must_use]
+    pub fn in_file(self, path: &std::path::Path) -> Error {
+        match self {
+            Error::InvalidInput(_) | Error::Malformed(_) => Error::InFile {
+                path: path.to_path_buf(),
+                source: Box::new(self),
+            },
+            named => named,
+        }
     }
 }
 
@@ -37,6 +62,8 @@ impl std::fmt::Display for Error {
                 write!(f, "cannot {action} {}: {source}", path.display())
             }
             Error::Format { path, message } => write!(f, "{}: {message}", path.display()),
+            Error::Malformed(message) | Error::Encode(message) => f.write_str(message),
+            Error::InFile { path, source } => write!(f, "{}: {source}", escaped_path(path)),
         }
     }
 }

@@ -174,12 +174,36 @@ fn default_masking() -> Masking {
 }
 
 /// Perceptual roughness used: one value or a `[min, max]` range.
-#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq)]
+#[derive(Clone, Copy, Debug, Serialize, PartialEq)]
 #[serde(untagged)]
 pub enum Roughness {
     One(f64),
     Range([f64; 2]),
 }
+
+/// A number or a pair, and otherwise kiln's own message (serde's for an untagged enum says only
+/// that no variant matched).
+impl<'de> Deserialize<'de> for Roughness {
+    fn deserialize<D: serde::Deserializer<'de>>(
+        deserializer: D,
+    ) -> std::result::Result<Self, D::Error> {
+        #[derive(Deserialize)]
+        #[serde(untagged)]
+        enum Either {
+            One(f64),
+            Range([f64; 2]),
+        }
+        match Either::deserialize(deserializer) {
+            Ok(Either::One(r)) => Ok(Roughness::One(r)),
+            Ok(Either::Range(range)) => Ok(Roughness::Range(range)),
+            Err(_) => Err(serde::de::Error::custom(ROUGHNESS_FORM)),
+        }
+    }
+}
+
+/// What a scene's `roughness` is, as a refusal says.
+const ROUGHNESS_FORM: &str =
+    "roughness is one perceptual roughness in [0, 1] or a [min, max] range";
 
 impl Roughness {
     /// `[min, max]`.
@@ -264,11 +288,6 @@ fn toml_message(error: &toml::de::Error, text: &str, origin: &str) -> String {
             "{}: a Fresnel model is \"none\", {{ schlick = {{ f0 = 0.04 }} }} (f0 \
              and an optional f90, one value or [r, g, b]), {{ dielectric = {{ ior = 1.5 }} }} or \
              {{ conductor = {{ eta = [r, g, b], k = [r, g, b] }} }}",
-            crate::error::quoted(source_line)
-        );
-    } else if message.contains("untagged enum Roughness") {
-        message = format!(
-            "{}: roughness is one perceptual roughness in [0, 1] or a [min, max] range",
             crate::error::quoted(source_line)
         );
     } else if !source_line.is_empty() {
@@ -365,7 +384,7 @@ impl Scene {
             }
         }
         if let Some(preset) = self.preset() {
-            self.validate_for(preset).map_err(bad)?;
+            self.validate_for(preset).map_err(|e| bad(e.to_string()))?;
         } else if let Some(m) = self.materials.iter().find(|m| m.sheen) {
             return Err(bad(format!(
                 "material '{}': sheen = true needs an engine whose texture holds the cloth \
@@ -422,16 +441,16 @@ impl Scene {
     /// What a scene that names `preset` may ask: the engine's own format (no `formats` or
     /// `precision`), materials of the model the engine evaluates, and only effects its layout
     /// serves.
-    fn validate_for(&self, preset: Preset) -> std::result::Result<(), String> {
+    fn validate_for(&self, preset: Preset) -> crate::Result<()> {
         let layout = preset.layout();
         if let Some(output) = &self.output
             && (output.formats.is_some() || output.precision.is_some())
         {
-            return Err(format!(
+            return Err(crate::Error::InvalidInput(format!(
                 "[output] names preset {}, which writes the engine's own files ({}): formats \
                  and precision do not apply; remove them",
                 layout.name, layout.file_name
-            ));
+            )));
         }
         let engine_model = Model {
             ndf: Ndf::Ggx,
@@ -440,7 +459,7 @@ impl Scene {
         let sheen_in_layout = layout.extra.and_then(|e| e.effect()) == Some(Effect::Sheen);
         for m in &self.materials {
             if m.model() != engine_model {
-                return Err(format!(
+                return Err(crate::Error::InvalidInput(format!(
                     "material '{}' is {} {}, but {} evaluates {} {}: the engine's tables would \
                      not be this material's; change its ndf and masking or the preset",
                     m.name,
@@ -449,22 +468,22 @@ impl Scene {
                     layout.name,
                     engine_model.ndf.name(),
                     engine_model.masking.name()
-                ));
+                )));
             }
             if m.transmission && layout.glass.is_none() {
-                return Err(format!(
+                return Err(crate::Error::InvalidInput(format!(
                     "material '{}': transmission = true, but {}'s layout has no glass tables \
                      (cycles has them); bake the dielectric tables in kiln's own layout (a \
                      scene without a preset)",
                     m.name, layout.name
-                ));
+                )));
             }
             if m.sheen && !sheen_in_layout {
-                return Err(format!(
+                return Err(crate::Error::InvalidInput(format!(
                     "material '{}': sheen = true, but {}'s layout has no cloth channel (filament \
                      and godot have one)",
                     m.name, layout.name
-                ));
+                )));
             }
         }
         Ok(())

@@ -39,14 +39,18 @@ impl ShardIndex {
     ///
     /// # Errors
     /// Anything but two integers with `0 <= I < N`, `N` from 1 to 100,000.
-    pub fn parse(text: &str) -> std::result::Result<Self, String> {
-        let (i, n) = text
-            .split_once('/')
-            .ok_or_else(|| format!("--shard takes I/N (e.g. 0/4) or auto, not '{text}'"))?;
+    pub fn parse(text: &str) -> crate::Result<Self> {
+        let (i, n) = text.split_once('/').ok_or_else(|| {
+            crate::Error::InvalidInput(format!(
+                "--shard takes I/N (e.g. 0/4) or auto, not '{text}'"
+            ))
+        })?;
         let number = |s: &str, what: &str| {
-            s.trim()
-                .parse::<usize>()
-                .map_err(|_| format!("--shard {text}: {what} '{s}' is not a whole number"))
+            s.trim().parse::<usize>().map_err(|_| {
+                crate::Error::InvalidInput(format!(
+                    "--shard {text}: {what} '{s}' is not a whole number"
+                ))
+            })
         };
         Self::new(number(i, "the index")?, number(n, "the count")?)
     }
@@ -55,15 +59,17 @@ impl ShardIndex {
     ///
     /// # Errors
     /// Unless `index < count <= 100_000`.
-    pub fn new(index: usize, count: usize) -> std::result::Result<Self, String> {
+    pub fn new(index: usize, count: usize) -> crate::Result<Self> {
         if count == 0 || count > 100_000 {
-            return Err(format!("the shard count must be 1 to 100000 (got {count})"));
+            return Err(crate::Error::InvalidInput(format!(
+                "the shard count must be 1 to 100000 (got {count})"
+            )));
         }
         if index >= count {
-            return Err(format!(
+            return Err(crate::Error::InvalidInput(format!(
                 "shard index {index} is not below the count {count} (indices run from 0 to {})",
                 count - 1
-            ));
+            )));
         }
         Ok(Self { index, count })
     }
@@ -78,24 +84,24 @@ impl ShardIndex {
     pub fn from_environment(
         get: &dyn Fn(&str) -> Option<String>,
         count: Option<usize>,
-    ) -> std::result::Result<Self, String> {
-        let number = |name: &str| -> std::result::Result<Option<usize>, String> {
+    ) -> crate::Result<Self> {
+        let number = |name: &str| -> crate::Result<Option<usize>> {
             get(name)
                 .map(|v| {
-                    v.trim()
-                        .parse::<usize>()
-                        .map_err(|_| format!("{name}={v} is not a whole number"))
+                    v.trim().parse::<usize>().map_err(|_| {
+                        crate::Error::InvalidInput(format!("{name}={v} is not a whole number"))
+                    })
                 })
                 .transpose()
         };
         let slurm = number("SLURM_ARRAY_TASK_ID")?;
         let kubernetes = number("JOB_COMPLETION_INDEX")?;
         match (slurm, kubernetes) {
-            (Some(_), Some(_)) => Err(
+            (Some(_), Some(_)) => Err(crate::Error::InvalidInput(
                 "--shard auto: both SLURM_ARRAY_TASK_ID and JOB_COMPLETION_INDEX are set; give \
                  --shard I/N"
                     .into(),
-            ),
+            )),
             (Some(id), None) => {
                 let (min, max) = (
                     number("SLURM_ARRAY_TASK_MIN")?,
@@ -106,33 +112,41 @@ impl ShardIndex {
                     (Some(n), _) => n,
                     (None, Some(max)) if max >= min => max - min + 1,
                     _ => {
-                        return Err("--shard auto under Slurm needs SLURM_ARRAY_TASK_COUNT or \
-                                    SLURM_ARRAY_TASK_MIN and _MAX (submit with --array=0-N)"
-                            .into());
+                        return Err(crate::Error::InvalidInput(
+                            "--shard auto under Slurm needs SLURM_ARRAY_TASK_COUNT or \
+                             SLURM_ARRAY_TASK_MIN and _MAX (submit with --array=0-N)"
+                                .into(),
+                        ));
                     }
                 };
                 if id < min {
-                    return Err(format!(
+                    return Err(crate::Error::InvalidInput(format!(
                         "SLURM_ARRAY_TASK_ID={id} is below SLURM_ARRAY_TASK_MIN={min}"
-                    ));
+                    )));
                 }
-                Self::new(id - min, total).map_err(|e| format!("--shard auto (Slurm): {e}"))
+                Self::new(id - min, total)
+                    .map_err(|e| crate::Error::InvalidInput(format!("--shard auto (Slurm): {e}")))
             }
             (None, Some(index)) => {
                 let total = match count {
                     Some(n) => n,
-                    None => number("KILN_SHARD_COUNT")?.ok_or(
-                        "--shard auto under Kubernetes needs the completion count in \
-                         KILN_SHARD_COUNT (JOB_COMPLETION_INDEX alone does not say it)",
-                    )?,
+                    None => number("KILN_SHARD_COUNT")?.ok_or_else(|| {
+                        crate::Error::InvalidInput(
+                            "--shard auto under Kubernetes needs the completion count in \
+                             KILN_SHARD_COUNT (JOB_COMPLETION_INDEX alone does not say it)"
+                                .into(),
+                        )
+                    })?,
                 };
-                Self::new(index, total).map_err(|e| format!("--shard auto (Kubernetes): {e}"))
+                Self::new(index, total).map_err(|e| {
+                    crate::Error::InvalidInput(format!("--shard auto (Kubernetes): {e}"))
+                })
             }
-            (None, None) => Err(
+            (None, None) => Err(crate::Error::InvalidInput(
                 "--shard auto: neither SLURM_ARRAY_TASK_ID (a Slurm array task) nor \
                  JOB_COMPLETION_INDEX (a Kubernetes indexed job) is set; give --shard I/N"
                     .into(),
-            ),
+            )),
         }
     }
 
@@ -422,10 +436,76 @@ pub fn read_shards(paths: &[PathBuf]) -> Result<Vec<(PathBuf, ShardFile)>> {
 /// index, a table range that is not the partition's, a digest that does not hold (each naming
 /// the shard file and the texel range), or the bake's own checks.
 pub fn merge(shards: &[(PathBuf, ShardFile)]) -> Result<(ShardedBake, Vec<Table>)> {
-    let name = |p: &Path| p.display().to_string();
-    let Some((first_path, first)) = shards.first() else {
+    let Some((_, first)) = shards.first() else {
         return Err(Error::InvalidInput("no shard files to merge".into()));
     };
+    let count = first.count;
+    check_one_bake(shards)?;
+    let specs = integrated_specs(&first.bake.options);
+    let by_index = shards_by_index(shards, count, &specs)?;
+    let options = first.bake.options.resolved();
+    let mut tables: Vec<Table> = Vec::new();
+    // The index of the next integrated table in each shard's list.
+    let mut t = 0;
+    for spec in options.specs() {
+        let command = first.bake.options.command_for(spec.model);
+        if spec.quantity == Quantity::FMsNorm {
+            let table = crate::table::normalisation::derive_from(&spec, &tables, command)?;
+            tables.push(table);
+            continue;
+        }
+        let ranges = partition(&spec, count);
+        // Grown from the shards' own numbers, each checked against its range first: nothing is
+        // sized by what a shard claims.
+        let (mut value, mut one_minus_value, mut std_error, mut check) =
+            (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let plan = first.bake.options.check_plan(&options, &spec);
+        let mut shares = Vec::with_capacity(count);
+        for (index, entry) in by_index.iter().enumerate() {
+            let (path, shard) = entry;
+            let range = ranges[index];
+            let piece = share_of(path, shard, t, &spec, (index, count), range, plan.as_ref())?;
+            value.extend(&piece.value);
+            one_minus_value.extend(&piece.one_minus_value);
+            std_error.extend(&piece.std_error);
+            check.extend(&piece.check);
+            shares.push(Share {
+                path,
+                index,
+                range,
+                piece,
+            });
+        }
+        confirm_shares(&spec, &shares, plan.as_ref())?;
+        let table = Table {
+            spec,
+            value,
+            one_minus_value,
+            std_error,
+            command,
+            node_errors: None,
+            requested_max_error: None,
+            lookup_fit: None,
+        };
+        // The check's texels are in ascending order and the shards' ranges too: the
+        // concatenation is the unsharded bake's sequence of terms, summed in the same order.
+        let terms = plan.map(|_| check);
+        tables.push(
+            first
+                .bake
+                .options
+                .confirm_with(table, terms.as_deref(), &|_| {})?,
+        );
+        t += 1;
+    }
+    Ok((first.bake.clone(), tables))
+}
+
+/// Checks that every shard is of one bake: its index and count valid, the same options (their
+/// digest recomputed), this kiln's versions, one count, and options `kiln bake` would run.
+fn check_one_bake(shards: &[(PathBuf, ShardFile)]) -> Result<()> {
+    let name = |p: &Path| p.display().to_string();
+    let (first_path, first) = &shards[0];
     let count = first.count;
     // Each shard's own index and count within what `--shard` accepts, before any is used to
     // size anything.
@@ -476,7 +556,17 @@ pub fn merge(shards: &[(PathBuf, ShardFile)]) -> Result<(ShardedBake, Vec<Table>
             name(first_path)
         ))
     })?;
-    let specs = integrated_specs(&first.bake.options);
+    Ok(())
+}
+
+/// The shards in index order, each index below the count and given once, none missing (the
+/// missing one's texel ranges of `specs` said).
+fn shards_by_index<'a>(
+    shards: &'a [(PathBuf, ShardFile)],
+    count: usize,
+    specs: &[TableSpec],
+) -> Result<Vec<&'a (PathBuf, ShardFile)>> {
+    let name = |p: &Path| p.display().to_string();
     let mut by_index: Vec<Option<&(PathBuf, ShardFile)>> = vec![None; count];
     for entry in shards {
         let (path, shard) = entry;
@@ -511,118 +601,82 @@ pub fn merge(shards: &[(PathBuf, ShardFile)]) -> Result<(ShardedBake, Vec<Table>
             ranges.join(", ")
         )));
     }
-    let options = first.bake.options.resolved();
-    let mut tables: Vec<Table> = Vec::new();
-    // The index of the next integrated table in each shard's list.
-    let mut t = 0;
-    for spec in options.specs() {
-        let command = first.bake.options.command_for(spec.model);
-        if spec.quantity == Quantity::FMsNorm {
-            let table = crate::table::normalisation::derive_from(&spec, &tables, command)?;
-            tables.push(table);
-            continue;
-        }
-        let ranges = partition(&spec, count);
-        // Grown from the shards' own numbers, each checked against its range first: nothing is
-        // sized by what a shard claims.
-        let (mut value, mut one_minus_value, mut std_error, mut check) =
-            (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-        let plan = first.bake.options.check_plan(&options, &spec);
-        let mut shares = Vec::with_capacity(count);
-        for (index, entry) in by_index.iter().enumerate() {
-            let (path, shard) = entry.expect("checked above");
-            let range = ranges[index];
-            let piece = shard
-                .tables
-                .get(t)
-                .filter(|p| p.spec == spec)
-                .ok_or_else(|| {
-                    Error::InvalidInput(format!(
-                        "{}: has no share of {} (texels {}..{})",
-                        name(path),
-                        spec.id(),
-                        range.0,
-                        range.1
-                    ))
-                })?;
-            let n = range.1 - range.0;
-            if piece.range != range
-                || piece.value.len() != n
-                || piece.one_minus_value.len() != n
-                || piece.std_error.len() != n
-            {
-                return Err(Error::InvalidInput(format!(
-                    "{}: its share of {} is texels {}..{} with {} values, where shard {index} of \
-                     {count} takes texels {}..{}",
-                    name(path),
-                    spec.id(),
-                    piece.range.0,
-                    piece.range.1,
-                    piece.value.len(),
-                    range.0,
-                    range.1
-                )));
-            }
-            if piece.compute_digest() != piece.digest {
-                return Err(Error::InvalidInput(format!(
-                    "{}: the digest of {} texels {}..{} does not hold: the file was damaged or \
-                     edited; run shard {index} again",
-                    name(path),
-                    spec.id(),
-                    range.0,
-                    range.1
-                )));
-            }
-            let checked = plan.as_ref().map_or(0, |(indices, _)| {
-                indices
-                    .iter()
-                    .filter(|k| (range.0..range.1).contains(*k))
-                    .count()
-            });
-            if piece.check.len() != checked {
-                return Err(Error::InvalidInput(format!(
-                    "{}: {} checked texels of {} in texels {}..{}, where the check takes {checked}",
-                    name(path),
-                    piece.check.len(),
-                    spec.id(),
-                    range.0,
-                    range.1
-                )));
-            }
-            value.extend(&piece.value);
-            one_minus_value.extend(&piece.one_minus_value);
-            std_error.extend(&piece.std_error);
-            check.extend(&piece.check);
-            shares.push(Share {
-                path,
-                index,
-                range,
-                piece,
-            });
-        }
-        confirm_shares(&spec, &shares, plan.as_ref())?;
-        let table = Table {
-            spec,
-            value,
-            one_minus_value,
-            std_error,
-            command,
-            node_errors: None,
-            requested_max_error: None,
-            lookup_fit: None,
-        };
-        // The check's texels are in ascending order and the shards' ranges too: the
-        // concatenation is the unsharded bake's sequence of terms, summed in the same order.
-        let terms = plan.map(|_| check);
-        tables.push(
-            first
-                .bake
-                .options
-                .confirm_with(table, terms.as_deref(), &|_| {})?,
-        );
-        t += 1;
+    Ok(by_index
+        .into_iter()
+        .map(|e| e.expect("checked above"))
+        .collect())
+}
+
+/// Shard `index` of `count`'s share of table `t` (`spec`), checked: its texel range, its lengths,
+/// its digest, and the count of its checked texels (`plan`'s in its range).
+fn share_of<'a>(
+    path: &Path,
+    shard: &'a ShardFile,
+    t: usize,
+    spec: &TableSpec,
+    (index, count): (usize, usize),
+    range: (usize, usize),
+    plan: Option<&(Vec<usize>, crate::integrate::reference::ReferenceSettings)>,
+) -> Result<&'a ShardTable> {
+    let name = |p: &Path| p.display().to_string();
+    let piece = shard
+        .tables
+        .get(t)
+        .filter(|p| p.spec == *spec)
+        .ok_or_else(|| {
+            Error::InvalidInput(format!(
+                "{}: has no share of {} (texels {}..{})",
+                name(path),
+                spec.id(),
+                range.0,
+                range.1
+            ))
+        })?;
+    let n = range.1 - range.0;
+    if piece.range != range
+        || piece.value.len() != n
+        || piece.one_minus_value.len() != n
+        || piece.std_error.len() != n
+    {
+        return Err(Error::InvalidInput(format!(
+            "{}: its share of {} is texels {}..{} with {} values, where shard {index} of \
+             {count} takes texels {}..{}",
+            name(path),
+            spec.id(),
+            piece.range.0,
+            piece.range.1,
+            piece.value.len(),
+            range.0,
+            range.1
+        )));
     }
-    Ok((first.bake.clone(), tables))
+    if piece.compute_digest() != piece.digest {
+        return Err(Error::InvalidInput(format!(
+            "{}: the digest of {} texels {}..{} does not hold: the file was damaged or \
+             edited; run shard {index} again",
+            name(path),
+            spec.id(),
+            range.0,
+            range.1
+        )));
+    }
+    let checked = plan.map_or(0, |(indices, _)| {
+        indices
+            .iter()
+            .filter(|k| (range.0..range.1).contains(*k))
+            .count()
+    });
+    if piece.check.len() != checked {
+        return Err(Error::InvalidInput(format!(
+            "{}: {} checked texels of {} in texels {}..{}, where the check takes {checked}",
+            name(path),
+            piece.check.len(),
+            spec.id(),
+            range.0,
+            range.1
+        )));
+    }
+    Ok(piece)
 }
 
 /// One shard's share of a table, as the merge found it.

@@ -294,27 +294,17 @@ fn the_audit_compares_the_lobe_with_the_isotropic_value_the_engine_reads() {
     assert!((audit.max_azimuthal_spread - (0.594_323_5 - 0.578_363_4)).abs() < 1e-6);
 }
 
-/// `kiln verify --anisotropy-convention` refuses what it does not audit.
+/// `kiln verify-anisotropy` refuses what it does not audit: it takes no model flags and no
+/// table.
 #[test]
 fn the_anisotropy_audit_refuses_other_models() {
     command::refused(
-        &[
-            "verify",
-            "--anisotropy-convention",
-            "rms",
-            "--ndf",
-            "beckmann",
-        ],
-        &["--anisotropy-convention", "--ndf"],
+        &["verify-anisotropy", "rms", "--ndf", "beckmann"],
+        &["--ndf"],
     );
     command::refused(
-        &[
-            "verify",
-            "--anisotropy-convention",
-            "rms",
-            "tables/ggx_E.exr",
-        ],
-        &["--anisotropy-convention"],
+        &["verify-anisotropy", "rms", "tables/ggx_E.exr"],
+        &["tables/ggx_E.exr"],
     );
 }
 

@@ -418,12 +418,12 @@ fn messages_teach() {
     let output = kiln(&["plan", "--scene", scene.to_str().unwrap()]);
     assert!(output.status.success());
     assert!(stderr(&output).contains("warning"), "{}", stderr(&output));
-    // --furnace on an E_avg file asks for the E file.
+    // The furnace of an E_avg file asks for the E file.
     let tables = Path::new(env!("CARGO_MANIFEST_DIR")).join("tables");
     let average = tables.join("ggx-height-correlated-E_avg.json");
     refused(
-        &["verify", "--furnace", average.to_str().unwrap()],
-        &["--furnace", "E file", "E_avg"],
+        &["furnace", average.to_str().unwrap()],
+        &["white furnace", "E file", "E_avg"],
     );
     // A truncated kiln sidecar is damaged, not an external table without --shape.
     let text = std::fs::read(tables.join("ggx-height-correlated-E.json")).unwrap();
@@ -620,8 +620,7 @@ fn the_glass_layout_refuses_what_it_cannot_do() {
     // picture), a PNG.
     let picture = dir.path().join("furnace.png");
     let drawn = kiln(&[
-        "verify",
-        "--furnace",
+        "furnace",
         table.to_str().unwrap(),
         "--plot",
         picture.to_str().unwrap(),
@@ -1152,4 +1151,24 @@ fn the_wgsl_says_which_texture_webgpu_filters() {
     let ktx2 = std::fs::read(dir.path().join("ggx-height-correlated-E.ktx2")).unwrap();
     let format = u32::from_le_bytes(ktx2[12..16].try_into().unwrap());
     assert_eq!(format, 83);
+}
+
+/// A flag that a mode sets for itself (a scene's model, an audit's grid under `kiln
+/// compensation --bake`) is refused by the flags given, not by clap's list of the whole group.
+#[test]
+fn a_conflict_names_the_flags_given() {
+    let said = crate::command::refused(
+        &["bake", "--scene", "scene.toml", "--ndf", "ggx", "--size=8"],
+        &["'--scene <SCENE>' cannot be used with '--ndf <NDF>', '--size <SIZE>'"],
+    );
+    assert!(!said.contains("--masking"), "{said}");
+    let said = crate::command::refused(
+        &["compensation", "--bake", "out", "--f0", "0.5"],
+        &["'--bake <DIR>' cannot be used with '--f0 <F0>'"],
+    );
+    assert!(!said.contains("--roughness"), "{said}");
+    crate::command::refused(
+        &["bake", "--max-error", "1e-3", "--samples", "64"],
+        &["cannot be used with '--samples <SAMPLES>'"],
+    );
 }

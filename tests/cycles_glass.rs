@@ -346,6 +346,6 @@ fn a_transmission_convention_belongs_to_the_dielectric_tables_only() {
     let mut spec = BakeOptions::default().resolved().specs().remove(0);
     assert!(spec.check().is_ok());
     spec.transmission = TransmissionConvention::Cycles;
-    let message = spec.check().unwrap_err();
+    let message = spec.check().unwrap_err().to_string();
     assert!(message.contains("dielectric"), "{message}");
 }

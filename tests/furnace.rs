@@ -1,4 +1,4 @@
-//! `kiln verify --furnace`: the white furnace test of an `E` / `E_avg` pair through the
+//! `kiln furnace`: the white furnace test of an `E` / `E_avg` pair through the
 //! Kulla-Conty lobe ([`kiln::verify::furnace`]).
 
 use kiln::verify::furnace::furnace;

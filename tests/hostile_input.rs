@@ -417,7 +417,7 @@ fn targets(dir: &Path) -> Vec<Target> {
         }),
     });
 
-    // A formula file (`kiln verify --fit FILE`): the formula language. A message about a bad
+    // A formula file (`kiln verify-fit FILE`): the formula language. A message about a bad
     // file quotes its text escaped and bounded (issue 64, defect 7): no control character may
     // reach the terminal, however the text was mutated.
     let formula = std::fs::read(
@@ -447,7 +447,8 @@ fn targets(dir: &Path) -> Vec<Target> {
                     }
                     Ok(values.into_iter().filter(|v| v.is_finite()).collect())
                 }
-                Err(message) => {
+                Err(error) => {
+                    let message = error.to_string();
                     assert!(
                         !message.chars().any(|c| c.is_control() && c != '\n'),
                         "raw control characters in {message:?}"

@@ -200,7 +200,7 @@ fn long_commands_announce_their_estimate_first() {
             "1024",
         ][..],
         // 1025^2 reference points.
-        &["verify", "--fit", "karis", "--points", "1025"][..],
+        &["verify-fit", "karis", "--points", "1025"][..],
         // A rational fit of 97 coefficients.
         &["fit", "--degrees", "6,6/6,6", "--out", out][..],
     ] {

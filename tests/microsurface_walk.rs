@@ -661,7 +661,7 @@ fn the_compensation_table_bakes_reads_back_and_is_audited() {
         (
             "ktx2",
             kiln::format::ktx2::decode
-                as fn(&[u8]) -> Result<kiln::format::texture::DecodedTexture, String>,
+                as fn(&[u8]) -> kiln::Result<kiln::format::texture::DecodedTexture>,
         ),
         ("dds", kiln::format::dds::decode),
     ] {

@@ -14,7 +14,17 @@ use command::kiln;
 
 /// Runs `kiln verify ... --json` and returns its exit status and report.
 fn verify(args: &[&str]) -> (Option<i32>, Value) {
-    let mut all = vec!["verify", "--json"];
+    json_of("verify", args)
+}
+
+/// `kiln furnace --json ARGS`: the exit status and the report (`Null` if none).
+fn furnace(args: &[&str]) -> (Option<i32>, Value) {
+    json_of("furnace", args)
+}
+
+/// `kiln COMMAND --json ARGS`: the exit status and the report (`Null` if none).
+fn json_of(command: &str, args: &[&str]) -> (Option<i32>, Value) {
+    let mut all = vec![command, "--json"];
     all.extend_from_slice(args);
     let output = kiln(&all);
     let report = serde_json::from_slice(&output.stdout).unwrap_or(Value::Null);
@@ -473,14 +483,14 @@ fn max_error_gates_a_build_and_tables_compare_with_each_other() {
     assert!(report["against"].as_str().unwrap().starts_with("table"));
 }
 
-/// `--furnace` finds the normalisation beside the E file (`f_ms_norm`, else `E_avg`; or takes
+/// `kiln furnace` finds the normalisation beside the E file (`f_ms_norm`, else `E_avg`; or takes
 /// --average), reports JSON, and gates on --max-error; a file not named like a kiln E table
 /// asks for --average.
 #[test]
 fn furnace_flag_finds_the_average_and_gates() {
     let tables = Path::new(env!("CARGO_MANIFEST_DIR")).join("tables");
     let e = tables.join("ggx-height-correlated-E.json");
-    let (status, report) = verify(&["--furnace", e.to_str().unwrap()]);
+    let (status, report) = furnace(&[e.to_str().unwrap()]);
     assert_eq!(status, Some(0));
     assert!(
         report["average"]
@@ -507,8 +517,7 @@ fn furnace_flag_finds_the_average_and_gates() {
         turquin >= lookup && turquin <= lookup / 0.3,
         "{turquin} vs {lookup}"
     );
-    let (status, report) = verify(&[
-        "--furnace",
+    let (status, report) = furnace(&[
         e.to_str().unwrap(),
         "--form",
         "kulla-conty",
@@ -519,8 +528,7 @@ fn furnace_flag_finds_the_average_and_gates() {
     // The binary copies: the same test within f32 rounding.
     let bin = tables.join("ggx-height-correlated-E.bin");
     let norm = tables.join("ggx-height-correlated-f_ms_norm.bin");
-    let (_, from_bin) = verify(&[
-        "--furnace",
+    let (_, from_bin) = furnace(&[
         bin.to_str().unwrap(),
         "--form",
         "kulla-conty",
@@ -530,8 +538,7 @@ fn furnace_flag_finds_the_average_and_gates() {
     assert!((number(&from_bin, "max_deviation") - kulla_conty).abs() < 0.05 * kulla_conty);
     // With the exact E_avg instead, the lookup's mismatch shows at low roughness.
     let avg = tables.join("ggx-height-correlated-E_avg.json");
-    let (_, exact) = verify(&[
-        "--furnace",
+    let (_, exact) = furnace(&[
         e.to_str().unwrap(),
         "--form",
         "kulla-conty",
@@ -544,12 +551,12 @@ fn furnace_flag_finds_the_average_and_gates() {
     let renamed = tempfile::tempdir().unwrap();
     let other = renamed.path().join("mine.json");
     std::fs::copy(&e, &other).unwrap();
-    let output = kiln(&["verify", "--furnace", other.to_str().unwrap()]);
+    let output = kiln(&["furnace", other.to_str().unwrap()]);
     assert_eq!(output.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&output.stderr).contains("--average"));
 }
 
-/// `--furnace --plot` draws the deviation maps (SVG text names each form and its worst
+/// `kiln furnace --plot` draws the deviation maps (SVG text names each form and its worst
 /// deviation); a plot file that is neither .svg nor .png is refused before any work.
 #[test]
 fn furnace_plot_draws_each_form() {
@@ -558,8 +565,7 @@ fn furnace_plot_draws_each_form() {
     let dir = tempfile::tempdir().unwrap();
     let svg = dir.path().join("furnace.svg");
     succeeded(&[
-        "verify",
-        "--furnace",
+        "furnace",
         e.to_str().unwrap(),
         "--form",
         "kulla-conty",
@@ -573,8 +579,7 @@ fn furnace_plot_draws_each_form() {
     // showed 4.3e-5 and a ring elsewhere, beside the command's 1.16e-4 at r 0.001), and its
     // colour bar says what the colours mean.
     let json = kiln(&[
-        "verify",
-        "--furnace",
+        "furnace",
         e.to_str().unwrap(),
         "--form",
         "kulla-conty",
@@ -594,8 +599,7 @@ fn furnace_plot_draws_each_form() {
     }
     let bad = dir.path().join("furnace.txt");
     let output = kiln(&[
-        "verify",
-        "--furnace",
+        "furnace",
         e.to_str().unwrap(),
         "--plot",
         bad.to_str().unwrap(),
@@ -605,7 +609,7 @@ fn furnace_plot_draws_each_form() {
     assert!(!bad.exists());
 }
 
-/// `--plot` without `--furnace` draws the audit's error maps: an engine file audited with
+/// `kiln verify --plot` draws the audit's error maps: an engine file audited with
 /// `--preset` gives one picture per table (its quantity in the name), each naming its groups and
 /// their worst error; a PNG is a PNG; a plot that is neither is refused before any work.
 #[test]
@@ -691,7 +695,7 @@ fn glass_furnace_checks_turquins_form() {
     );
     let table = dir.path().join("ggx-height-correlated-E_dielectric.json");
     let table = table.to_str().unwrap();
-    let (status, report) = verify(&["--furnace", table, "--density", "1"]);
+    let (status, report) = furnace(&[table, "--density", "1"]);
     assert_eq!(status, Some(0), "{report}");
     let forms = report["forms"].as_array().unwrap();
     assert_eq!(forms.len(), 1);
@@ -704,14 +708,13 @@ fn glass_furnace_checks_turquins_form() {
         turquin >= number(&audit, "lookup_max_error"),
         "{report} {audit}"
     );
-    let output = kiln(&["verify", "--furnace", table, "--form", "kulla-conty"]);
+    let output = kiln(&["furnace", table, "--form", "kulla-conty"]);
     assert_eq!(output.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&output.stderr).contains("glass"));
     // Its picture: over sqrt(mu) and the IOR, the command's worst point stated with its eta.
     let svg = dir.path().join("glass.svg");
     succeeded(&[
-        "verify",
-        "--furnace",
+        "furnace",
         table,
         "--density",
         "1",
@@ -734,4 +737,30 @@ fn glass_furnace_checks_turquins_form() {
     );
     assert!(text.contains(&stated), "the picture lacks '{stated}'");
     assert!(text.contains("sqrt(mu)") && text.contains("eta or 1 / eta"));
+}
+
+/// The modes of the last release's `kiln verify` that are commands now still work for this
+/// release: the same report as the new command's, and a note on stderr that names it (none
+/// with --quiet).
+#[test]
+fn old_verify_modes_run_their_new_commands_with_a_note() {
+    let e = Path::new(env!("CARGO_MANIFEST_DIR")).join("tables/ggx-height-correlated-E.json");
+    let e = e.to_str().unwrap();
+    let old = kiln(&["verify", "--furnace", e, "--form", "kulla-conty", "--json"]);
+    let new = kiln(&["furnace", e, "--form", "kulla-conty", "--json"]);
+    assert_eq!(old.status.code(), Some(0));
+    assert_eq!(old.stdout, new.stdout);
+    let note = String::from_utf8_lossy(&old.stderr);
+    assert!(
+        note.contains("`kiln verify --furnace` is now `kiln furnace`"),
+        "{note}"
+    );
+    assert!(new.stderr.is_empty());
+    let old = kiln(&["verify", "--fit=nonesuch", "-q"]);
+    assert_eq!(old.status.code(), Some(2));
+    let said = String::from_utf8_lossy(&old.stderr);
+    assert!(
+        said.contains("nonesuch: neither a fit kiln knows") && !said.contains("note"),
+        "{said}"
+    );
 }

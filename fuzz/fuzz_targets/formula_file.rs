@@ -1,4 +1,4 @@
-//! Formula files (`kiln verify --fit FILE`): the text is parsed as a formula file; a file that
+//! Formula files (`kiln verify-fit FILE`): the text is parsed as a formula file; a file that
 //! parses is evaluated over the domain's corners and middle (a NaN is the formula's, not a
 //! fault), and a refusal's message may hold no raw control character (issue 64: messages quote
 //! a file's text escaped and bounded).
@@ -20,7 +20,8 @@ fuzz_target!(|data: &[u8]| {
                 }
             }
         }
-        Err(message) => {
+        Err(error) => {
+            let message = error.to_string();
             assert!(!message.chars().any(|c| c.is_control() && c != '\n'));
         }
     }

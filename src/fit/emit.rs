@@ -1,5 +1,5 @@
 //! A fit kiln made ([`super::polynomial`], [`super::rational`]) as text: a formula file kiln
-//! audits (`kiln verify --fit FILE.toml`) and functions in WGSL, GLSL, HLSL, Rust and C that
+//! audits (`kiln verify-fit FILE.toml`) and functions in WGSL, GLSL, HLSL, Rust and C that
 //! compute the same formula in f32.
 
 use super::polynomial::PolynomialFit;
@@ -9,7 +9,7 @@ use super::rational::{R_POWER, RationalFit, T_POWER};
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 #[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum FitFormat {
-    /// The formula file (`kiln verify --fit` reads it).
+    /// The formula file (`kiln verify-fit` reads it).
     Toml,
     Wgsl,
     Glsl,
@@ -76,7 +76,7 @@ impl FitText for PolynomialFit {
             "E of {} (F = 1) as a polynomial of degree {} in u = 2 t - 1 and {} in v = 2 r - 1 \
              ({} coefficients), t = (mu (1 + 4 alpha) / (mu + 4 alpha))^0.4, alpha = r^2 \
              (kiln's adaptive axis); max error {max_error:.2e} over mu in [0, 1], r in [0, 1] \
-             against kiln's reference (kiln verify --fit); made by `{command}`",
+             against kiln's reference (kiln verify-fit); made by `{command}`",
             self.model,
             self.degrees.t,
             self.degrees.r,
@@ -140,7 +140,7 @@ impl FitText for RationalFit {
              u = 2 t - 1 and {} in s = 2 r^{R_POWER} - 1, Q of degrees {} and {} with constant \
              term 1 ({} coefficients), t = (mu (1 + alpha) / (mu + alpha))^{T_POWER}, \
              alpha = r^2; max error {max_error:.2e} over mu in [0, 1], r in \
-             [0, 1] against kiln's reference (kiln verify --fit); made by `{command}`",
+             [0, 1] against kiln's reference (kiln verify-fit); made by `{command}`",
             self.model,
             if self.shape.additive {
                 "= A(u) + B(s) (no cross terms) "

@@ -1,6 +1,6 @@
 //! The texture-free fits engines ship for the directional albedo, written from their published
 //! formulas (kiln's own code, the coefficients as published), each in its source's roughness
-//! convention: what `kiln verify --fit` audits.
+//! convention: what `kiln verify-fit` audits.
 //!
 //! Every fit here is of GGX's split-sum terms: `E_scale` and `E_bias` (Karis 2013; their sum is
 //! `E` for `F = 1`), or `E` and `E_bias` (Unreal 5).

@@ -1,4 +1,4 @@
-//! A small expression language for fits given as text (`kiln verify --fit FILE.toml`): numbers,
+//! A small expression language for fits given as text (`kiln verify-fit FILE.toml`): numbers,
 //! the variables `mu`, `r` (perceptual roughness) and `alpha = r^2`, names defined earlier in
 //! the file, `+ - * / ^` (`^` binds tightest and to the right; unary minus binds looser than
 //! `^`, so `-x^2 = -(x^2)`), parentheses and the shader functions `pow exp exp2 log log2 sqrt

@@ -1,7 +1,7 @@
 //! Texture-free fits of the directional albedo: the ones engines ship ([`engine`]) and any given
 //! as a formula file ([`FormulaFit`], in the language of [`formula`]), each a function of `mu`
 //! and the perceptual roughness `r` (`alpha = r^2`) for some of `E`, `E_scale`, `E_bias`.
-//! `kiln verify --fit` audits them ([`crate::verify::fit`]). The fits kiln makes itself are
+//! `kiln verify-fit` audits them ([`crate::verify::fit`]). The fits kiln makes itself are
 //! [`polynomial`] and [`rational`], written out by [`emit`].
 
 pub mod emit;
@@ -122,60 +122,63 @@ impl FormulaFit {
         }
         let text = String::from_utf8(bytes)
             .map_err(|_| bad("not UTF-8 text: a formula file is TOML".into()))?;
-        Self::parse(&text).map_err(bad)
+        Self::parse(&text).map_err(|e| bad(e.to_string()))
     }
 
     /// Parses a formula file's text (see [`FormulaFit`]); errors without the file's name.
     ///
     /// # Errors
     /// As [`FormulaFit::read`].
-    pub fn parse(text: &str) -> std::result::Result<Self, String> {
+    pub fn parse(text: &str) -> crate::Result<Self> {
         let file: FormulaFile = toml::from_str(text).map_err(|e| {
-            format!(
+            crate::Error::InvalidInput(format!(
                 "not a formula file ({}); it holds name = \"...\" and at least one of E, \
                  E_scale, E_bias as formulas in mu, r and alpha",
                 e.message()
-            )
+            ))
         })?;
         if file.define.len() > MAX_DEFINITIONS {
-            return Err(format!(
+            return Err(crate::Error::InvalidInput(format!(
                 "{} definitions; at most {MAX_DEFINITIONS}",
                 file.define.len()
-            ));
+            )));
         }
         let mut names: Vec<String> = VARIABLES.iter().map(ToString::to_string).collect();
         let mut definitions = Vec::new();
         for (k, line) in file.define.iter().enumerate() {
             let Some((name, formula)) = line.split_once('=') else {
-                return Err(format!(
+                return Err(crate::Error::InvalidInput(format!(
                     "define[{k}] is {}: write it as name = formula",
                     crate::error::quoted(line)
-                ));
+                )));
             };
             let name = name.trim();
             let valid = name.starts_with(|c: char| c.is_ascii_alphabetic() || c == '_')
                 && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
             if !valid || name.len() > 64 {
-                return Err(format!(
+                return Err(crate::Error::InvalidInput(format!(
                     "define[{k}]: {} is not a name (letters, digits and _, at most 64)",
                     crate::error::quoted(name)
-                ));
+                )));
             }
             if names.iter().any(|n| n == name) {
-                return Err(format!(
+                return Err(crate::Error::InvalidInput(format!(
                     "define[{k}]: {} is already defined",
                     crate::error::quoted(name)
-                ));
+                )));
             }
-            let expr =
-                Expr::parse(formula, &names).map_err(|e| format!("define[{k}] ({name}): {e}"))?;
+            let expr = Expr::parse(formula, &names)
+                .map_err(|e| crate::Error::InvalidInput(format!("define[{k}] ({name}): {e}")))?;
             definitions.push(expr);
             names.push(name.to_string());
         }
         let parse = |key: &str, formula: &Option<String>| {
             formula
                 .as_deref()
-                .map(|f| Expr::parse(f, &names).map_err(|e| format!("{key}: {e}")))
+                .map(|f| {
+                    Expr::parse(f, &names)
+                        .map_err(|e| crate::Error::InvalidInput(format!("{key}: {e}")))
+                })
                 .transpose()
         };
         let fit = FormulaFit {
@@ -187,7 +190,9 @@ impl FormulaFit {
             e_bias: parse("E_bias", &file.e_bias)?,
         };
         if fit.quantities().is_empty() {
-            return Err("no formula: give at least one of E, E_scale, E_bias".into());
+            return Err(crate::Error::InvalidInput(
+                "no formula: give at least one of E, E_scale, E_bias".into(),
+            ));
         }
         Ok(fit)
     }
@@ -252,16 +257,37 @@ mod tests {
         let fit = FormulaFit::parse("name = \"x\"\nE_scale = \"mu\"\nE_bias = \"alpha\"").unwrap();
         assert_eq!(fit.value(Quantity::E, 0.25, 0.5), 0.5);
         let err = |t: &str| FormulaFit::parse(t).unwrap_err();
-        assert!(err("name = \"x\"").contains("no formula"));
-        assert!(err("E = \"mu\"").contains("not a formula file"));
-        assert!(err("name = \"x\"\nE = \"mu\"\nF = \"1\"").contains("unknown field"));
-        assert!(err("name = \"x\"\nE = \"nu\"").contains("E: at character 1: unknown name"));
-        assert!(err("name = \"x\"\ndefine = [\"k\"]\nE = \"mu\"").contains("name = formula"));
-        assert!(err("name = \"x\"\ndefine = [\"mu = 1\"]\nE = \"mu\"").contains("already"));
-        assert!(err("name = \"x\"\ndefine = [\"2k = 1\"]\nE = \"mu\"").contains("not a name"));
+        assert!(err("name = \"x\"").to_string().contains("no formula"));
+        assert!(err("E = \"mu\"").to_string().contains("not a formula file"));
+        assert!(
+            err("name = \"x\"\nE = \"mu\"\nF = \"1\"")
+                .to_string()
+                .contains("unknown field")
+        );
+        assert!(
+            err("name = \"x\"\nE = \"nu\"")
+                .to_string()
+                .contains("E: at character 1: unknown name")
+        );
+        assert!(
+            err("name = \"x\"\ndefine = [\"k\"]\nE = \"mu\"")
+                .to_string()
+                .contains("name = formula")
+        );
+        assert!(
+            err("name = \"x\"\ndefine = [\"mu = 1\"]\nE = \"mu\"")
+                .to_string()
+                .contains("already")
+        );
+        assert!(
+            err("name = \"x\"\ndefine = [\"2k = 1\"]\nE = \"mu\"")
+                .to_string()
+                .contains("not a name")
+        );
         // A definition sees only what comes before it.
         assert!(
             err("name = \"x\"\ndefine = [\"a = b\", \"b = 1\"]\nE = \"a\"")
+                .to_string()
                 .contains("define[0] (a): at character 2: unknown name 'b'")
         );
     }

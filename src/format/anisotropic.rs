@@ -90,6 +90,6 @@ pub fn decode(bytes: &[u8], name: &str) -> Result<AnisotropicTable> {
         "kiln anisotropic --bake DIR",
     )?;
     let table = document.table;
-    table.check().map_err(bad)?;
+    table.check().map_err(|e| bad(e.to_string()))?;
     Ok(table)
 }

@@ -198,33 +198,37 @@ pub struct BinaryContents {
 }
 
 /// Decodes kiln's binary format, checking every size against the bytes present.
-pub fn decode(bytes: &[u8]) -> std::result::Result<BinaryContents, String> {
-    let word = |offset: usize| -> std::result::Result<u32, String> {
+pub fn decode(bytes: &[u8]) -> crate::Result<BinaryContents> {
+    let word = |offset: usize| -> crate::Result<u32> {
         bytes
             .get(offset..offset + 4)
             .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-            .ok_or_else(|| format!("file ends inside the header (at byte {offset})"))
+            .ok_or_else(|| {
+                crate::Error::Malformed(format!("file ends inside the header (at byte {offset})"))
+            })
     };
     if bytes.len() < FIXED_HEADER || &bytes[..8] != MAGIC {
-        return Err("not a kiln binary table (bad magic)".into());
+        return Err(crate::Error::Malformed(
+            "not a kiln binary table (bad magic)".into(),
+        ));
     }
     let version = word(8)?;
     let max_rank = match version {
         VERSION => 2,
         VERSION_IOR => 3,
         _ => {
-            return Err(format!(
+            return Err(crate::Error::Malformed(format!(
                 "unsupported kiln binary version {version} (this kiln reads {VERSION} and \
                  {VERSION_IOR})"
-            ));
+            )));
         }
     };
     let rank = word(16)? as usize;
     let channel_count = word(20)? as usize;
     if !(1..=max_rank).contains(&rank) || channel_count == 0 || channel_count > 64 {
-        return Err(format!(
+        return Err(crate::Error::Malformed(format!(
             "bad header: rank {rank}, {channel_count} channels (version {version})"
-        ));
+        )));
     }
     let (fixed, entry_size, name_bytes) = if version == VERSION_IOR {
         (FIXED_HEADER_IOR, CHANNEL_ENTRY_IOR, NAME_BYTES_IOR)
@@ -242,10 +246,10 @@ pub fn decode(bytes: &[u8]) -> std::result::Result<BinaryContents, String> {
         .try_fold(1_usize, |n, &s| n.checked_mul(s))
         .filter(|&n| n > 0 && n <= super::MAX_TEXELS)
         .ok_or_else(|| {
-            format!(
+            crate::Error::Malformed(format!(
                 "bad header: shape {shape:?} (1 to {} texels)",
                 super::MAX_TEXELS
-            )
+            ))
         })?;
     let mut axes = Vec::with_capacity(rank);
     for k in 0..rank {
@@ -262,19 +266,23 @@ pub fn decode(bytes: &[u8]) -> std::result::Result<BinaryContents, String> {
         let entry = fixed + entry_size * c;
         let name_field = bytes
             .get(entry..entry + name_bytes)
-            .ok_or("file ends inside the channel list")?;
+            .ok_or_else(|| crate::Error::Malformed("file ends inside the channel list".into()))?;
         let name_len = name_field
             .iter()
             .position(|&b| b == 0)
             .unwrap_or(name_bytes);
         let name = String::from_utf8_lossy(&name_field[..name_len]).into_owned();
         let dtype = Precision::from_code(word(entry + name_bytes)?)
-            .ok_or_else(|| format!("channel {name}: unknown dtype"))?;
+            .ok_or_else(|| crate::Error::Malformed(format!("channel {name}: unknown dtype")))?;
         let plane = word(entry + name_bytes + 4)? as usize;
         let data = plane
             .checked_add(count * dtype.bytes())
             .and_then(|end| bytes.get(plane..end))
-            .ok_or_else(|| format!("channel {name}: file too short for {count} values"))?;
+            .ok_or_else(|| {
+                crate::Error::Malformed(format!(
+                    "channel {name}: file too short for {count} values"
+                ))
+            })?;
         let values = match dtype {
             Precision::F32 => data
                 .chunks_exact(4)

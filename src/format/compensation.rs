@@ -153,6 +153,6 @@ pub fn decode(bytes: &[u8], name: &str) -> Result<CompensationTable> {
         )));
     }
     let table = document.table;
-    table.check().map_err(bad)?;
+    table.check().map_err(|e| bad(e.to_string()))?;
     Ok(table)
 }

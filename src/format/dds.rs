@@ -23,10 +23,13 @@ pub fn dxgi_format(channels: usize, precision: Precision) -> Option<DxgiFormat> 
 }
 
 /// Encodes a texture of one, two or four channels.
-pub fn encode(texture: &Texture, precision: Precision) -> std::result::Result<Vec<u8>, String> {
+pub fn encode(texture: &Texture, precision: Precision) -> crate::Result<Vec<u8>> {
     let channels = texture.channels.len();
-    let format = dxgi_format(channels, precision)
-        .ok_or_else(|| format!("DDS output takes one, two or four channels (got {channels})"))?;
+    let format = dxgi_format(channels, precision).ok_or_else(|| {
+        crate::Error::Encode(format!(
+            "DDS output takes one, two or four channels (got {channels})"
+        ))
+    })?;
     let (width, height, depth) = texture.extent();
     let (dimension, depth, caps2) = match (height, depth) {
         (0, _) => (D3D10ResourceDimension::Texture1D, None, None),
@@ -49,16 +52,18 @@ pub fn encode(texture: &Texture, precision: Precision) -> std::result::Result<Ve
         resource_dimension: dimension,
         alpha_mode: AlphaMode::Unknown,
     })
-    .map_err(|e| e.to_string())?;
+    .map_err(|e| crate::Error::Encode(e.to_string()))?;
     dds.data = texture.interleaved(precision);
     let mut bytes = Vec::new();
-    dds.write(&mut bytes).map_err(|e| e.to_string())?;
+    dds.write(&mut bytes)
+        .map_err(|e| crate::Error::Encode(e.to_string()))?;
     Ok(bytes)
 }
 
 /// Reads a DDS file of one, two or four 16- or 32-bit float channels (DX10 header), one level.
-pub fn decode(bytes: &[u8]) -> std::result::Result<super::texture::DecodedTexture, String> {
-    let dds = Dds::read(bytes).map_err(|e| format!("not a DDS file ({e})"))?;
+pub fn decode(bytes: &[u8]) -> crate::Result<super::texture::DecodedTexture> {
+    let dds =
+        Dds::read(bytes).map_err(|e| crate::Error::Malformed(format!("not a DDS file ({e})")))?;
     let format = dds.get_dxgi_format();
     let (channels, precision) = match format {
         Some(DxgiFormat::R16_Float) => (1, Precision::F16),
@@ -68,9 +73,9 @@ pub fn decode(bytes: &[u8]) -> std::result::Result<super::texture::DecodedTextur
         Some(DxgiFormat::R32G32_Float) => (2, Precision::F32),
         Some(DxgiFormat::R32G32B32A32_Float) => (4, Precision::F32),
         other => {
-            return Err(format!(
+            return Err(crate::Error::Malformed(format!(
                 "format {other:?}: kiln reads R, RG and RGBA DXGI float textures"
-            ));
+            )));
         }
     };
     let extent = (

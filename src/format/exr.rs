@@ -20,16 +20,16 @@ pub const METADATA_ATTRIBUTE: &str = "kiln";
 /// `roughness` (or `eta`) high; a 1-D table is one row; a 3-D table `(eta, roughness, mu)` is its
 /// `eta` slices stacked top to bottom, `mu` wide and `eta x roughness` high (image row
 /// `eta_index * R + r_index`).
-pub fn encode(table: &Table, precision: Precision) -> std::result::Result<Vec<u8>, String> {
+pub fn encode(table: &Table, precision: Precision) -> crate::Result<Vec<u8>> {
     let shape = table.spec.shape();
     let (width, height) = match shape[..] {
         [slices, rows, columns] => (columns, slices * rows),
         [rows, columns] => (columns, rows),
         [n] => (n, 1),
         _ => {
-            return Err(format!(
+            return Err(crate::Error::Encode(format!(
                 "cannot store a table of shape {shape:?} as an image"
-            ));
+            )));
         }
     };
     let names = table.channel_names();
@@ -47,19 +47,15 @@ pub fn encode(table: &Table, precision: Precision) -> std::result::Result<Vec<u8
 
 /// Encodes only the table's value channel, under the channel name `name` (an engine's layout,
 /// e.g. Enterprise PBR's half-float `Y`), with the same header and metadata as [`encode`].
-pub fn encode_value_as(
-    table: &Table,
-    name: &str,
-    precision: Precision,
-) -> std::result::Result<Vec<u8>, String> {
+pub fn encode_value_as(table: &Table, name: &str, precision: Precision) -> crate::Result<Vec<u8>> {
     let shape = table.spec.shape();
     let (width, height) = match shape[..] {
         [rows, columns] => (columns, rows),
         [n] => (n, 1),
         _ => {
-            return Err(format!(
+            return Err(crate::Error::Encode(format!(
                 "cannot store a table of shape {shape:?} as an image"
-            ));
+            )));
         }
     };
     write(
@@ -75,9 +71,9 @@ pub fn encode_planes(
     table: &Table,
     planes: &[(&str, &[f64])],
     precision: Precision,
-) -> std::result::Result<Vec<u8>, String> {
+) -> crate::Result<Vec<u8>> {
     let [rows, columns] = table.spec.shape()[..] else {
-        return Err("engine planes are 2-D".to_string());
+        return Err(crate::Error::Encode("engine planes are 2-D".to_string()));
     };
     write(
         table,
@@ -97,12 +93,12 @@ pub fn encode_texture(
     texture: &super::texture::Texture,
     layer: &str,
     precision: Precision,
-) -> std::result::Result<Vec<u8>, String> {
+) -> crate::Result<Vec<u8>> {
     let [rows, columns] = texture.shape[..] else {
-        return Err(format!(
+        return Err(crate::Error::Encode(format!(
             "cannot store a texture of shape {:?} as an image",
             texture.shape
-        ));
+        )));
     };
     write_image(
         layer,
@@ -121,9 +117,9 @@ fn write(
     table: &Table,
     size: (usize, usize),
     channels: Vec<(&str, &[f64], Precision)>,
-) -> std::result::Result<Vec<u8>, String> {
+) -> crate::Result<Vec<u8>> {
     let metadata = serde_json::to_string(&Metadata::new(table, channels[0].2.name()))
-        .map_err(|e| e.to_string())?;
+        .map_err(|e| crate::Error::Encode(e.to_string()))?;
     write_image(table.spec.id().as_str(), &metadata, size, channels)
 }
 
@@ -134,7 +130,7 @@ fn write_image(
     metadata: &str,
     (width, height): (usize, usize),
     channels: Vec<(&str, &[f64], Precision)>,
-) -> std::result::Result<Vec<u8>, String> {
+) -> crate::Result<Vec<u8>> {
     let samples = |values: &[f64], precision: Precision| match precision {
         Precision::F32 => FlatSamples::F32(values.iter().map(|&v| v as f32).collect()),
         Precision::F16 => {
@@ -151,7 +147,10 @@ fn write_image(
     attributes.software_name = Some(Text::from(format!("kiln {KILN_VERSION}").as_str()));
     attributes.other.insert(
         Text::from(METADATA_ATTRIBUTE),
-        AttributeValue::Text(Text::new_or_none(metadata).ok_or("metadata is not ASCII")?),
+        AttributeValue::Text(
+            Text::new_or_none(metadata)
+                .ok_or_else(|| crate::Error::Encode("metadata is not ASCII".into()))?,
+        ),
     );
     let encoding = Encoding {
         compression: Compression::ZIP16,
@@ -169,7 +168,7 @@ fn write_image(
         .write()
         .non_parallel()
         .to_buffered(Cursor::new(&mut bytes))
-        .map_err(|e| e.to_string())?;
+        .map_err(|e| crate::Error::Encode(e.to_string()))?;
     Ok(bytes)
 }
 
@@ -184,22 +183,22 @@ pub struct ExrContents {
 }
 
 /// Reads the first layer of an EXR file from memory.
-pub fn decode(bytes: &[u8]) -> std::result::Result<ExrContents, String> {
+pub fn decode(bytes: &[u8]) -> crate::Result<ExrContents> {
     // The header first: a data window beyond what a table can be is refused before the image
     // is allocated (a 405-byte file can claim 2^40 pixels).
     let meta = ::exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false)
-        .map_err(|e| e.to_string())?;
+        .map_err(|e| crate::Error::Malformed(e.to_string()))?;
     for header in &meta.headers {
         let (w, h) = (header.layer_size.0, header.layer_size.1);
         let samples = w
             .saturating_mul(h)
             .saturating_mul(header.channels.list.len().max(1));
         if w.saturating_mul(h) > super::MAX_TEXELS || samples > 4 * super::MAX_TEXELS {
-            return Err(format!(
+            return Err(crate::Error::Malformed(format!(
                 "a {w} x {h} image with {} channels, more than the {} texels kiln reads",
                 header.channels.list.len(),
                 super::MAX_TEXELS
-            ));
+            )));
         }
     }
     let image = read()
@@ -209,7 +208,7 @@ pub fn decode(bytes: &[u8]) -> std::result::Result<ExrContents, String> {
         .first_valid_layer()
         .all_attributes()
         .from_buffered(Cursor::new(bytes))
-        .map_err(|e| e.to_string())?;
+        .map_err(|e| crate::Error::Malformed(e.to_string()))?;
     let layer = image.layer_data;
     let metadata = layer
         .attributes

@@ -107,6 +107,6 @@ pub fn decode(bytes: &[u8], name: &str) -> Result<GlassCompensationTable> {
         "kiln compensation --bake DIR --ior ETA",
     )?;
     let table = document.table;
-    table.check().map_err(bad)?;
+    table.check().map_err(|e| bad(e.to_string()))?;
     Ok(table)
 }

@@ -41,8 +41,9 @@ pub fn sidecar(table: &Table, precision: &str, files: BTreeMap<String, String>) 
 }
 
 /// Encodes the sidecar as pretty-printed JSON with a final newline.
-pub fn encode(sidecar: &Sidecar) -> std::result::Result<Vec<u8>, String> {
-    let mut bytes = serde_json::to_vec_pretty(sidecar).map_err(|e| e.to_string())?;
+pub fn encode(sidecar: &Sidecar) -> crate::Result<Vec<u8>> {
+    let mut bytes =
+        serde_json::to_vec_pretty(sidecar).map_err(|e| crate::Error::Encode(e.to_string()))?;
     bytes.push(b'\n');
     Ok(bytes)
 }

@@ -54,7 +54,7 @@ fn align(n: usize, to: usize) -> usize {
 }
 
 /// Encodes a texture of one, two or four channels, uncompressed.
-pub fn encode(texture: &Texture, precision: Precision) -> std::result::Result<Vec<u8>, String> {
+pub fn encode(texture: &Texture, precision: Precision) -> crate::Result<Vec<u8>> {
     encode_with(texture, precision, Supercompression::None)
 }
 
@@ -63,10 +63,13 @@ pub fn encode_with(
     texture: &Texture,
     precision: Precision,
     supercompression: Supercompression,
-) -> std::result::Result<Vec<u8>, String> {
+) -> crate::Result<Vec<u8>> {
     let channels = texture.channels.len();
-    let format = vk_format(channels, precision)
-        .ok_or_else(|| format!("KTX2 output takes one, two or four channels (got {channels})"))?;
+    let format = vk_format(channels, precision).ok_or_else(|| {
+        crate::Error::Encode(format!(
+            "KTX2 output takes one, two or four channels (got {channels})"
+        ))
+    })?;
     let type_size = precision.bytes();
     let texel_bytes = type_size * channels;
     let raw = texture.interleaved(precision);
@@ -174,18 +177,25 @@ pub fn encode_with(
 /// # Errors
 /// A message naming what is wrong with the file.
 #[cfg(feature = "containers")]
-pub fn decode(bytes: &[u8]) -> std::result::Result<super::texture::DecodedTexture, String> {
-    let u32_at = |offset: usize| -> std::result::Result<u32, String> {
+pub fn decode(bytes: &[u8]) -> crate::Result<super::texture::DecodedTexture> {
+    let u32_at = |offset: usize| -> crate::Result<u32> {
         bytes
             .get(offset..offset + 4)
             .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-            .ok_or_else(|| format!("the file ends at byte {} inside its header", bytes.len()))
+            .ok_or_else(|| {
+                crate::Error::Malformed(format!(
+                    "the file ends at byte {} inside its header",
+                    bytes.len()
+                ))
+            })
     };
-    let u64_at = |offset: usize| -> std::result::Result<u64, String> {
+    let u64_at = |offset: usize| -> crate::Result<u64> {
         Ok(u64::from(u32_at(offset)?) | u64::from(u32_at(offset + 4)?) << 32)
     };
     if bytes.len() < 80 || bytes[..12] != IDENTIFIER {
-        return Err("not a KTX2 file (no KTX 2.0 identifier)".into());
+        return Err(crate::Error::Malformed(
+            "not a KTX2 file (no KTX 2.0 identifier)".into(),
+        ));
     }
     let format = u32_at(12)?;
     let (channels, precision) = match format {
@@ -196,9 +206,9 @@ pub fn decode(bytes: &[u8]) -> std::result::Result<super::texture::DecodedTextur
         103 => (2, Precision::F32),
         109 => (4, Precision::F32),
         other => {
-            return Err(format!(
+            return Err(crate::Error::Malformed(format!(
                 "VkFormat {other}: kiln reads R, RG and RGBA textures of 16- or 32-bit floats"
-            ));
+            )));
         }
     };
     let extent = (
@@ -211,7 +221,7 @@ pub fn decode(bytes: &[u8]) -> std::result::Result<super::texture::DecodedTextur
     let scheme = u32_at(44)?;
     let (kvd_offset, kvd_length) = (u32_at(56)? as usize, u32_at(60)? as usize);
     if level_count > 64 {
-        return Err(format!("{level_count} levels"));
+        return Err(crate::Error::Malformed(format!("{level_count} levels")));
     }
     // The first level's index entry: byte offset, byte length (then the uncompressed length).
     let (offset, length) = (u64_at(80)?, u64_at(88)?);
@@ -220,11 +230,11 @@ pub fn decode(bytes: &[u8]) -> std::result::Result<super::texture::DecodedTextur
         .zip(usize::try_from(length).ok())
         .and_then(|(o, l)| bytes.get(o..o.checked_add(l)?))
         .ok_or_else(|| {
-            format!(
+            crate::Error::Malformed(format!(
                 "level 0 claims bytes {offset} to {} of a {}-byte file",
                 offset.saturating_add(length),
                 bytes.len()
-            )
+            ))
         })?;
     // What the texels must take: decompression stops there, whatever the file claims.
     let expected = texels * channels * precision.bytes();
@@ -232,19 +242,19 @@ pub fn decode(bytes: &[u8]) -> std::result::Result<super::texture::DecodedTextur
         0 => level.to_vec(),
         2 => {
             let mut out = Vec::new();
-            let decoder =
-                ruzstd::decoding::StreamingDecoder::new(level).map_err(|e| format!("zstd: {e}"))?;
+            let decoder = ruzstd::decoding::StreamingDecoder::new(level)
+                .map_err(|e| crate::Error::Malformed(format!("zstd: {e}")))?;
             std::io::Read::read_to_end(
                 &mut std::io::Read::take(decoder, expected as u64 + 1),
                 &mut out,
             )
-            .map_err(|e| format!("zstd: {e}"))?;
+            .map_err(|e| crate::Error::Malformed(format!("zstd: {e}")))?;
             out
         }
         other => {
-            return Err(format!(
+            return Err(crate::Error::Malformed(format!(
                 "supercompression scheme {other}: kiln reads none (0) or Zstandard (2)"
-            ));
+            )));
         }
     };
     // Key/value data: (u32 length, key NUL value, padding to 4) entries.
@@ -253,7 +263,9 @@ pub fn decode(bytes: &[u8]) -> std::result::Result<super::texture::DecodedTextur
         let kvd = kvd_offset
             .checked_add(kvd_length)
             .and_then(|end| bytes.get(kvd_offset..end))
-            .ok_or("the key/value data lies outside the file")?;
+            .ok_or_else(|| {
+                crate::Error::Malformed("the key/value data lies outside the file".into())
+            })?;
         let mut at = 0;
         while at + 4 <= kvd.len() {
             let n = u32::from_le_bytes([kvd[at], kvd[at + 1], kvd[at + 2], kvd[at + 3]]) as usize;
@@ -261,7 +273,9 @@ pub fn decode(bytes: &[u8]) -> std::result::Result<super::texture::DecodedTextur
                 .checked_add(4)
                 .zip((at + 4).checked_add(n))
                 .and_then(|(start, end)| kvd.get(start..end))
-                .ok_or("a key/value entry runs past the key/value data")?;
+                .ok_or_else(|| {
+                    crate::Error::Malformed("a key/value entry runs past the key/value data".into())
+                })?;
             if let Some(split) = entry.iter().position(|&b| b == 0)
                 && &entry[..split] == b"kiln"
             {

@@ -253,12 +253,15 @@ pub fn embedded_json(metadata: &Metadata) -> String {
 }
 
 /// Finds the metadata line of a generated C header or Rust source (see [`EMBEDDED_PREFIX`]).
-pub fn find_embedded(text: &str) -> Option<std::result::Result<Metadata, String>> {
+pub fn find_embedded(text: &str) -> Option<crate::Result<Metadata>> {
     let line = text
         .lines()
         .take_while(|line| {
             line.starts_with("//") || line.starts_with("/*") || line.starts_with(" *")
         })
         .find_map(|line| line.split_once(EMBEDDED_PREFIX).map(|(_, json)| json))?;
-    Some(serde_json::from_str(line.trim()).map_err(|e| format!("bad kiln metadata comment: {e}")))
+    Some(
+        serde_json::from_str(line.trim())
+            .map_err(|e| crate::Error::Malformed(format!("bad kiln metadata comment: {e}"))),
+    )
 }

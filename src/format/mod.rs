@@ -186,18 +186,20 @@ pub fn encode_all(
         let mut written = BTreeMap::new();
         for &format in formats {
             let bytes = match format {
-                Format::Exr => exr::encode(table, precision).map_err(|m| fail(format, m))?,
+                Format::Exr => {
+                    exr::encode(table, precision).map_err(|m| fail(format, m.to_string()))?
+                }
                 Format::Bin => binary::encode(table, precision),
                 Format::Rs => rust::encode(table).into_bytes(),
                 Format::Png => match png::encode(table) {
                     None => continue,
-                    Some(result) => result.map_err(|m| fail(format, m))?,
+                    Some(result) => result.map_err(|m| fail(format, m.to_string()))?,
                 },
                 Format::Ktx2 => ktx2::encode(&texture::Texture::of_table(table), precision)
-                    .map_err(|m| fail(format, m))?,
+                    .map_err(|m| fail(format, m.to_string()))?,
                 #[cfg(feature = "containers")]
                 Format::Dds => dds::encode(&texture::Texture::of_table(table), precision)
-                    .map_err(|m| fail(format, m))?,
+                    .map_err(|m| fail(format, m.to_string()))?,
                 #[cfg(not(feature = "containers"))]
                 Format::Dds => {
                     return Err(fail(
@@ -217,7 +219,7 @@ pub fn encode_all(
         }
         if formats.contains(&Format::Json) {
             let sidecar = json::sidecar(table, precision.name(), written);
-            let bytes = json::encode(&sidecar).map_err(|m| fail(Format::Json, m))?;
+            let bytes = json::encode(&sidecar).map_err(|m| fail(Format::Json, m.to_string()))?;
             files.push((format!("{id}.json"), bytes));
         }
     }

@@ -31,7 +31,7 @@ pub fn viridis(t: f64) -> [u8; 3] {
 }
 
 /// Encodes the table's value channel as a heat map; `None` for a 1-D table.
-pub fn encode(table: &Table) -> Option<std::result::Result<Vec<u8>, String>> {
+pub fn encode(table: &Table) -> Option<crate::Result<Vec<u8>>> {
     let (rows, columns) = match table.spec.shape()[..] {
         [slices, rows, columns] => (slices * rows, columns),
         [rows, columns] => (rows, columns),
@@ -68,7 +68,11 @@ pub fn encode(table: &Table) -> Option<std::result::Result<Vec<u8>, String>> {
         writer.write_image_data(&pixels)?;
         writer.finish()
     })();
-    Some(result.map(|()| bytes).map_err(|e| e.to_string()))
+    Some(
+        result
+            .map(|()| bytes)
+            .map_err(|e| crate::Error::Encode(e.to_string())),
+    )
 }
 
 /// An 8-bit RGB image whose three channels hold the same grey level, `round(255 v)` clamped to
@@ -78,12 +82,12 @@ pub fn encode_grey8(
     (width, height): (usize, usize),
     values: &[f64],
     comment: &str,
-) -> std::result::Result<Vec<u8>, String> {
+) -> crate::Result<Vec<u8>> {
     if values.len() != width * height {
-        return Err(format!(
+        return Err(crate::Error::Encode(format!(
             "{} values for a {width} x {height} image",
             values.len()
-        ));
+        )));
     }
     let pixels: Vec<u8> = values.iter().flat_map(|&v| [unorm8(v); 3]).collect();
     let mut bytes = Vec::new();
@@ -96,7 +100,9 @@ pub fn encode_grey8(
         writer.write_image_data(&pixels)?;
         writer.finish()
     })();
-    result.map(|()| bytes).map_err(|e| e.to_string())
+    result
+        .map(|()| bytes)
+        .map_err(|e| crate::Error::Encode(e.to_string()))
 }
 
 /// `v` as an 8-bit unsigned normalised number: `round(255 v)`, clamped to [0, 255] (NaN to 0).
@@ -108,24 +114,21 @@ pub fn unorm8(v: f64) -> u8 {
 /// A PNG image read as grey levels in [0, 1]: its first channel (grey or red), 8 or 16 bits
 /// (fewer bits and palettes expanded to 8), rows top to bottom. Refused before anything is
 /// decoded unless it is `expected` (width, height).
-pub fn decode_grey(
-    bytes: &[u8],
-    expected: (usize, usize),
-) -> std::result::Result<Vec<f64>, String> {
+pub fn decode_grey(bytes: &[u8], expected: (usize, usize)) -> crate::Result<Vec<f64>> {
     let mut decoder = png::Decoder::new(bytes);
     decoder.set_transformations(png::Transformations::EXPAND);
     let mut reader = decoder
         .read_info()
-        .map_err(|e| format!("not a PNG file ({e})"))?;
+        .map_err(|e| crate::Error::Malformed(format!("not a PNG file ({e})")))?;
     let (width, height) = {
         let info = reader.info();
         (info.width as usize, info.height as usize)
     };
     if (width, height) != expected {
-        return Err(format!(
+        return Err(crate::Error::Malformed(format!(
             "a {width} x {height} image (expected {} x {})",
             expected.0, expected.1
-        ));
+        )));
     }
     if reader.info().color_type == png::ColorType::Indexed {
         check_palette_indices(bytes)?;
@@ -133,7 +136,7 @@ pub fn decode_grey(
     let mut buffer = vec![0; reader.output_buffer_size()];
     let frame = reader
         .next_frame(&mut buffer)
-        .map_err(|e| format!("a damaged PNG file ({e})"))?;
+        .map_err(|e| crate::Error::Malformed(format!("a damaged PNG file ({e})")))?;
     let samples = frame.color_type.samples();
     let sixteen = frame.bit_depth == png::BitDepth::Sixteen;
     let bytes_per_sample = if sixteen { 2 } else { 1 };
@@ -150,20 +153,20 @@ pub fn decode_grey(
         }
     }
     if values.len() != width * height {
-        return Err(format!(
+        return Err(crate::Error::Malformed(format!(
             "{} pixels decoded of {width} x {height}",
             values.len()
-        ));
+        )));
     }
     Ok(values)
 }
 
 /// Refuses a palette image with a pixel whose index is past its palette (the PNG
 /// specification calls that an error; expanded, such a pixel read as black, a silent 0).
-fn check_palette_indices(bytes: &[u8]) -> std::result::Result<(), String> {
+fn check_palette_indices(bytes: &[u8]) -> crate::Result<()> {
     let mut reader = png::Decoder::new(bytes)
         .read_info()
-        .map_err(|e| format!("not a PNG file ({e})"))?;
+        .map_err(|e| crate::Error::Malformed(format!("not a PNG file ({e})")))?;
     let (colours, width, height, bits) = {
         let info = reader.info();
         let colours = info.palette.as_ref().map_or(0, |p| p.len() / 3);
@@ -177,7 +180,7 @@ fn check_palette_indices(bytes: &[u8]) -> std::result::Result<(), String> {
     let mut buffer = vec![0; reader.output_buffer_size()];
     let frame = reader
         .next_frame(&mut buffer)
-        .map_err(|e| format!("a damaged PNG file ({e})"))?;
+        .map_err(|e| crate::Error::Malformed(format!("a damaged PNG file ({e})")))?;
     let mask = (1_usize << bits) - 1;
     for (y, row) in buffer[..frame.buffer_size()]
         .chunks_exact(frame.line_size)
@@ -188,10 +191,10 @@ fn check_palette_indices(bytes: &[u8]) -> std::result::Result<(), String> {
             let bit = x * bits;
             let index = (usize::from(row[bit / 8]) >> (8 - bits - bit % 8)) & mask;
             if index >= colours {
-                return Err(format!(
+                return Err(crate::Error::Malformed(format!(
                     "pixel ({x}, {y}) holds palette index {index}, past its palette of \
                      {colours} colours (a damaged or hand-made file)"
-                ));
+                )));
             }
         }
     }
@@ -310,7 +313,9 @@ mod tests {
             let past = palette_png(2, [0, 1, 3, 0], depth);
             let message = decode_grey(&past, (4, 1)).unwrap_err();
             assert!(
-                message.contains("pixel (2, 0) holds palette index 3, past its palette of 2"),
+                message
+                    .to_string()
+                    .contains("pixel (2, 0) holds palette index 3, past its palette of 2"),
                 "{message}"
             );
         }

@@ -36,14 +36,16 @@ impl Texture {
 
     /// The value planes of several tables of the same axes as channels R, G, ... (an engine's
     /// scale/bias texture, for instance).
-    pub fn of_values(tables: &[&Table]) -> std::result::Result<Texture, String> {
-        let first = tables.first().ok_or("a texture needs at least one table")?;
+    pub fn of_values(tables: &[&Table]) -> crate::Result<Texture> {
+        let first = tables
+            .first()
+            .ok_or_else(|| crate::Error::Malformed("a texture needs at least one table".into()))?;
         if let Some(other) = tables.iter().find(|t| t.spec.axes() != first.spec.axes()) {
-            return Err(format!(
+            return Err(crate::Error::Malformed(format!(
                 "{} and {} have different axes and cannot share a texture",
                 first.spec.id(),
                 other.spec.id()
-            ));
+            )));
         }
         Ok(Texture {
             shape: first.spec.shape(),
@@ -105,14 +107,14 @@ fn metadata_json(tables: &[&Table]) -> String {
 }
 
 /// The tables' metadata of a texture's `kiln` JSON (as `metadata_json` writes it).
-pub fn texture_metadata(text: &str) -> std::result::Result<Vec<super::metadata::Metadata>, String> {
+pub fn texture_metadata(text: &str) -> crate::Result<Vec<super::metadata::Metadata>> {
     #[derive(serde::Deserialize)]
     struct TextureMetadata {
         tables: Vec<super::metadata::Metadata>,
     }
     serde_json::from_str::<TextureMetadata>(text)
         .map(|t| t.tables)
-        .map_err(|e| format!("bad kiln metadata: {e}"))
+        .map_err(|e| crate::Error::Malformed(format!("bad kiln metadata: {e}")))
 }
 
 /// A float texture read back from a GPU container ([`super::ktx2::decode`],
@@ -137,18 +139,16 @@ impl DecodedTexture {
     ///
     /// # Errors
     /// An extent of more than [`super::MAX_TEXELS`] texels.
-    pub fn texels_within_limit(
-        extent: (usize, usize, usize),
-    ) -> std::result::Result<usize, String> {
+    pub fn texels_within_limit(extent: (usize, usize, usize)) -> crate::Result<usize> {
         let texels = extent.0.saturating_mul(extent.1).saturating_mul(extent.2);
         if texels > super::MAX_TEXELS {
-            return Err(format!(
+            return Err(crate::Error::Malformed(format!(
                 "{} x {} x {} texels, more than the {} kiln reads",
                 extent.0,
                 extent.1,
                 extent.2,
                 super::MAX_TEXELS
-            ));
+            )));
         }
         Ok(texels)
     }
@@ -161,16 +161,16 @@ impl DecodedTexture {
         precision: Precision,
         data: &[u8],
         metadata: Option<String>,
-    ) -> std::result::Result<Self, String> {
+    ) -> crate::Result<Self> {
         let texels = extent
             .0
             .checked_mul(extent.1)
             .and_then(|n| n.checked_mul(extent.2))
-            .ok_or("the texture's extent overflows")?;
+            .ok_or_else(|| crate::Error::Malformed("the texture's extent overflows".into()))?;
         let size = precision.bytes();
         let expected = texels.saturating_mul(count).saturating_mul(size);
         if data.len() != expected {
-            return Err(format!(
+            return Err(crate::Error::Malformed(format!(
                 "{} bytes of texels where {} x {} x {} texels of {count} channels of {} bytes \
                  need {expected}",
                 data.len(),
@@ -178,7 +178,7 @@ impl DecodedTexture {
                 extent.1,
                 extent.2,
                 size
-            ));
+            )));
         }
         let value = |k: usize| -> f64 {
             let b = &data[k * size..(k + 1) * size];

@@ -29,8 +29,8 @@
 //! `c_{2k} = (4 / pi) ∫_0^{pi/2} E(phi) cos(2 k phi) dphi` for `k > 0`
 //! ([`reference_anisotropic_fourier`]).
 
-use super::albedo::{QmcSettings, replicates, sum_over_block};
 use super::estimate::Estimate;
+use super::qmc::{QmcSettings, replicates, sum_over_block};
 use super::reference::{ReferenceSettings, ReferenceValue};
 use crate::model::{AnisotropicGgx, Vec3};
 use crate::numerics::gauss_kronrod::integrate_pieces;
@@ -44,30 +44,32 @@ const X_MAX: f64 = 44.0;
 
 /// Checks an anisotropic view and roughness: `mu` in [0, 1], both roughness values finite and
 /// in (0, 1000].
-pub fn check_anisotropic(ndf: AnisotropicGgx, mu: f64) -> Result<(), String> {
+pub fn check_anisotropic(ndf: AnisotropicGgx, mu: f64) -> crate::Result<()> {
     for (name, alpha) in [("alpha_x", ndf.alpha_x), ("alpha_y", ndf.alpha_y)] {
         if !(alpha > 0.0 && alpha <= 1000.0) {
-            return Err(format!(
+            return Err(crate::Error::InvalidInput(format!(
                 "{name} = {alpha} is outside (0, 1000]: anisotropic GGX needs a positive \
                  roughness on each axis (a mirror along one axis is the limit alpha -> 0, \
                  give 1e-4)"
-            ));
+            )));
         }
     }
     if !(0.0..=1.0).contains(&mu) {
-        return Err(format!("mu = {mu} is outside [0, 1]"));
+        return Err(crate::Error::InvalidInput(format!(
+            "mu = {mu} is outside [0, 1]"
+        )));
     }
     Ok(())
 }
 
 /// Checks a view's azimuth: radians from the tangent, in `[-2 pi, 2 pi]`.
-pub fn check_azimuth(phi: f64) -> Result<(), String> {
+pub fn check_azimuth(phi: f64) -> crate::Result<()> {
     if (-2.0 * PI..=2.0 * PI).contains(&phi) {
         Ok(())
     } else {
-        Err(format!(
+        Err(crate::Error::InvalidInput(format!(
             "the view's azimuth phi = {phi} is outside [-2 pi, 2 pi] (radians from the tangent)"
-        ))
+        )))
     }
 }
 

@@ -32,18 +32,18 @@
 //! then lies below `mu = 1e-6`; the similarity [`crate::model::smooth_point`] uses for `E` does not
 //! hold once `F` depends on `mu`).
 
-use super::albedo::{
-    BeckmannView, GgxView, Levels, QmcSettings, TAG_DIELECTRIC, TAG_DIELECTRIC_AVG, levels_sum,
-    model_key, replicates, sin_from_cos, sum_over_block,
-};
+use super::albedo::{GgxView, Levels, TAG_DIELECTRIC, TAG_DIELECTRIC_AVG, levels_sum, model_key};
+use super::beckmann_albedo::BeckmannView;
 use super::dielectric_average::average;
 pub use super::dielectric_reference::DielectricReference;
 use super::estimate::Estimate;
 use super::gauss_kronrod::{KRONROD_NODES, integrate_pieces, integrate_pieces_batch};
+use super::qmc::{QmcSettings, replicates, sum_over_block};
 use super::reference::{ReferenceSettings, ladder, phi_breaks, s_of_x, t_of_s, x_range};
 use crate::model::dielectric::{
     TransmissionConvention, refract, scattering_with, scatterings_at_cos,
 };
+use crate::model::vector::sin_from_cos;
 use crate::model::{
     Beckmann, Ggx, Masking, MicrofacetDistribution, Model, Ndf, SMOOTH_ALPHA, Vec3,
 };
@@ -611,6 +611,113 @@ fn critical_crossings(mu: f64, so: f64, c: f64) -> Vec<f64> {
     crossings
 }
 
+/// The outer integral's breaks in the azimuth: [`phi_breaks`], and with a critical angle
+/// (`critical_cos`, light leaving the denser medium) where its curve leaves the slice, a ladder
+/// beyond it, where it crosses the horizon, and its crossings ([`critical_crossings`]).
+fn outer_breaks(mu: f64, so: f64, critical_cos: Option<f64>) -> Vec<f64> {
+    let mut breaks = phi_breaks(mu, so);
+    if let Some(c) = critical_cos {
+        // Where the critical angle's curve leaves the slice (rho(phi) = critical cos), the
+        // inner integral has a kink in phi: break there.
+        if c > mu && so > 0.0 {
+            let cos_phi = ((c - mu) * (c + mu)).sqrt() / so;
+            if cos_phi < 1.0 {
+                breaks.extend([cos_phi.acos(), (-cos_phi).acos()]);
+            }
+            // Beyond it the slices reach past the critical angle, where the Fresnel factor
+            // falls from 1 over a width ~c in o.m: a layer of the inner integral in phi,
+            // ~c / so wide, at the end of a piece up to pi / 2 long, which the outer rule
+            // stepped over at mu = 0 (GGX alpha 0.051, eta 0.99968: 2.4e-7 off where 4.0e-8
+            // was stated, at tolerance 1e-7). A ladder in rho closes in on it, from c / 4 (one
+            // started at c / 16 made `kiln verify --preset cycles` of the inside table 14 %
+            // slower than without a ladder; this one 3 %).
+            for rung in ladder(4.0 * c, 1.0) {
+                let rho = c + rung;
+                let cos_phi = ((rho - mu) * (rho + mu)).sqrt() / so;
+                if cos_phi < 1.0 {
+                    breaks.extend([cos_phi.acos(), (-cos_phi).acos()]);
+                }
+            }
+        }
+        // And where it crosses the horizon (theta_m = pi / 2 at rho sin(delta) = so cos(phi)
+        // = critical cos): beyond, the slice refracts up to its visible edge. Without this break
+        // the outer rule stepped over the kink (GGX alpha 0.327, mu 0.300, eta 1/3: 1.8e-7 off
+        // where 4.8e-8 was stated, at tolerance 1e-7).
+        if c < so {
+            breaks.push((c / so).acos());
+        }
+        breaks.extend(critical_crossings(mu, so, c));
+        breaks.sort_by(f64::total_cmp);
+    }
+    breaks
+}
+
+/// A slice's breaks in `x` made ready for its pieces: the critical angles added, those outside
+/// `[x_min, x_visible]` dropped, sorted, a piece between two critical angles halved and one
+/// ending at a critical angle from `x_min` given a break a unit before it.
+fn finish_slice_breaks(
+    mut breaks: Vec<f64>,
+    critical: &[f64],
+    x_min: f64,
+    x_visible: f64,
+) -> Vec<f64> {
+    breaks.extend(critical);
+    breaks.retain(|&b| b >= x_min && b <= x_visible);
+    breaks.sort_by(f64::total_cmp);
+    breaks.dedup();
+    // A piece between the two critical angles has a square root at both ends: split it, so
+    // that each half has one, which its substitution below makes smooth.
+    if let [first, second] = critical[..]
+        && breaks
+            .windows(2)
+            .any(|w| (w[0] == first && w[1] == second) || (w[0] == second && w[1] == first))
+    {
+        breaks.push(0.5 * (first + second));
+        breaks.sort_by(f64::total_cmp);
+    }
+    // The piece from x_min is integrated from x = -infinity in s (below); when it ends at a
+    // critical angle, a break a unit before it keeps the square-root piece finite.
+    if let Some(&first) = breaks.get(1)
+        && first <= 0.0
+        && critical.contains(&first)
+        && first - 1.0 > x_min
+    {
+        breaks.insert(1, first - 1.0);
+    }
+    breaks
+}
+
+/// Where the refracted direction crosses the horizon along a slice: the sign changes of its
+/// `z` (`refracted_z`, `None` where the facet does not refract) between the points of `scan`,
+/// found by bisection, each added to `breaks` with a ladder into its masking layer on both
+/// sides.
+fn refraction_horizon_breaks(
+    scan: &[f64],
+    refracted_z: &dyn Fn(f64) -> Option<f64>,
+    alpha: f64,
+    breaks: &mut Vec<f64>,
+) {
+    let mut previous: Option<(f64, f64)> = None;
+    for &x in scan {
+        let z = refracted_z(x);
+        if let (Some((x0, z0)), Some(z1)) = (previous, z)
+            && (z0 < 0.0) != (z1 < 0.0)
+        {
+            let root = bisect(x0, x, 40, |mid| {
+                refracted_z(mid).is_some_and(|zm| (zm < 0.0) == (z0 < 0.0))
+            });
+            breaks.push(root);
+            // The refracted direction grazes the horizon here: its masking layer, on both
+            // sides.
+            let layer = 2.0 * alpha / (2.0 * (alpha * root.exp()).atan()).sin();
+            for rung in ladder(layer, LADDER_REACH) {
+                breaks.extend([root - rung, root + rung]);
+            }
+        }
+        previous = z.map(|z| (x, z));
+    }
+}
+
 /// `[R, T, 1 - E]` for one distribution (see the module docs).
 fn quadrature<N: MicrofacetDistribution>(
     ndf: N,
@@ -704,25 +811,12 @@ fn quadrature<N: MicrofacetDistribution>(
             }
         }
         scan.sort_by(f64::total_cmp);
-        let mut previous: Option<(f64, f64)> = None;
-        for &x in &scan {
-            let z = refracted_z(x, cos_phi, sin_phi);
-            if let (Some((x0, z0)), Some(z1)) = (previous, z)
-                && (z0 < 0.0) != (z1 < 0.0)
-            {
-                let root = bisect(x0, x, 40, |mid| {
-                    refracted_z(mid, cos_phi, sin_phi).is_some_and(|zm| (zm < 0.0) == (z0 < 0.0))
-                });
-                breaks.push(root);
-                // The refracted direction grazes the horizon here: its masking layer, on both
-                // sides.
-                let layer = 2.0 * alpha / (2.0 * (alpha * root.exp()).atan()).sin();
-                for rung in ladder(layer, LADDER_REACH) {
-                    breaks.extend([root - rung, root + rung]);
-                }
-            }
-            previous = z.map(|z| (x, z));
-        }
+        refraction_horizon_breaks(
+            &scan,
+            &|x| refracted_z(x, cos_phi, sin_phi),
+            alpha,
+            &mut breaks,
+        );
         evaluations += scan.len() as u64 * 2;
         // The reflected direction's masking layer below its horizon curve (as in `E`'s
         // reference: a layer of width ~alpha / sin(2 theta*) in x, which a piece much wider
@@ -730,29 +824,7 @@ fn quadrature<N: MicrofacetDistribution>(
         for rung in ladder(alpha / (2.0 * theta_star).sin(), LADDER_REACH) {
             breaks.push(x_star - rung);
         }
-        breaks.extend(&critical);
-        breaks.retain(|&b| b >= x_min && b <= x_visible);
-        breaks.sort_by(f64::total_cmp);
-        breaks.dedup();
-        // A piece between the two critical angles has a square root at both ends: split it, so
-        // that each half has one, which its substitution below makes smooth.
-        if let [first, second] = critical[..]
-            && breaks
-                .windows(2)
-                .any(|w| (w[0] == first && w[1] == second) || (w[0] == second && w[1] == first))
-        {
-            breaks.push(0.5 * (first + second));
-            breaks.sort_by(f64::total_cmp);
-        }
-        // The piece from x_min is integrated from x = -infinity in s (below); when it ends at a
-        // critical angle, a break a unit before it keeps the square-root piece finite.
-        if let Some(&first) = breaks.get(1)
-            && first <= 0.0
-            && critical.contains(&first)
-            && first - 1.0 > x_min
-        {
-            breaks.insert(1, first - 1.0);
-        }
+        let breaks = finish_slice_breaks(breaks, &critical, x_min, x_visible);
         // Beside the critical angle 1 - F and the refracted direction go as sqrt(distance):
         // integrate those pieces in s with x = edge +- s^2, which makes them smooth.
         let pieces = breaks.len().saturating_sub(1).max(1) as f64;
@@ -787,40 +859,7 @@ fn quadrature<N: MicrofacetDistribution>(
         }
         total
     };
-    let mut breaks = phi_breaks(mu, so);
-    if let Some(c) = critical_cos {
-        // Where the critical angle's curve leaves the slice (rho(phi) = critical cos), the
-        // inner integral has a kink in phi: break there.
-        if c > mu && so > 0.0 {
-            let cos_phi = ((c - mu) * (c + mu)).sqrt() / so;
-            if cos_phi < 1.0 {
-                breaks.extend([cos_phi.acos(), (-cos_phi).acos()]);
-            }
-            // Beyond it the slices reach past the critical angle, where the Fresnel factor
-            // falls from 1 over a width ~c in o.m: a layer of the inner integral in phi,
-            // ~c / so wide, at the end of a piece up to pi / 2 long, which the outer rule
-            // stepped over at mu = 0 (GGX alpha 0.051, eta 0.99968: 2.4e-7 off where 4.0e-8
-            // was stated, at tolerance 1e-7). A ladder in rho closes in on it, from c / 4 (one
-            // started at c / 16 made `kiln verify --preset cycles` of the inside table 14 %
-            // slower than without a ladder; this one 3 %).
-            for rung in ladder(4.0 * c, 1.0) {
-                let rho = c + rung;
-                let cos_phi = ((rho - mu) * (rho + mu)).sqrt() / so;
-                if cos_phi < 1.0 {
-                    breaks.extend([cos_phi.acos(), (-cos_phi).acos()]);
-                }
-            }
-        }
-        // And where it crosses the horizon (theta_m = pi / 2 at rho sin(delta) = so cos(phi)
-        // = critical cos): beyond, the slice refracts up to its visible edge. Without this break
-        // the outer rule stepped over the kink (GGX alpha 0.327, mu 0.300, eta 1/3: 1.8e-7 off
-        // where 4.8e-8 was stated, at tolerance 1e-7).
-        if c < so {
-            breaks.push((c / so).acos());
-        }
-        breaks.extend(critical_crossings(mu, so, c));
-        breaks.sort_by(f64::total_cmp);
-    }
+    let breaks = outer_breaks(mu, so, critical_cos);
     let outer = integrate_pieces(
         &mut over_phi,
         &breaks,

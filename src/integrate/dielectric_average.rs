@@ -217,6 +217,57 @@ fn slice_lanes<N: MicrofacetDistribution>(
     values
 }
 
+/// The inner integral's breaks in `phi_h`, and the lowest `phi_h` integrated: the horizons of
+/// the view (`o.z = 0` at `cos phi_h = a / b`, views at larger `phi_h` above), of the reflected
+/// direction (at pi less that) and, where the slice `refracts`, of the refracted direction (at
+/// `cos phi_h = eta cos(theta_t) cos(theta_m) / b`), each with a ladder into its masking layer.
+/// `(a, b) = (cos theta_h cos theta_m, sin theta_h sin theta_m)`.
+fn azimuth_breaks(
+    (a, b, cos_m): (f64, f64, f64),
+    (alpha, eta): (f64, f64),
+    cos_theta_t: f64,
+    refracts: bool,
+    convention: TransmissionConvention,
+) -> (Vec<f64>, f64) {
+    // Horizons in phi_h: the view's (o.z = 0, views at larger phi_h are above), the
+    // reflected direction's (at pi - that, reflections at smaller phi_h are above) and
+    // the refracted one's (refractions at larger phi_h are below).
+    let mut breaks = vec![0.0, PI];
+    let mut lower = 0.0;
+    let layer = |phi: f64, width: f64| -> f64 {
+        let slope = b * phi.sin();
+        width / slope.max((width * b).sqrt()).max(1e-300)
+    };
+    if a < b {
+        let phi_o = (a / b).acos();
+        lower = phi_o;
+        let phi_r = PI - phi_o;
+        breaks.extend([phi_o, phi_r]);
+        let width = layer(phi_o, alpha);
+        for rung in ladder(width, PI) {
+            breaks.extend([phi_o + rung, phi_r - rung]);
+        }
+    }
+    if refracts && b > 0.0 {
+        let w_t = eta * cos_theta_t * cos_m / b;
+        if w_t < 1.0 {
+            let phi_t = w_t.acos();
+            breaks.push(phi_t);
+            let width = layer(phi_t, alpha * eta);
+            // The transmission's masking layer is on the side where the refracted
+            // direction is below the surface; in the convention that keeps refractions
+            // above it too, on both.
+            for rung in ladder(width, PI) {
+                breaks.push(phi_t + rung);
+                if convention.keeps_refraction_above() {
+                    breaks.push(phi_t - rung);
+                }
+            }
+        }
+    }
+    (breaks, lower)
+}
+
 /// `R_avg`, `T_avg` and `(1 - E)_avg` with the stated error (see the module docs) for one
 /// distribution.
 pub(crate) fn average<N: MicrofacetDistribution>(
@@ -311,43 +362,14 @@ pub(crate) fn average<N: MicrofacetDistribution>(
             let (sin_h, cos_h) = theta_h.sin_cos();
             let a = cos_h * cos_m;
             let b = sin_h * sin_m;
-            // Horizons in phi_h: the view's (o.z = 0, views at larger phi_h are above), the
-            // reflected direction's (at pi - that, reflections at smaller phi_h are above) and
-            // the refracted one's (refractions at larger phi_h are below).
-            let mut breaks = vec![0.0, PI];
-            let mut lower = 0.0;
-            let layer = |phi: f64, width: f64| -> f64 {
-                let slope = b * phi.sin();
-                width / slope.max((width * b).sqrt()).max(1e-300)
-            };
-            if a < b {
-                let phi_o = (a / b).acos();
-                lower = phi_o;
-                let phi_r = PI - phi_o;
-                breaks.extend([phi_o, phi_r]);
-                let width = layer(phi_o, alpha);
-                for rung in ladder(width, PI) {
-                    breaks.extend([phi_o + rung, phi_r - rung]);
-                }
-            }
-            let cos_theta_t = cos_t(theta_h);
-            if critical.is_none_or(|c| theta_h < c) && b > 0.0 {
-                let w_t = eta * cos_theta_t * cos_m / b;
-                if w_t < 1.0 {
-                    let phi_t = w_t.acos();
-                    breaks.push(phi_t);
-                    let width = layer(phi_t, alpha * eta);
-                    // The transmission's masking layer is on the side where the refracted
-                    // direction is below the surface; in the convention that keeps refractions
-                    // above it too, on both.
-                    for rung in ladder(width, PI) {
-                        breaks.push(phi_t + rung);
-                        if convention.keeps_refraction_above() {
-                            breaks.push(phi_t - rung);
-                        }
-                    }
-                }
-            }
+            let refracts = critical.is_none_or(|c| theta_h < c);
+            let (mut breaks, lower) = azimuth_breaks(
+                (a, b, cos_m),
+                (alpha, eta),
+                cos_t(theta_h),
+                refracts,
+                convention,
+            );
             tidy(&mut breaks, lower, PI);
             if breaks.len() < 2 {
                 return [0.0; 4];

@@ -15,9 +15,9 @@
 //! inner one evaluates a rule's nodes at once (`inner_values`, compiled for AVX2 where the CPU
 //! has it), and its error estimates are carried through the outer integral into the stated error.
 
-use super::albedo::sin_from_cos;
 use super::gauss_kronrod::{KRONROD_NODES, Quadrature, integrate_pieces, integrate_pieces_batch};
 use crate::model::sheen::{ashikhmin_v, charlie_d, charlie_weight};
+use crate::model::vector::sin_from_cos;
 use crate::numerics::elementary::sin_cos_lane;
 use std::f64::consts::{FRAC_PI_2, PI};
 

@@ -22,13 +22,14 @@
 //!   quantities (the [`Point`]'s `eta` is the relative index itself, already inverted);
 //! - `F_avg`: Gauss-Kronrod to 1e-14 whatever the method (a 1-D integral).
 
-use super::albedo::{QmcSettings, albedo, average_albedo, weighted_albedo};
+use super::albedo::{albedo, average_albedo, weighted_albedo};
 use super::average_quadrature::average_albedo_to;
 use super::dielectric::{
     dielectric_albedo_with, dielectric_average_albedo_with, reference_dielectric_albedo_with,
     reference_dielectric_average_albedo_with,
 };
 use super::estimate::Estimate;
+use super::qmc::QmcSettings;
 use super::quantity::Quantity;
 use super::reference::{
     ReferenceSettings, ReferenceValue, reference_albedo, reference_weighted_albedo,

@@ -136,19 +136,19 @@ impl AnisotropyConvention {
 
     /// [`AnisotropyConvention::alphas`] after checking `a` against the convention's range
     /// (`[0, max_anisotropy]`).
-    pub fn checked_alphas(self, alpha: f64, a: f64) -> Result<(f64, f64), String> {
+    pub fn checked_alphas(self, alpha: f64, a: f64) -> crate::Result<(f64, f64)> {
         self.check_anisotropy(a)?;
         Ok(self.alphas(alpha, a))
     }
 
     /// Checks an anisotropy against the convention's range, `[0, max_anisotropy]`.
-    pub fn check_anisotropy(self, a: f64) -> Result<(), String> {
+    pub fn check_anisotropy(self, a: f64) -> crate::Result<()> {
         let max = self.max_anisotropy();
         if !(0.0..=max).contains(&a) {
-            return Err(format!(
+            return Err(crate::Error::InvalidInput(format!(
                 "anisotropy {a} is outside [0, {max}] for the {self} convention (swap the \
                  tangent and bitangent for the other direction)"
-            ));
+            )));
         }
         Ok(())
     }

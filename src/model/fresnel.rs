@@ -106,10 +106,12 @@ impl Fresnel {
     }
 
     /// Checks the parameters, naming the bad one and the allowed range.
-    pub fn validate(&self) -> Result<(), String> {
-        let finite = |what: &str, v: &[f64]| -> Result<(), String> {
+    pub fn validate(&self) -> crate::Result<()> {
+        let finite = |what: &str, v: &[f64]| -> crate::Result<()> {
             match v.iter().find(|x| !x.is_finite()) {
-                Some(x) => Err(format!("{what} must be finite (got {x})")),
+                Some(x) => Err(crate::Error::InvalidInput(format!(
+                    "{what} must be finite (got {x})"
+                ))),
                 None => Ok(()),
             }
         };
@@ -120,10 +122,10 @@ impl Fresnel {
                 finite("f90", &f90)?;
                 for (what, v) in [("f0", f0), ("f90", f90)] {
                     if let Some(x) = v.iter().find(|x| !(0.0..=1.0).contains(*x)) {
-                        return Err(format!(
+                        return Err(crate::Error::InvalidInput(format!(
                             "{what} must be in [0, 1] (got {})",
                             crate::error::shown(*x)
-                        ));
+                        )));
                     }
                 }
                 Ok(())
@@ -131,12 +133,12 @@ impl Fresnel {
             Fresnel::Dielectric { eta } => {
                 finite("ior", &[eta])?;
                 if !(1.0 / MAX_INDEX..=MAX_INDEX).contains(&eta) {
-                    return Err(format!(
+                    return Err(crate::Error::InvalidInput(format!(
                         "ior must be between 0.01 and 100 (got {}); it is n_inside / \
                          n_outside, e.g. 1.5 for glass in air, 1/1.5 for light leaving glass \
                          (real materials lie between 1/4 and 4)",
                         crate::error::shown(eta)
-                    ));
+                    )));
                 }
                 Ok(())
             }
@@ -147,17 +149,17 @@ impl Fresnel {
                     .iter()
                     .find(|x| !(1.0 / MAX_INDEX..=MAX_INDEX).contains(*x))
                 {
-                    return Err(format!(
+                    return Err(crate::Error::InvalidInput(format!(
                         "eta must be between 0.01 and 100 (got {}); metals lie between 0.03 \
                          and 5",
                         crate::error::shown(*x)
-                    ));
+                    )));
                 }
                 if let Some(x) = k.iter().find(|x| !(0.0..=MAX_INDEX).contains(*x)) {
-                    return Err(format!(
+                    return Err(crate::Error::InvalidInput(format!(
                         "k must be between 0 and 100 (got {}); metals lie below 12",
                         crate::error::shown(*x)
-                    ));
+                    )));
                 }
                 Ok(())
             }
@@ -425,6 +427,7 @@ mod tests {
             Fresnel::Dielectric { eta: 0.0 }
                 .validate()
                 .unwrap_err()
+                .to_string()
                 .contains("ior")
         );
         assert!(
@@ -434,6 +437,7 @@ mod tests {
             }
             .validate()
             .unwrap_err()
+            .to_string()
             .contains("eta")
         );
         assert!(
@@ -443,6 +447,7 @@ mod tests {
             }
             .validate()
             .unwrap_err()
+            .to_string()
             .contains("f0")
         );
         assert!(Fresnel::Dielectric { eta: 1.5 }.validate().is_ok());
@@ -546,13 +551,16 @@ mod tests {
         }
         let refused = |model: Fresnel, words: &str| {
             let message = model.validate().unwrap_err();
-            assert!(message.contains(words), "{message}: wanted {words}");
+            assert!(
+                message.to_string().contains(words),
+                "{message}: wanted {words}"
+            );
         };
         for good in [none, schlick, glass, metal] {
-            assert_eq!(good.validate(), Ok(()));
+            assert!(good.validate().is_ok());
         }
         for eta in [0.01, 100.0] {
-            assert_eq!(Fresnel::Dielectric { eta }.validate(), Ok(()));
+            assert!(Fresnel::Dielectric { eta }.validate().is_ok());
         }
         refused(Fresnel::Dielectric { eta: f64::NAN }, "ior must be finite");
         refused(
@@ -567,7 +575,7 @@ mod tests {
             f0: [0.5, f0, 0.5],
             f90: [1.0, 1.0, f90],
         };
-        assert_eq!(schlick_with(0.0, 1.0).validate(), Ok(()));
+        assert!(schlick_with(0.0, 1.0).validate().is_ok());
         refused(schlick_with(-0.1, 1.0), "f0 must be in [0, 1] (got -0.1)");
         refused(schlick_with(0.5, 1.1), "f90 must be in [0, 1] (got 1.1)");
         refused(
@@ -579,8 +587,8 @@ mod tests {
             eta: [1.0, eta, 1.0],
             k: [1.0, 1.0, k],
         };
-        assert_eq!(metal_with(100.0, 0.0).validate(), Ok(()));
-        assert_eq!(metal_with(0.01, 100.0).validate(), Ok(()));
+        assert!(metal_with(100.0, 0.0).validate().is_ok());
+        assert!(metal_with(0.01, 100.0).validate().is_ok());
         refused(metal_with(0.001, 1.0), "eta must be between 0.01 and 100");
         refused(metal_with(1.0, -0.5), "k must be between 0 and 100");
         refused(metal_with(1.0, 101.0), "k must be between 0 and 100");

@@ -4,7 +4,7 @@
 //! notes), `docs/physics.md` "Kulla-Conty quantities":
 //! `f_ms(o, i) = (1 - E(mu_o)) (1 - E(mu_i)) / (pi (1 - E_avg))`. Its albedo,
 //! `∫ f_ms mu_i dω_i = (1 - E(mu_o)) 2 ∫ (1 - E(mu_i)) mu_i dmu_i / (1 - E_avg)`, is exactly
-//! `1 - E(mu_o)`: the energy single scattering loses (`kiln verify --furnace` checks it on tables).
+//! `1 - E(mu_o)`: the energy single scattering loses (`kiln furnace` checks it on tables).
 //!
 //! Precision: pass `1 - E` and `1 - E_avg` as kiln stores them (estimated directly), never
 //! `1.0 - E`: at `alpha = 1e-3` (GGX), `1 - E_avg` is 7.4e-6, which `1.0 - E_avg` in f32 gets
@@ -22,7 +22,7 @@
 //! `E_avg` reaches +119 % at r = 1/31 (`1 - E_avg` 8.0e-6 against the lookup's 1.74e-5), an
 //! energy error of 0.128 at grazing views; with kiln's `f_ms_norm` table
 //! ([`crate::table::normalisation`], `normalisation_lookup`) the error stays below 4.1e-6 at
-//! every roughness and `mu` (`kiln verify --furnace tables/ggx-height-correlated-E.json`, 1402
+//! every roughness and `mu` (`kiln furnace tables/ggx-height-correlated-E.json`, 1402
 //! roughness values, quarter-texel and finer). So: `f_ms_norm` for the lobe's denominator, the
 //! `E_avg` table for the colour term [`fresnel_colour`] (where the physical average belongs)
 //! and for anything else that wants the true average.

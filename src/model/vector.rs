@@ -77,6 +77,12 @@ impl Mul<f64> for Vec3 {
     }
 }
 
+/// `sqrt(1 - mu^2)` computed as `sqrt((1 - mu)(1 + mu))`, accurate near `mu = 1`.
+#[must_use]
+pub fn sin_from_cos(mu: f64) -> f64 {
+    ((1.0 - mu) * (1.0 + mu)).max(0.0).sqrt()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -17,9 +17,9 @@ pub(super) type Decoded = (Vec<(Quantity, Vec<f64>)>, Option<Vec<f64>>);
 
 /// The values of an `n x n` plane moved between kiln's order (roughness rows, `mu` columns)
 /// and the engine's ([`super::layout::TexelOrder`]).
-struct Orders<'a> {
-    layout: &'a Layout,
-    n: usize,
+pub(super) struct Orders<'a> {
+    pub(super) layout: &'a Layout,
+    pub(super) n: usize,
 }
 
 impl Orders<'_> {
@@ -34,7 +34,7 @@ impl Orders<'_> {
         out
     }
 
-    fn kiln(&self, engine: &[f64]) -> Vec<f64> {
+    pub(super) fn kiln(&self, engine: &[f64]) -> Vec<f64> {
         let n = self.n;
         let mut out = vec![0.0; n * n];
         for r in 0..n {
@@ -113,15 +113,15 @@ pub(super) fn encode(
     match layout.container {
         Container::CycleTables(arrays) => Ok(main(cycle_tables(layout, arrays, tables, carried)?)),
         Container::Ktx2 => {
-            let mut texture =
-                Texture::of_values(&channel_tables(layout, tables)?).map_err(invalid)?;
+            let mut texture = Texture::of_values(&channel_tables(layout, tables)?)
+                .map_err(|e| invalid(e.to_string()))?;
             texture.channels = planes(layout, n, tables, extra)?;
             #[cfg(feature = "containers")]
             let scheme = crate::format::ktx2::Supercompression::Zstd;
             #[cfg(not(feature = "containers"))]
             let scheme = crate::format::ktx2::Supercompression::None;
             crate::format::ktx2::encode_with(&texture, Precision::F16, scheme)
-                .map_err(invalid)
+                .map_err(|e| invalid(e.to_string()))
                 .map(main)
         }
         #[cfg(not(feature = "containers"))]
@@ -130,11 +130,11 @@ pub(super) fn encode(
         )),
         #[cfg(feature = "containers")]
         Container::Dds => {
-            let mut texture =
-                Texture::of_values(&channel_tables(layout, tables)?).map_err(invalid)?;
+            let mut texture = Texture::of_values(&channel_tables(layout, tables)?)
+                .map_err(|e| invalid(e.to_string()))?;
             texture.channels = planes(layout, n, tables, extra)?;
             crate::format::dds::encode(&texture, Precision::F16)
-                .map_err(invalid)
+                .map_err(|e| invalid(e.to_string()))
                 .map(main)
         }
         Container::ExrPlanes => {
@@ -147,7 +147,7 @@ pub(super) fn encode(
             // The metadata is the E table's (the one every such engine holds).
             let described = table_of(tables, Quantity::E)?;
             crate::format::exr::encode_planes(described, &named, Precision::F16)
-                .map_err(invalid)
+                .map_err(|e| invalid(e.to_string()))
                 .map(main)
         }
         Container::ExrPerTable(files) => files
@@ -155,7 +155,7 @@ pub(super) fn encode(
             .map(|&(file, quantity)| {
                 let table = table_of(tables, quantity)?;
                 let bytes = crate::format::exr::encode_value_as(table, "Y", Precision::F16)
-                    .map_err(invalid)?;
+                    .map_err(|e| invalid(e.to_string()))?;
                 Ok((file.to_string(), bytes))
             })
             .collect(),
@@ -181,8 +181,8 @@ pub(super) fn encode(
                     quantity.symbol(),
                     safe(&table.command)
                 );
-                let bytes =
-                    crate::format::png::encode_grey8((n, n), &plane, &comment).map_err(invalid)?;
+                let bytes = crate::format::png::encode_grey8((n, n), &plane, &comment)
+                    .map_err(|e| invalid(e.to_string()))?;
                 Ok((file.to_string(), bytes))
             })
             .collect(),
@@ -222,278 +222,7 @@ pub(super) fn encode_normalisation(form: Normalisation, norm: &Table) -> Result<
             Ok(out.into_bytes())
         }
         // Values from 1e-7 to 1: stored in f32, as f16 would lose the small ones.
-        Normalisation::ExrF32(_) => crate::format::exr::encode_value_as(norm, "Y", Precision::F32)
-            .map_err(Error::InvalidInput),
-    }
-}
-
-/// Reads an engine's file of an `n x n` layout: its tables in kiln's order and its extra
-/// channel. `normalisation_size` is the length of the layout's `f_ms_norm` (0 without).
-/// `bad` makes the error for bytes that are not the engine's file.
-pub(super) fn decode(
-    layout: &Layout,
-    bytes: &[u8],
-    n: usize,
-    normalisation_size: usize,
-    bad: &dyn Fn(String) -> Error,
-) -> Result<Decoded> {
-    let orders = Orders { layout, n };
-    // The layout's channels from planes in the engine's order: the tables (each required) and
-    // the extra channel (kept if present).
-    let from_planes = |planes: &[Option<&[f64]>]| -> Result<Decoded> {
-        let mut tables = Vec::new();
-        let mut extra = None;
-        for (k, channel) in layout.channels.iter().enumerate() {
-            let plane = planes.get(k).copied().flatten();
-            match channel {
-                Channel::Table(q) => {
-                    let plane =
-                        plane.ok_or_else(|| bad(format!("no channel for {}", q.symbol())))?;
-                    tables.push((*q, orders.kiln(plane)));
-                }
-                // All zeros: not computed when the file was written (no material asked).
-                Channel::Extra => {
-                    extra = plane
-                        .filter(|p| p.iter().any(|&v| v != 0.0))
-                        .map(|p| orders.kiln(p));
-                }
-                Channel::Constant(_) => {}
-            }
-        }
-        Ok((tables, extra))
-    };
-    // Channel `c` of `stride` interleaved half floats per texel.
-    let half_plane = |bits: &[u16], stride: usize, c: usize| -> Vec<f64> {
-        (0..n * n)
-            .map(|k| f64::from(half::f16::from_bits(bits[stride * k + c]).to_f32()))
-            .collect()
-    };
-    // Interleaved half floats with every channel, or only the tables' (an RG16F Filament include
-    // from before the cloth channel, a Godot texture without it).
-    let from_half_bits = |bits: &[u16], strides: &[usize]| -> Result<Decoded> {
-        let stride = strides
-            .iter()
-            .copied()
-            .find(|&s| bits.len() == s * n * n)
-            .ok_or_else(|| {
-                let expected: Vec<String> =
-                    strides.iter().map(|s| (s * n * n).to_string()).collect();
-                bad(format!(
-                    "{} half floats (expected {} for {n} x {n} texels)",
-                    bits.len(),
-                    expected.join(" or ")
-                ))
-            })?;
-        let planes: Vec<Vec<f64>> = (0..stride).map(|c| half_plane(bits, stride, c)).collect();
-        let planes: Vec<Option<&[f64]>> = planes.iter().map(|p| Some(p.as_slice())).collect();
-        from_planes(&planes)
-    };
-    let table_channels = layout
-        .channels
-        .iter()
-        .filter(|c| matches!(c, Channel::Table(_)))
-        .count();
-    match layout.container {
-        Container::CycleTables(arrays) => {
-            let text = String::from_utf8_lossy(bytes);
-            if let Some(Normalisation::CycleTable(_)) = layout.normalisation
-                && let Some(norm) = c_array(&text, "table_ggx_f_ms_norm")
-            {
-                if norm.len() != normalisation_size {
-                    return Err(bad(format!(
-                        "table_ggx_f_ms_norm has {} values (expected {normalisation_size})",
-                        norm.len()
-                    )));
-                }
-                return Ok((vec![(Quantity::FMsNorm, norm)], None));
-            }
-            // Each array read once; every required one must be there before any size is
-            // checked (a file from before Cycles' glass tables, or without them, is read
-            // without them).
-            let found: Vec<(&str, Quantity, Option<Vec<f64>>)> = arrays
-                .iter()
-                .map(|&(name, quantity)| (name, quantity, c_array(&text, name)))
-                .collect();
-            if let Some((name, _, _)) = found
-                .iter()
-                .find(|(_, q, values)| !q.has_ior() && values.is_none())
-            {
-                return Err(bad(format!("no {name}")));
-            }
-            let mut tables = Vec::new();
-            for (name, quantity, values) in found {
-                let Some(values) = values else { continue };
-                let glass = quantity.has_ior().then_some(layout.glass).flatten();
-                let (side, slices) = match glass {
-                    Some(g) => (g.size, g.size),
-                    None => (n, 1),
-                };
-                let expected = slices * if quantity.has_mu() { side * side } else { side };
-                if values.len() != expected {
-                    return Err(bad(format!(
-                        "{name} has {} values (expected {expected})",
-                        values.len()
-                    )));
-                }
-                let values = if quantity.has_mu() {
-                    let orders = Orders { layout, n: side };
-                    values
-                        .chunks(side * side)
-                        .flat_map(|slice| orders.kiln(slice))
-                        .collect()
-                } else {
-                    values
-                };
-                tables.push((quantity, values));
-            }
-            Ok((tables, None))
-        }
-        #[cfg(not(feature = "containers"))]
-        Container::Ktx2 => Err(bad(
-            "reading KTX2 needs kiln's `containers` feature".to_string()
-        )),
-        #[cfg(feature = "containers")]
-        Container::Ktx2 => {
-            let texture = crate::format::ktx2::decode(bytes).map_err(bad)?;
-            let channels = layout.channels.len();
-            if texture.channels.len() != channels
-                || texture.precision != Precision::F16
-                || texture.extent != (n, n, 1)
-            {
-                return Err(bad(format!(
-                    "expected {n} x {n} with {channels} f16 channels, found {} x {} x {} with {} \
-                     {} channels",
-                    texture.extent.0,
-                    texture.extent.1,
-                    texture.extent.2,
-                    texture.channels.len(),
-                    texture.precision.name()
-                )));
-            }
-            let planes: Vec<Option<&[f64]>> = texture
-                .channels
-                .iter()
-                .map(|v| Some(v.as_slice()))
-                .collect();
-            from_planes(&planes)
-        }
-        #[cfg(not(feature = "containers"))]
-        Container::Dds => Err(bad(
-            "reading DDS needs kiln's `containers` feature".to_string()
-        )),
-        #[cfg(feature = "containers")]
-        Container::Dds => {
-            let dds =
-                ddsfile::Dds::read(bytes).map_err(|e| bad(format!("not a DDS file ({e})")))?;
-            let format = dds.get_dxgi_format();
-            let stride = match format {
-                Some(ddsfile::DxgiFormat::R16G16B16A16_Float) => 4,
-                Some(ddsfile::DxgiFormat::R16G16_Float) => 2,
-                _ => 0,
-            };
-            if !(stride == layout.channels.len() || stride == table_channels)
-                || (dds.get_width(), dds.get_height()) != (n as u32, n as u32)
-                || dds.data.len() < 2 * stride * n * n
-            {
-                return Err(bad(format!(
-                    "expected {n} x {n} with {} f16 channels, found {} x {} {format:?}",
-                    layout.channels.len(),
-                    dds.get_width(),
-                    dds.get_height()
-                )));
-            }
-            let bits = little_endian(&dds.data[..2 * stride * n * n]);
-            from_half_bits(&bits, &[stride])
-        }
-        Container::ExrPlanes => {
-            let image = crate::format::exr::decode(bytes)
-                .map_err(|e| bad(format!("not an EXR file ({e})")))?;
-            if (image.width, image.height) != (n, n) {
-                return Err(bad(format!(
-                    "{} x {} (expected {n} x {n})",
-                    image.width, image.height
-                )));
-            }
-            let plane = |name: &str| {
-                image
-                    .channels
-                    .iter()
-                    .find(|(c, _)| c == name)
-                    .map(|(_, values)| values.as_slice())
-            };
-            let planes: Vec<Option<&[f64]>> = ["R", "G", "B", "A"]
-                .iter()
-                .take(layout.channels.len())
-                .map(|name| plane(name))
-                .collect();
-            from_planes(&planes)
-        }
-        Container::ExrPerTable(files) => {
-            let image = crate::format::exr::decode(bytes).map_err(bad)?;
-            let (_, values) = image
-                .channels
-                .iter()
-                .find(|(name, _)| name == "Y")
-                .ok_or_else(|| bad("no channel Y".into()))?;
-            let size = (image.width, image.height);
-            for &(_, quantity) in files {
-                match (quantity.has_mu(), size) {
-                    (true, s) if s == (n, n) => {
-                        return Ok((vec![(quantity, orders.kiln(values))], None));
-                    }
-                    (false, s) if s == (n, 1) => {
-                        return Ok((vec![(quantity, values.clone())], None));
-                    }
-                    _ => {}
-                }
-            }
-            if let Some(Normalisation::ExrF32(_)) = layout.normalisation
-                && size == (normalisation_size, 1)
-            {
-                return Ok((vec![(Quantity::FMsNorm, values.clone())], None));
-            }
-            let mut expected: Vec<String> = files
-                .iter()
-                .map(|&(file, q)| {
-                    let (w, h) = if q.has_mu() { (n, n) } else { (n, 1) };
-                    format!("{file}, {w} x {h}")
-                })
-                .collect();
-            if let Some(form) = layout.normalisation {
-                expected.push(format!("{}, {normalisation_size} x 1", form.file()));
-            }
-            Err(bad(format!(
-                "{} x {} (expected {})",
-                size.0,
-                size.1,
-                expected.join(", or ")
-            )))
-        }
-        Container::Png8(files) => {
-            let plane = crate::format::png::decode_grey(bytes, (n, n)).map_err(bad)?;
-            // A file whose rows are each one value is the 1-D table's; otherwise the 2-D one's.
-            let rows_are_constant = plane
-                .chunks_exact(n)
-                .all(|row| row.iter().all(|&v| v == row[0]));
-            let one_d = files.iter().find(|(_, q)| !q.has_mu());
-            let two_d = files.iter().find(|(_, q)| q.has_mu());
-            match (rows_are_constant, one_d, two_d) {
-                (true, Some(&(_, quantity)), _) => {
-                    let values = (0..n).map(|r| plane[layout.order.index(r, 0, n)]).collect();
-                    Ok((vec![(quantity, values)], None))
-                }
-                (_, _, Some(&(_, quantity))) => Ok((vec![(quantity, orders.kiln(&plane))], None)),
-                _ => Err(bad("no table of this layout fits the image".to_string())),
-            }
-        }
-        Container::ThreeModule => {
-            let bits = three_data(bytes).map_err(bad)?;
-            from_half_bits(&bits, &[layout.channels.len()])
-        }
-        Container::HalfBitsInclude => {
-            let bits = include_half_bits(bytes).map_err(bad)?;
-            from_half_bits(&bits, &[layout.channels.len(), table_channels])
-        }
+        Normalisation::ExrF32(_) => crate::format::exr::encode_value_as(norm, "Y", Precision::F32),
     }
 }
 
@@ -725,7 +454,7 @@ fn cycle_tables(
 
 /// Little-endian 16-bit words (a container's half floats).
 #[cfg(feature = "containers")]
-fn little_endian(data: &[u8]) -> Vec<u16> {
+pub(super) fn little_endian(data: &[u8]) -> Vec<u16> {
     data.chunks_exact(2)
         .map(|b| u16::from_le_bytes([b[0], b[1]]))
         .collect()
@@ -733,7 +462,7 @@ fn little_endian(data: &[u8]) -> Vec<u16> {
 
 /// The numbers of the C float array `name` (`name[...] = { ... }`), `f` suffixes allowed, read
 /// as f32 (what the C compiler stores) and widened.
-fn c_array(text: &str, name: &str) -> Option<Vec<f64>> {
+pub(super) fn c_array(text: &str, name: &str) -> Option<Vec<f64>> {
     let (_, body) = c_declaration(text, name)?;
     body.split(',')
         .map(str::trim)
@@ -791,7 +520,7 @@ fn filament_include(
 
 /// Every `0x` number outside `//` comments of a Filament include: RGB (or, from cmgen before
 /// the cloth channel, RG) half-float bits per texel.
-fn include_half_bits(bytes: &[u8]) -> std::result::Result<Vec<u16>, String> {
+pub(super) fn include_half_bits(bytes: &[u8]) -> crate::Result<Vec<u16>> {
     let text = String::from_utf8_lossy(bytes);
     text.lines()
         .map(|line| line.split("//").next().unwrap_or(""))
@@ -805,7 +534,7 @@ fn include_half_bits(bytes: &[u8]) -> std::result::Result<Vec<u16>, String> {
                 .next()
                 .unwrap_or("")
         })
-        .map(|s| u16::from_str_radix(s, 16).map_err(|e| format!("'0x{s}': {e}")))
+        .map(|s| u16::from_str_radix(s, 16).map_err(|e| Error::Malformed(format!("'0x{s}': {e}"))))
         .collect()
 }
 
@@ -858,23 +587,28 @@ fn three_module(n: usize, planes: &[(String, Vec<f64>)], command: &str) -> Strin
 }
 
 /// The half-float bits of the `Uint16Array` in a three.js `DFGLUTData.js`, in file order.
-pub(super) fn three_data(bytes: &[u8]) -> std::result::Result<Vec<u16>, String> {
+pub(super) fn three_data(bytes: &[u8]) -> crate::Result<Vec<u16>> {
     let text = String::from_utf8_lossy(bytes);
-    let start = text.find("Uint16Array").ok_or("no Uint16Array")?;
+    let start = text
+        .find("Uint16Array")
+        .ok_or_else(|| crate::Error::Malformed("no Uint16Array".into()))?;
     let body = &text[start..];
-    let open = body.find('[').ok_or("no [ after Uint16Array")?;
+    let open = body
+        .find('[')
+        .ok_or_else(|| crate::Error::Malformed("no [ after Uint16Array".into()))?;
     // The first ] after the [ (one before it is not this array's).
     let close = body[open..]
         .find(']')
         .map(|c| open + c)
-        .ok_or("no ] after the [")?;
+        .ok_or_else(|| crate::Error::Malformed("no ] after the [".into()))?;
     body[open + 1..close]
         .split(',')
         .map(str::trim)
         .filter(|s| !s.is_empty())
         .map(|s| {
             let digits = s.trim_start_matches("0x").trim_start_matches("0X");
-            u16::from_str_radix(digits, 16).map_err(|e| format!("{}: {e}", crate::error::quoted(s)))
+            u16::from_str_radix(digits, 16)
+                .map_err(|e| crate::Error::Malformed(format!("{}: {e}", crate::error::quoted(s))))
         })
         .collect()
 }

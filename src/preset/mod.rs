@@ -50,6 +50,7 @@
 //!   `F0 E + (F90 - F0) E_Fc`), B = 0, A = 1, as a half-float EXR to import in its place.
 
 mod container;
+mod decode;
 pub mod layout;
 
 pub use container::Carried;
@@ -452,7 +453,9 @@ impl Preset {
             return Ok(layout.size);
         }
         let bad = |m: String| self.not_its_file(m);
-        let halves = container::three_data(bytes).map_err(bad)?.len();
+        let halves = container::three_data(bytes)
+            .map_err(|e| bad(e.to_string()))?
+            .len();
         let stride = layout.channels.len();
         let n = (1..=container::MAX_THREE_SIZE)
             .find(|&n| stride * n * n == halves)
@@ -479,7 +482,7 @@ impl Preset {
     /// [`Preset::decode`] and [`Preset::decode_extra`] in one reading.
     fn decode_all(self, bytes: &[u8]) -> Result<container::Decoded> {
         let n = self.size_in(bytes)?;
-        container::decode(self.layout(), bytes, n, self.normalisation_size(), &|m| {
+        decode::decode(self.layout(), bytes, n, self.normalisation_size(), &|m| {
             self.not_its_file(m)
         })
     }

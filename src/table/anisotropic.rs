@@ -5,7 +5,7 @@
 //!
 //! An anisotropic lobe's albedo depends on the view's azimuth `phi` (from the tangent) as well
 //! as on `mu`: at `alpha = (0.9, 0.1)` by up to 0.25 near grazing
-//! (`kiln verify --anisotropy-convention`), far beyond what one roughness can follow. Its
+//! (`kiln verify-anisotropy`), far beyond what one roughness can follow. Its
 //! Fourier series in `phi` decays slowly there (`c_2 = 0.054`, `c_4 = -0.033`, `c_6 = 0.022` at
 //! `mu = 0.02`), so the table samples the azimuth itself.
 //!
@@ -73,7 +73,7 @@ impl AnisotropicSizes {
     }
 
     /// Every axis 2 to 256 samples.
-    pub fn check(&self) -> Result<(), String> {
+    pub fn check(&self) -> crate::Result<()> {
         for (axis, n) in [
             ("mu", self.mu),
             ("azimuth", self.azimuth),
@@ -81,7 +81,9 @@ impl AnisotropicSizes {
             ("anisotropy", self.anisotropy),
         ] {
             if !(2..=256).contains(&n) {
-                return Err(format!("the {axis} axis has {n} samples; give 2 to 256"));
+                return Err(crate::Error::InvalidInput(format!(
+                    "the {axis} axis has {n} samples; give 2 to 256"
+                )));
             }
         }
         Ok(())
@@ -185,7 +187,7 @@ impl AnisotropicTable {
         sizes: AnisotropicSizes,
         tolerance: f64,
         progress: &(dyn Fn(u64) + Sync),
-    ) -> Result<Self, String> {
+    ) -> crate::Result<Self> {
         sizes.check()?;
         convention.check_anisotropy(max_anisotropy)?;
         check_tolerance(tolerance)?;
@@ -322,14 +324,14 @@ impl AnisotropicTable {
     ///
     /// # Errors
     /// A sentence naming what does not fit.
-    pub fn check(&self) -> Result<(), String> {
+    pub fn check(&self) -> crate::Result<()> {
         self.sizes.check()?;
         self.convention.check_anisotropy(self.max_anisotropy)?;
         if !(self.max_error >= 0.0 && self.max_error.is_finite()) {
-            return Err(format!(
+            return Err(crate::Error::Malformed(format!(
                 "max_error {} is not a finite number >= 0",
                 self.max_error
-            ));
+            )));
         }
         let n = self.sizes.len();
         let rows = self.sizes.roughness * self.sizes.anisotropy;
@@ -338,10 +340,16 @@ impl AnisotropicTable {
             ("average", &self.average, rows),
         ] {
             if values.len() != len {
-                return Err(format!("{what} holds {} numbers for {len}", values.len()));
+                return Err(crate::Error::Malformed(format!(
+                    "{what} holds {} numbers for {len}",
+                    values.len()
+                )));
             }
             if let Some(k) = values.iter().position(|v| !(0.0..=1.0).contains(v)) {
-                return Err(format!("{what} at {k} is {}, outside [0, 1]", values[k]));
+                return Err(crate::Error::Malformed(format!(
+                    "{what} at {k} is {}, outside [0, 1]",
+                    values[k]
+                )));
             }
         }
         Ok(())
@@ -349,11 +357,13 @@ impl AnisotropicTable {
 }
 
 /// Checks a bake's reference tolerance: in `[1e-10, 1e-2]`.
-pub fn check_tolerance(tolerance: f64) -> Result<(), String> {
+pub fn check_tolerance(tolerance: f64) -> crate::Result<()> {
     if (1e-10..=1e-2).contains(&tolerance) {
         Ok(())
     } else {
-        Err(format!("tolerance {tolerance:e} is outside [1e-10, 1e-2]"))
+        Err(crate::Error::InvalidInput(format!(
+            "tolerance {tolerance:e} is outside [1e-10, 1e-2]"
+        )))
     }
 }
 

@@ -19,18 +19,24 @@ impl TableSpec {
     ///
     /// # Errors
     /// A sentence naming what does not fit.
-    pub fn check(&self) -> Result<(), String> {
+    pub fn check(&self) -> crate::Result<()> {
         let q = self.quantity;
         let slot = |name: &str, axis: Option<Axis>, wanted: bool, right: fn(&Axis) -> bool| match (
             axis, wanted,
         ) {
             (Some(a), true) if right(&a) => Ok(()),
-            (Some(a), true) => Err(format!(
+            (Some(a), true) => Err(crate::Error::Malformed(format!(
                 "its {name} axis is a {} axis (axes swapped?)",
                 a.name()
-            )),
-            (None, true) => Err(format!("{} needs a {name} axis", q.symbol())),
-            (Some(_), false) => Err(format!("{} has no {name} axis", q.symbol())),
+            ))),
+            (None, true) => Err(crate::Error::Malformed(format!(
+                "{} needs a {name} axis",
+                q.symbol()
+            ))),
+            (Some(_), false) => Err(crate::Error::Malformed(format!(
+                "{} has no {name} axis",
+                q.symbol()
+            ))),
             (None, false) => Ok(()),
         };
         slot("eta", self.ior, q.has_ior(), |a| {
@@ -44,25 +50,28 @@ impl TableSpec {
         for axis in self.axes() {
             let size = axis.size();
             if size == 0 || size > super::MAX_TEXELS {
-                return Err(format!("its {} axis has {size} samples", axis.name()));
+                return Err(crate::Error::Malformed(format!(
+                    "its {} axis has {size} samples",
+                    axis.name()
+                )));
             }
             if let Axis::Ior { max, .. } = axis
                 && !(max.0.is_finite() && max.0 > 1.0 && max.0 <= crate::model::fresnel::MAX_INDEX)
             {
-                return Err(format!(
+                return Err(crate::Error::Malformed(format!(
                     "its eta axis ends at {}, outside (1, {}]",
                     max.0,
                     crate::model::fresnel::MAX_INDEX
-                ));
+                )));
             }
             texels = texels.saturating_mul(size);
         }
         if texels > super::MAX_TEXELS {
-            return Err(format!(
+            return Err(crate::Error::Malformed(format!(
                 "shape {:?}: {texels} texels, more than the {} kiln reads",
                 self.shape(),
                 super::MAX_TEXELS
-            ));
+            )));
         }
         // kiln's glass layout: its mu coordinate needs the IOR, its IOR coordinate the roughness.
         let glass_mu =
@@ -70,15 +79,15 @@ impl TableSpec {
         let glass_ior =
             matches!(self.ior, Some(Axis::Ior { mapping, .. }) if mapping.depends_on_roughness());
         if glass_mu && !glass_ior {
-            return Err(
+            return Err(crate::Error::Malformed(
                 "its mu axis is in kiln's glass layout, which needs a glass IOR axis".into(),
-            );
+            ));
         }
         if glass_ior && self.roughness.is_none() {
-            return Err(format!(
+            return Err(crate::Error::Malformed(format!(
                 "its eta axis is in kiln's glass layout, which needs a roughness axis ({} has none)",
                 q.symbol()
-            ));
+            )));
         }
         let balanced_rows = matches!(
             self.roughness,
@@ -88,56 +97,64 @@ impl TableSpec {
             })
         );
         if balanced_rows && self.ior.is_some() {
-            return Err(format!(
+            return Err(crate::Error::Malformed(format!(
                 "its roughness axis has the balanced spacing, which kiln lays out for the tables \
                  over roughness and mu only ({} has an eta axis)",
                 q.symbol()
-            ));
+            )));
         }
         if !self.transmission.is_default() && (!q.has_ior() || q == Quantity::FAvg) {
-            return Err(format!(
+            return Err(crate::Error::Malformed(format!(
                 "a transmission convention belongs to the dielectric tables, not {}",
                 q.symbol()
-            ));
+            )));
         }
         if (q == Quantity::EF) != self.fresnel.is_some() {
-            return Err("a Fresnel model belongs to E_F tables, and only to them".into());
+            return Err(crate::Error::Malformed(
+                "a Fresnel model belongs to E_F tables, and only to them".into(),
+            ));
         }
         match (&self.lookup_of, q) {
             (Some(e), Quantity::FMsNorm) => {
                 if e.quantity != Quantity::E {
-                    return Err(format!(
+                    return Err(crate::Error::Malformed(format!(
                         "f_ms_norm is derived from an E table, not {}",
                         e.quantity.symbol()
-                    ));
+                    )));
                 }
-                e.check().map_err(|m| format!("its E table: {m}"))?;
+                e.check()
+                    .map_err(|m| crate::Error::Malformed(format!("its E table: {m}")))?;
                 // kiln's layout of the normalisation of that E table, or the one of files
                 // older than the refined start (the same without it).
                 let kiln = super::normalisation::refined_start_for(e);
                 if self.refined_start.is_some() && self.refined_start != kiln {
-                    return Err(format!(
+                    return Err(crate::Error::Malformed(format!(
                         "f_ms_norm's refined_start {:?} is not kiln's for its E table ({kiln:?})",
                         self.refined_start
-                    ));
+                    )));
                 }
                 let size = super::normalisation::size_of(e, self.refined_start);
                 let got = self.roughness.map_or(0, |axis| axis.size());
                 if got != size {
-                    return Err(format!(
+                    return Err(crate::Error::Malformed(format!(
                         "f_ms_norm of a {}-row E table has {size} entries with this layout, not \
                          {got}",
                         e.roughness_axis().size()
-                    ));
+                    )));
                 }
                 Ok(())
             }
-            (None, Quantity::FMsNorm) => Err("f_ms_norm needs lookup_of, its E table".into()),
-            (Some(_), _) => Err(format!("{} is not derived from another table", q.symbol())),
-            (None, _) if self.refined_start.is_some() => Err(format!(
+            (None, Quantity::FMsNorm) => Err(crate::Error::Malformed(
+                "f_ms_norm needs lookup_of, its E table".into(),
+            )),
+            (Some(_), _) => Err(crate::Error::Malformed(format!(
+                "{} is not derived from another table",
+                q.symbol()
+            ))),
+            (None, _) if self.refined_start.is_some() => Err(crate::Error::Malformed(format!(
                 "{} has no refined start (f_ms_norm only)",
                 q.symbol()
-            )),
+            ))),
             (None, _) => Ok(()),
         }
     }
@@ -222,7 +239,7 @@ impl Table {
     ///
     /// # Errors
     /// As above.
-    pub fn check(&self) -> Result<(), String> {
+    pub fn check(&self) -> crate::Result<()> {
         self.spec.check()?;
         let n = self.spec.len();
         let symbol = self.spec.quantity.symbol();
@@ -232,41 +249,41 @@ impl Table {
             ("std_error".to_string(), &self.std_error),
         ] {
             if channel.len() != n {
-                return Err(format!(
+                return Err(crate::Error::Malformed(format!(
                     "{name} has {} values for shape {:?} ({n} texels)",
                     channel.len(),
                     self.spec.shape()
-                ));
+                )));
             }
         }
         let range = -RANGE_TOLERANCE..=1.0 + RANGE_TOLERANCE;
         for k in 0..n {
             let (v, w, e) = (self.value[k], self.one_minus_value[k], self.std_error[k]);
             if !range.contains(&v) {
-                return Err(format!(
+                return Err(crate::Error::Malformed(format!(
                     "{symbol} at texel {k} is {}, outside [0, 1]",
                     crate::error::shown(v)
-                ));
+                )));
             }
             if !range.contains(&w) {
-                return Err(format!(
+                return Err(crate::Error::Malformed(format!(
                     "one_minus_{symbol} at texel {k} is {}, outside [0, 1]",
                     crate::error::shown(w)
-                ));
+                )));
             }
             if (v + w - 1.0).abs() > 2.0 * RANGE_TOLERANCE {
-                return Err(format!(
+                return Err(crate::Error::Malformed(format!(
                     "at texel {k}, {symbol} = {} and one_minus_{symbol} = {} do not add up \
                      to 1",
                     crate::error::shown(v),
                     crate::error::shown(w)
-                ));
+                )));
             }
             if !(e.is_finite() && e >= 0.0) {
-                return Err(format!(
+                return Err(crate::Error::Malformed(format!(
                     "std_error at texel {k} is {}",
                     crate::error::shown(e)
-                ));
+                )));
             }
         }
         Ok(())
@@ -308,7 +325,10 @@ mod tests {
 
     fn refused(spec: &TableSpec, words: &str) {
         match spec.check() {
-            Err(message) => assert!(message.contains(words), "{message}: wanted {words:?}"),
+            Err(message) => assert!(
+                message.to_string().contains(words),
+                "{message}: wanted {words:?}"
+            ),
             Ok(()) => panic!("accepted, wanted {words:?}: {spec:?}"),
         }
     }
@@ -340,7 +360,7 @@ mod tests {
             ior: Some(ior(3.0)),
             ..e_spec()
         };
-        assert_eq!(dielectric.check(), Ok(()));
+        assert!(dielectric.check().is_ok());
         refused(
             &TableSpec {
                 mu: Some(glass_mu),
@@ -353,7 +373,7 @@ mod tests {
             mu: Some(glass_mu),
             ..dielectric
         };
-        assert_eq!(glass.check(), Ok(()));
+        assert!(glass.check().is_ok());
         let f_avg = TableSpec {
             quantity: Quantity::FAvg,
             ior: Some(glass_ior),
@@ -367,7 +387,7 @@ mod tests {
     /// Each axis in its place, of a size kiln reads; each rule both ways.
     #[test]
     fn a_spec_needs_its_quantitys_axes_in_their_places() {
-        assert_eq!(e_spec().check(), Ok(()));
+        assert!(e_spec().check().is_ok());
         let swapped = TableSpec {
             roughness: Some(MU),
             mu: Some(ROUGHNESS),
@@ -386,7 +406,7 @@ mod tests {
             ..e_spec()
         };
         refused(&e_avg, "E_avg has no mu axis");
-        assert_eq!(TableSpec { mu: None, ..e_avg }.check(), Ok(()));
+        assert!(TableSpec { mu: None, ..e_avg }.check().is_ok());
         refused(
             &TableSpec {
                 ior: Some(ior(3.0)),
@@ -423,7 +443,7 @@ mod tests {
             mu: Some(long(super::super::MAX_TEXELS)),
             ..e_spec()
         };
-        assert_eq!(widest.check(), Ok(()));
+        assert!(widest.check().is_ok());
         refused(
             &TableSpec {
                 mu: Some(long(super::super::MAX_TEXELS + 1)),
@@ -442,7 +462,7 @@ mod tests {
             ..e_spec()
         };
         for max in [1.0001, 3.0, crate::model::fresnel::MAX_INDEX] {
-            assert_eq!(glass(max).check(), Ok(()), "{max}");
+            assert!(glass(max).check().is_ok(), "{max}");
         }
         for max in [1.0, 0.5, 100.5, f64::NAN, f64::INFINITY] {
             refused(&glass(max), "its eta axis ends at");
@@ -467,7 +487,7 @@ mod tests {
             transmission: cycles,
             ..e_spec()
         };
-        assert_eq!(glass.check(), Ok(()));
+        assert!(glass.check().is_ok());
         refused(
             &TableSpec {
                 transmission: cycles,
@@ -495,13 +515,13 @@ mod tests {
             ..e_spec()
         };
         refused(&e_f, "a Fresnel model belongs to E_F tables");
-        assert_eq!(
+        assert!(
             TableSpec {
                 fresnel: schlick,
                 ..e_f
             }
-            .check(),
-            Ok(())
+            .check()
+            .is_ok()
         );
         let norm = TableSpec {
             quantity: Quantity::FMsNorm,
@@ -519,7 +539,7 @@ mod tests {
                 ..norm.clone()
             }
         };
-        assert_eq!(of(e_spec()).check(), Ok(()));
+        assert!(of(e_spec()).check().is_ok());
         // Its size follows its E table and refined start; older files have none.
         let resized = |size: usize, refined_start| {
             let mut spec = of(e_spec());
@@ -533,13 +553,13 @@ mod tests {
         };
         let kiln = of(e_spec());
         let rows = e_spec().roughness_axis().size();
-        assert_eq!(
+        assert!(
             resized(
                 (rows - 1) * crate::table::normalisation::SUBDIVISIONS + 1,
                 None
             )
-            .check(),
-            Ok(())
+            .check()
+            .is_ok()
         );
         refused(
             &resized(kiln.roughness_axis().size() + 1, kiln.refined_start),
@@ -606,13 +626,16 @@ mod tests {
     /// one-minus value adding up to 1, errors finite and not negative.
     #[test]
     fn a_tables_channels_hold_what_its_spec_promises() {
-        assert_eq!(table(0.5, 1e-6).check(), Ok(()));
-        assert_eq!(table(1.0 + 0.9e-3, 0.0).check(), Ok(()));
-        assert_eq!(table(-0.9e-3, 0.0).check(), Ok(()));
+        assert!(table(0.5, 1e-6).check().is_ok());
+        assert!(table(1.0 + 0.9e-3, 0.0).check().is_ok());
+        assert!(table(-0.9e-3, 0.0).check().is_ok());
         let mut t = table(0.5, 0.0);
         t.value.pop();
         match t.check() {
-            Err(m) => assert_eq!(m, "E has 11 values for shape [4, 3] (12 texels)"),
+            Err(m) => assert_eq!(
+                m.to_string(),
+                "E has 11 values for shape [4, 3] (12 texels)"
+            ),
             Ok(()) => panic!("a short channel passed"),
         }
         let mut t = table(0.5, 0.0);
@@ -620,32 +643,43 @@ mod tests {
         assert!(
             t.check()
                 .unwrap_err()
+                .to_string()
                 .starts_with("std_error has 13 values")
         );
         let mut t = table(0.5, 0.0);
         t.value[7] = 1.0 + 1.1e-3;
         assert_eq!(
-            t.check(),
-            Err("E at texel 7 is 1.0011, outside [0, 1]".into())
+            t.check().unwrap_err().to_string(),
+            "E at texel 7 is 1.0011, outside [0, 1]"
         );
         let mut t = table(0.5, 0.0);
         t.one_minus_value[2] = -1.1e-3;
         assert_eq!(
-            t.check(),
-            Err("one_minus_E at texel 2 is -0.0011, outside [0, 1]".into())
+            t.check().unwrap_err().to_string(),
+            "one_minus_E at texel 2 is -0.0011, outside [0, 1]"
         );
         let mut t = table(0.5, 0.0);
         t.value[4] = f64::NAN;
-        assert!(t.check().unwrap_err().starts_with("E at texel 4 is NaN"));
+        assert!(
+            t.check()
+                .unwrap_err()
+                .to_string()
+                .starts_with("E at texel 4 is NaN")
+        );
         // Each in range, not adding up to 1 (0.4 + 0.6 = 1; 0.4 + 0.5 = 0.9).
         let mut t = table(0.5, 0.0);
         t.value[3] = 0.4;
-        assert!(t.check().unwrap_err().contains("at texel 3, E = 0.4"));
+        assert!(
+            t.check()
+                .unwrap_err()
+                .to_string()
+                .contains("at texel 3, E = 0.4")
+        );
         // A difference from 1 of 1.9e-3, within twice the tolerance, passes.
         let mut t = table(0.5, 0.0);
         t.value[3] = 0.5 + 0.95e-3;
         t.one_minus_value[3] = 0.5 + 0.95e-3;
-        assert_eq!(t.check(), Ok(()));
+        assert!(t.check().is_ok());
         // Shown as a message shows numbers: -1e-300, not 300 digits (issue 64).
         for (bad, shown) in [
             (f64::NAN, "NaN"),
@@ -654,7 +688,10 @@ mod tests {
         ] {
             let mut t = table(0.5, 0.0);
             t.std_error[11] = bad;
-            assert_eq!(t.check(), Err(format!("std_error at texel 11 is {shown}")));
+            assert_eq!(
+                t.check().unwrap_err().to_string(),
+                format!("std_error at texel 11 is {shown}")
+            );
         }
     }
 }

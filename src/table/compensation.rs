@@ -175,31 +175,39 @@ impl CompensationTable {
     ///
     /// # Errors
     /// A sentence naming what does not fit.
-    pub fn check(&self) -> Result<(), String> {
+    pub fn check(&self) -> crate::Result<()> {
         use crate::integrate::quantity::Quantity;
-        self.spec.check().map_err(|e| format!("spec: {e}"))?;
+        self.spec
+            .check()
+            .map_err(|e| crate::Error::Malformed(format!("spec: {e}")))?;
         self.average_spec
             .check()
-            .map_err(|e| format!("average_spec: {e}"))?;
+            .map_err(|e| crate::Error::Malformed(format!("average_spec: {e}")))?;
         if self.spec.quantity != Quantity::E || self.spec.ior.is_some() {
-            return Err("spec is not an E layout over (roughness, mu)".into());
+            return Err(crate::Error::Malformed(
+                "spec is not an E layout over (roughness, mu)".into(),
+            ));
         }
         if self.average_spec.quantity != Quantity::EAvg || self.average_spec.ior.is_some() {
-            return Err("average_spec is not an E_avg layout over roughness".into());
+            return Err(crate::Error::Malformed(
+                "average_spec is not an E_avg layout over roughness".into(),
+            ));
         }
         if self.average_spec.roughness != self.spec.roughness
             || self.average_spec.model != self.spec.model
         {
-            return Err("the averages' layout is not over the table's roughness axis".into());
+            return Err(crate::Error::Malformed(
+                "the averages' layout is not over the table's roughness axis".into(),
+            ));
         }
         let lengths = |what: &str, channels: &[Vec<f64>], n: usize| match channels
             .iter()
             .position(|c| c.len() != n)
         {
-            Some(j) => Err(format!(
+            Some(j) => Err(crate::Error::Malformed(format!(
                 "{what} {j} holds {} numbers for {n} texels",
                 channels[j].len()
-            )),
+            ))),
             None => Ok(()),
         };
         lengths("coefficient", &self.coefficients, self.spec.len())?;
@@ -216,7 +224,9 @@ impl CompensationTable {
         let finite = |what: &str, channels: &[Vec<f64>]| {
             for (j, channel) in channels.iter().enumerate() {
                 if let Some(k) = channel.iter().position(|v| !v.is_finite()) {
-                    return Err(format!("{what} {j} at texel {k} is not a finite number"));
+                    return Err(crate::Error::Malformed(format!(
+                        "{what} {j} at texel {k} is not a finite number"
+                    )));
                 }
             }
             Ok(())
@@ -228,9 +238,9 @@ impl CompensationTable {
             .iter()
             .position(|e| !(*e >= 0.0 && e.is_finite()))
         {
-            return Err(format!(
+            return Err(crate::Error::Malformed(format!(
                 "std_error at texel {k} is not a finite number >= 0"
-            ));
+            )));
         }
         Ok(())
     }
@@ -331,6 +341,7 @@ mod tests {
             short
                 .check()
                 .unwrap_err()
+                .to_string()
                 .contains("coefficient 2 holds 15")
         );
         let mut nan = table.clone();
@@ -338,6 +349,7 @@ mod tests {
         assert!(
             nan.check()
                 .unwrap_err()
+                .to_string()
                 .contains("average coefficient 1 at texel 0")
         );
         let mut negative = table.clone();
@@ -346,6 +358,7 @@ mod tests {
             negative
                 .check()
                 .unwrap_err()
+                .to_string()
                 .contains("std_error at texel 5")
         );
         let mut swapped = table.clone();

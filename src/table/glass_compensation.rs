@@ -139,17 +139,21 @@ impl GlassCompensationTable {
     ///
     /// # Errors
     /// A sentence naming what does not fit.
-    pub fn check(&self) -> Result<(), String> {
+    pub fn check(&self) -> crate::Result<()> {
         use crate::integrate::quantity::Quantity;
-        self.spec.check().map_err(|e| format!("spec: {e}"))?;
+        self.spec
+            .check()
+            .map_err(|e| crate::Error::Malformed(format!("spec: {e}")))?;
         if self.spec.quantity != Quantity::E || self.spec.ior.is_some() {
-            return Err("spec is not an E layout over (roughness, mu)".into());
+            return Err(crate::Error::Malformed(
+                "spec is not an E layout over (roughness, mu)".into(),
+            ));
         }
         crate::integrate::walk::check_eta(self.eta).map_err(|_| {
-            format!(
+            crate::Error::Malformed(format!(
                 "eta {} is out of range [0.01, 100]",
                 crate::error::shown(self.eta)
-            )
+            ))
         })?;
         let n = self.spec.len();
         let channels = [
@@ -161,13 +165,15 @@ impl GlassCompensationTable {
         ];
         for (what, values) in channels {
             if values.len() != n {
-                return Err(format!(
+                return Err(crate::Error::Malformed(format!(
                     "{what} holds {} numbers for {n} texels",
                     values.len()
-                ));
+                )));
             }
             if let Some(k) = values.iter().position(|v| !(*v >= 0.0 && v.is_finite())) {
-                return Err(format!("{what} at texel {k} is not a finite number >= 0"));
+                return Err(crate::Error::Malformed(format!(
+                    "{what} at texel {k} is not a finite number >= 0"
+                )));
             }
         }
         Ok(())
@@ -224,6 +230,7 @@ mod tests {
             short
                 .check()
                 .unwrap_err()
+                .to_string()
                 .contains("transmission (inside) holds 8")
         );
         let mut negative = table.clone();
@@ -232,6 +239,7 @@ mod tests {
             negative
                 .check()
                 .unwrap_err()
+                .to_string()
                 .contains("reflection (outside) at texel 4")
         );
         let mut infinite = table.clone();
@@ -240,11 +248,17 @@ mod tests {
             infinite
                 .check()
                 .unwrap_err()
+                .to_string()
                 .contains("std_error at texel 2")
         );
         let mut eta = table.clone();
         eta.eta = 0.0;
-        assert!(eta.check().unwrap_err().contains("eta 0 is out of range"));
+        assert!(
+            eta.check()
+                .unwrap_err()
+                .to_string()
+                .contains("eta 0 is out of range")
+        );
         let mut average = table.clone();
         average.spec.quantity = crate::integrate::quantity::Quantity::EAvg;
         assert!(average.check().is_err());

@@ -1215,12 +1215,12 @@ mod tests {
             }
         };
         axes(&mut spec, 4096, 4096);
-        assert_eq!(spec.check(), Ok(()));
+        assert!(spec.check().is_ok());
         axes(&mut spec, 4 * 4096, 4096);
-        assert_eq!(spec.check(), Ok(()));
+        assert!(spec.check().is_ok());
         axes(&mut spec, 4 * 4096 + 1, 4096);
         let message = spec.check().unwrap_err();
-        assert!(message.contains("67112960 texels"), "{message}");
+        assert!(message.to_string().contains("67112960 texels"), "{message}");
     }
 
     #[test]

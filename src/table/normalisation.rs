@@ -6,7 +6,7 @@
 //! dmu`. A renderer evaluates `E` through a table's bilinear lookup, whose average `Ē` differs
 //! from the true `E_avg`; at low roughness, where `1 - E_avg` is tiny (7.4e-6 at `alpha = 1e-3`)
 //! while `1 - E(mu_o)` stays near 0.11 in the grazing layer, that relative mismatch becomes an
-//! energy error of up to 0.12 (`kiln verify --furnace` with `E_avg`, `docs/verify.md`). The
+//! energy error of up to 0.12 (`kiln furnace` with `E_avg`, `docs/verify.md`). The
 //! normalisation that closes the furnace for the lookup the renderer really uses is
 //! `1 - Ē(r) = 2 ∫ (1 - E_lookup(mu, r)) mu dmu`.
 //!
@@ -423,7 +423,7 @@ mod tests {
         assert_eq!(nodes.roughness_axis().grid(), Grid::Nodes);
         assert_eq!(centers.roughness_axis().grid(), Grid::Nodes);
         assert_eq!(nodes.quantity, Quantity::FMsNorm);
-        assert_eq!(nodes.check(), Ok(()));
+        assert!(nodes.check().is_ok());
         // Row 1 of 5 centres, t = 0.3, is node 0.3 * 80 = 24 of 81.
         assert_eq!(
             Grid::Nodes.coordinate(24, 81),

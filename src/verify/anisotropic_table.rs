@@ -82,11 +82,13 @@ pub fn lookup_average(table: &AnisotropicTable, r: f64, a: f64) -> f64 {
 }
 
 /// Checks the furnace's smallest roughness: in `[0, 1)`.
-pub fn check_min_roughness(min_roughness: f64) -> Result<(), String> {
+pub fn check_min_roughness(min_roughness: f64) -> crate::Result<()> {
     if (0.0..1.0).contains(&min_roughness) {
         Ok(())
     } else {
-        Err(format!("min roughness {min_roughness} is outside [0, 1)"))
+        Err(crate::Error::InvalidInput(format!(
+            "min roughness {min_roughness} is outside [0, 1)"
+        )))
     }
 }
 
@@ -99,9 +101,11 @@ pub fn anisotropic_furnace(
     points: usize,
     min_roughness: f64,
     seed: u64,
-) -> Result<AnisotropicFurnace, String> {
+) -> crate::Result<AnisotropicFurnace> {
     if points == 0 {
-        return Err("the furnace needs at least one point".into());
+        return Err(crate::Error::InvalidInput(
+            "the furnace needs at least one point".into(),
+        ));
     }
     check_min_roughness(min_roughness)?;
     let settings = ReferenceSettings {

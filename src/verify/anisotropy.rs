@@ -1,5 +1,5 @@
 //! How far an engine's isotropic `E` table is from an anisotropic lobe's albedo when the engine
-//! reads it at one roughness (`kiln verify --anisotropy-convention`).
+//! reads it at one roughness (`kiln verify-anisotropy`).
 //!
 //! Every engine compensates an anisotropic GGX lobe with its isotropic `E(mu, alpha)` read at a
 //! single `alpha` ([`IsotropicReading`]). The audit takes the engine's own parameters over a grid
@@ -119,7 +119,7 @@ pub struct AnisotropyAudit {
 pub fn audit_anisotropy(
     convention: AnisotropyConvention,
     grid: &AnisotropyGrid,
-) -> Result<AnisotropyAudit, String> {
+) -> crate::Result<AnisotropyAudit> {
     let empty = [
         ("roughness", grid.roughness.is_empty()),
         ("anisotropy", grid.anisotropy.is_empty()),
@@ -127,21 +127,29 @@ pub fn audit_anisotropy(
         ("phi", grid.phi.is_empty()),
     ];
     if let Some((axis, _)) = empty.iter().find(|(_, e)| *e) {
-        return Err(format!("the audit's {axis} axis is empty"));
+        return Err(crate::Error::InvalidInput(format!(
+            "the audit's {axis} axis is empty"
+        )));
     }
     for &r in &grid.roughness {
         if !(r > 0.0 && r <= 1.0) {
-            return Err(format!("roughness {r} is outside (0, 1]"));
+            return Err(crate::Error::InvalidInput(format!(
+                "roughness {r} is outside (0, 1]"
+            )));
         }
     }
     for &mu in &grid.mu {
         if !(mu > 0.0 && mu <= 1.0) {
-            return Err(format!("mu = {mu} is outside (0, 1]"));
+            return Err(crate::Error::InvalidInput(format!(
+                "mu = {mu} is outside (0, 1]"
+            )));
         }
     }
     for &phi in &grid.phi {
         if !(0.0..=FRAC_PI_2).contains(&phi) {
-            return Err(format!("phi = {phi} is outside [0, pi/2]"));
+            return Err(crate::Error::InvalidInput(format!(
+                "phi = {phi} is outside [0, pi/2]"
+            )));
         }
     }
     for &a in &grid.anisotropy {

@@ -1,7 +1,7 @@
 //! The audit of a texture-free fit ([`crate::fit::Fit`]): the fit's values against the
 //! deterministic reference over the whole domain, `mu` in [0, 1] (0 included) and the
 //! perceptual roughness `r` in [0, 1] (0 included), reporting each quantity's maximum error
-//! and where it is, with an error map (`kiln verify --fit`).
+//! and where it is, with an error map (`kiln verify-fit`).
 //!
 //! The points: `mu = t^2` and `r` on an `n x n` product grid in `(t, r)` (dense where the
 //! grazing layer and the near-mirror are), then around each quantity's worst point finer grids
@@ -183,6 +183,19 @@ fn compare(fit: &Fit, quantity: Quantity, (mu, r): (f64, f64), reference: f64) -
 pub fn fit_audit_points(fit: &Fit, settings: &FitAuditSettings) -> u64 {
     (settings.points * settings.points
         + fit.quantities().len() * ZOOM_ROUNDS * REFINE_POINTS * REFINE_POINTS) as u64
+}
+
+/// The estimated cost of [`audit_fit`], in seconds of one core: each point costs the reference
+/// of every quantity the fit gives, at the audit's tolerance.
+#[must_use]
+pub fn fit_audit_core_seconds(fit: &Fit, settings: &FitAuditSettings) -> f64 {
+    let digits = (-settings.tolerance.log10()).round().max(1.0) as u32;
+    let per_point: f64 = fit
+        .quantities()
+        .into_iter()
+        .map(|q| crate::integrate::cost::reference_seconds(q, settings.model, digits))
+        .sum();
+    fit_audit_points(fit, settings) as f64 * per_point
 }
 
 /// Audits `fit` against the reference for `settings.model` (see the module docs);

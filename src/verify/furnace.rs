@@ -21,9 +21,10 @@
 
 use crate::table::axis::Axis;
 use crate::table::normalisation::{normalisation_lookup, one_minus_lookup_average};
-use crate::table::{Quantity, Table};
+use crate::table::{Quantity, Table, TableSpec};
 use crate::{Error, Result};
 use serde::Serialize;
+use std::path::{Path, PathBuf};
 
 /// The furnace test at one roughness.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -327,6 +328,92 @@ impl Form {
             Form::Turquin => "turquin",
         }
     }
+}
+
+/// The forms a furnace test of a table of `spec` checks: `asked`, or by default both for an `E`
+/// table and Turquin's for glass (`E_dielectric` from either side), whose Kulla-Conty lobe kiln
+/// does not have.
+///
+/// # Errors
+/// A table of another quantity (the furnace needs an `E` table with its normalisation), or
+/// Kulla-Conty's form asked of glass.
+pub fn forms_for(spec: &TableSpec, asked: Option<&[Form]>) -> Result<Vec<Form>> {
+    let glass = matches!(
+        spec.quantity,
+        Quantity::EDielectric | Quantity::EDielectricInside
+    );
+    if !glass && spec.quantity != Quantity::E {
+        return Err(Error::InvalidInput(format!(
+            "it holds {}, and the white furnace tests an E table with its normalisation: give \
+             the E file (NAME-E.EXT), whose f_ms_norm or E_avg is found beside it or given with \
+             --average",
+            spec.quantity.symbol()
+        )));
+    }
+    if glass && asked.is_some_and(|f| f.contains(&Form::KullaConty)) {
+        return Err(Error::InvalidInput(
+            "it is a glass table: kiln checks Turquin's 1 / E compensation of it (--form \
+             turquin); the Kulla-Conty lobe of glass is not in this version"
+                .into(),
+        ));
+    }
+    Ok(match asked {
+        Some(forms) => forms.to_vec(),
+        None if glass => vec![Form::Turquin],
+        None => vec![Form::KullaConty, Form::Turquin],
+    })
+}
+
+/// The file beside a kiln `E` table's file `path` (`NAME.EXT`, named as kiln names it) that
+/// holds its Kulla-Conty normalisation: `f_ms_norm` if it is there, else `E_avg`.
+///
+/// # Errors
+/// A file not named as kiln names the table, or neither file beside it.
+pub fn normalisation_beside(path: &Path, spec: &TableSpec) -> Result<PathBuf> {
+    let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("");
+    let extension = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+    if stem != spec.id() {
+        return Err(Error::InvalidInput(format!(
+            "{} is not named as kiln names its E table ({}.{extension}): give its f_ms_norm or \
+             E_avg table with --average",
+            path.display(),
+            spec.id()
+        )));
+    }
+    let norm = crate::table::normalisation::spec_for(spec).id();
+    let average = TableSpec {
+        quantity: Quantity::EAvg,
+        mu: None,
+        ..spec.clone()
+    }
+    .id();
+    let candidates = [norm, average].map(|id| path.with_file_name(format!("{id}.{extension}")));
+    candidates
+        .iter()
+        .find(|candidate| candidate.is_file())
+        .cloned()
+        .ok_or_else(|| {
+            Error::InvalidInput(format!(
+                "found neither {} nor {} beside {}: give the normalisation with --average",
+                candidates[0].display(),
+                candidates[1].display(),
+                path.display()
+            ))
+        })
+}
+
+/// The estimated cost of [`turquin`] on a table of `spec` at `settings`' points, in seconds of
+/// one core: each point is the reference at [`TURQUIN_TRUTH_TOLERANCE`], and a glass table's
+/// points cost four times what the bake's figures say (measured at 1e-10: the 16 x 16 x 16
+/// `E_dielectric`'s 65340 points took 137 s on 2 threads, 2026-12-03, 4.2 ms each).
+#[must_use]
+pub fn turquin_core_seconds(spec: &TableSpec, settings: &super::AuditSettings) -> f64 {
+    let points = super::lookup_coordinate_count(spec, settings);
+    let glass = if spec.ior.is_some() { 4.0 } else { 1.0 };
+    let digits = (-TURQUIN_TRUTH_TOLERANCE.log10()).round() as u32;
+    points as f64
+        * glass
+        * crate::integrate::cost::reference_seconds(spec.quantity, spec.model, digits)
 }
 
 /// The edges of the IOR bands a glass table's furnace report gives, on the index as the axis

@@ -391,7 +391,7 @@ fn read_kiln_texture(
 /// The numbers of the array `name` in a generated C header (`static const float NAME[N] = {
 /// ... };`) or Rust source (`pub const NAME: [...] = [ ... ];`); `None` if there is no such
 /// array.
-fn source_array(text: &str, name: &str, c: bool) -> Option<std::result::Result<Vec<f64>, String>> {
+fn source_array(text: &str, name: &str, c: bool) -> Option<crate::Result<Vec<f64>>> {
     let declaration = if c {
         format!("static const float {name}[")
     } else {
@@ -405,7 +405,9 @@ fn source_array(text: &str, name: &str, c: bool) -> Option<std::result::Result<V
         .map(|k| &rest[k + open.len()..])
         .and_then(|body| body.find(close).map(|end| &body[..end]));
     let Some(body) = body else {
-        return Some(Err(format!("the array {name} is not closed")));
+        return Some(Err(crate::Error::Malformed(format!(
+            "the array {name} is not closed"
+        ))));
     };
     let numbers = body
         .split(|ch: char| ch.is_whitespace() || matches!(ch, ',' | '[' | ']'))
@@ -419,10 +421,10 @@ fn source_array(text: &str, name: &str, c: bool) -> Option<std::result::Result<V
             // The generators print the shortest literal that round-trips to the f32 they
             // store: parse it as that f32.
             digits.parse::<f32>().map(f64::from).map_err(|_| {
-                format!(
+                crate::Error::Malformed(format!(
                     "the array {name} holds {}, not a number",
                     crate::error::quoted(token)
-                )
+                ))
             })
         })
         .collect();
@@ -510,10 +512,7 @@ pub fn read_external(path: &Path, encoding: &Encoding, layout: &Layout) -> Resul
 }
 
 /// Builds kiln's spec for a layout and reorders the values into kiln's order (roughness slowest).
-fn spec_and_values(
-    layout: &Layout,
-    values: Vec<f64>,
-) -> std::result::Result<(TableSpec, Vec<f64>), String> {
+fn spec_and_values(layout: &Layout, values: Vec<f64>) -> crate::Result<(TableSpec, Vec<f64>)> {
     let roughness_axis = |size| Axis::Roughness {
         size,
         convention: layout.roughness,
@@ -541,26 +540,26 @@ fn spec_and_values(
         qmc: QmcSettings::default(),
     };
     if layout.shape.len() != layout.order.len() {
-        return Err(format!(
+        return Err(crate::Error::Malformed(format!(
             "--shape has {} sizes but --order names {} axes",
             layout.shape.len(),
             layout.order.len()
-        ));
+        )));
     }
     if layout.shape.iter().any(|&n| n < 2) {
-        return Err(format!(
+        return Err(crate::Error::Malformed(format!(
             "every axis needs at least 2 samples (shape {:?})",
             layout.shape
-        ));
+        )));
     }
     layout.model.validate()?;
     if layout.quantity.has_ior() {
-        return Err(format!(
+        return Err(crate::Error::Malformed(format!(
             "--quantity {}: only kiln's own dielectric and F_avg tables can be audited (their \
              sidecar or header describes the IOR axis); external layouts with an IOR axis are \
              not supported yet",
             layout.quantity.cli_name()
-        ));
+        )));
     }
     let two_d = layout.quantity.has_mu();
     match (two_d, &layout.order[..], &layout.shape[..]) {
@@ -575,13 +574,13 @@ fn spec_and_values(
                 .collect();
             Ok((spec(roughness_axis(n_r), Some(mu_axis(n_mu))), transposed))
         }
-        (true, _, _) => Err(format!(
+        (true, _, _) => Err(crate::Error::Malformed(format!(
             "an {} table needs two axes, e.g. --shape 32x32 --order mu,r",
             layout.quantity.symbol()
+        ))),
+        (false, _, _) => Err(crate::Error::Malformed(
+            "an E_avg table has one roughness axis, e.g. --shape 32 --order r".into(),
         )),
-        (false, _, _) => {
-            Err("an E_avg table has one roughness axis, e.g. --shape 32 --order r".into())
-        }
     }
 }
 
@@ -943,12 +942,14 @@ mod tests {
         assert!(
             open.unwrap()
                 .unwrap_err()
+                .to_string()
                 .contains("the array T is not closed")
         );
         let bad = source_array("pub const T: [f32; 2] = [1.0, x2];", "T", false);
         assert!(
             bad.unwrap()
                 .unwrap_err()
+                .to_string()
                 .contains("the array T holds 'x2', not a number")
         );
     }
@@ -1074,25 +1075,32 @@ mod tests {
         let (r, mu) = (AxisName::R, AxisName::Mu);
         assert!(
             fails(layout(Quantity::E, vec![2, 3], vec![r]), 6)
+                .to_string()
                 .contains("--shape has 2 sizes but --order names 1 axes")
         );
         assert!(
             fails(layout(Quantity::E, vec![1, 3], vec![r, mu]), 3)
+                .to_string()
                 .contains("every axis needs at least 2 samples (shape [1, 3])")
         );
         assert!(
             fails(layout(Quantity::EDielectric, vec![2, 3], vec![r, mu]), 6)
+                .to_string()
                 .contains("--quantity e-dielectric: only kiln's own dielectric")
         );
         assert!(
-            fails(layout(Quantity::E, vec![6], vec![r]), 6).contains("an E table needs two axes")
+            fails(layout(Quantity::E, vec![6], vec![r]), 6)
+                .to_string()
+                .contains("an E table needs two axes")
         );
         assert!(
             fails(layout(Quantity::E, vec![2, 3], vec![r, r]), 6)
+                .to_string()
                 .contains("an E table needs two axes")
         );
         assert!(
             fails(layout(Quantity::EAvg, vec![2, 3], vec![r, mu]), 6)
+                .to_string()
                 .contains("an E_avg table has one roughness axis")
         );
         let mut bad_model = layout(Quantity::E, vec![2, 3], vec![r, mu]);
@@ -1100,7 +1108,11 @@ mod tests {
             ndf: Ndf::Beckmann,
             masking: Masking::SchlickGgx,
         };
-        assert!(fails(bad_model, 6).contains("goes with --ndf ggx only"));
+        assert!(
+            fails(bad_model, 6)
+                .to_string()
+                .contains("goes with --ndf ggx only")
+        );
         // The forms that work: E_avg over r, E over (r, mu) as stored.
         let (spec, v) =
             spec_and_values(&layout(Quantity::EAvg, vec![4], vec![r]), values(4)).unwrap();

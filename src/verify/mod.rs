@@ -15,6 +15,8 @@ pub mod verdict;
 pub use error_map::{ErrorMap, MAX_MAP_CELLS, error_maps};
 
 use crate::integrate::reference::ReferenceSettings;
+use crate::integrate::value::Integral;
+use crate::model::RoughnessConvention;
 use crate::table::{Table, TableSpec};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -280,107 +282,13 @@ pub fn audit(
         })
         .collect();
 
-    // One group's values against the truth, with its error estimate, at `tolerance`.
-    let compare = |group: &[(Coordinates, f64)], tolerance: f64| -> Measured {
-        progress(Progress::Planned(group.len() as u64));
-        let points = group
-            .par_iter()
-            .map(|&(at, value)| {
-                let (reference, error_estimate, converged) = match against {
-                    Against::Reference(finest) | Against::ReferenceAt(finest) => {
-                        let settings = ReferenceSettings {
-                            tolerance,
-                            ..*finest
-                        };
-                        let r = integral.reference(at, &settings);
-                        (r.value, r.error, r.converged)
-                    }
-                    Against::Table(other) => {
-                        let theirs = other.spec.roughness_convention().from_alpha(at.alpha);
-                        let eta = at.eta.unwrap_or(1.0);
-                        let v = other.lookup_eta(at.mu.unwrap_or(1.0), theirs, eta);
-                        (v, 0.0, true)
-                    }
-                };
-                progress(Progress::Compared);
-                let Coordinates { alpha, mu, eta } = at;
-                let point = Point {
-                    mu,
-                    eta,
-                    roughness: convention.from_alpha(alpha),
-                    alpha,
-                    table: value,
-                    reference,
-                    error: (value - reference).abs(),
-                };
-                (point, error_estimate, converged)
-            })
-            .collect();
-        Measured { points, tolerance }
+    let comparison = Comparison {
+        against,
+        integral,
+        convention,
+        progress,
     };
-    // A group against the reference at the tolerance its figures call for.
-    let measure = |group: &[(Coordinates, f64)], with_p99: bool| -> Measured {
-        let finest = match against {
-            Against::Reference(finest) => finest,
-            Against::ReferenceAt(fixed) => return compare(group, fixed.tolerance),
-            Against::Table(_) => return compare(group, 0.0),
-        };
-        let finest = finest.tolerance;
-        let mut tolerance = finest;
-        let mut scouted = None;
-        if group.len() >= 4 * SCOUT_STRIDE && finest < SCOUT_TOLERANCE {
-            let sample: Vec<(Coordinates, f64)> =
-                group.iter().copied().step_by(SCOUT_STRIDE).collect();
-            let scout = compare(&sample, SCOUT_TOLERANCE);
-            let figure = scout.smallest_figure(with_p99);
-            tolerance = if figure.is_finite() {
-                tolerance_for(figure, finest)
-            } else {
-                SCOUT_TOLERANCE
-            };
-            scouted = Some(scout);
-        }
-        loop {
-            let measured = match scouted.take() {
-                // The scouted points already hold the truth at this tolerance or a finer one:
-                // only the rest.
-                Some(scout) if tolerance >= scout.tolerance => {
-                    let rest: Vec<(Coordinates, f64)> = group
-                        .iter()
-                        .enumerate()
-                        .filter(|(k, _)| k % SCOUT_STRIDE != 0)
-                        .map(|(_, p)| *p)
-                        .collect();
-                    let (mut scout_points, mut rest_points) = (
-                        scout.points.into_iter(),
-                        compare(&rest, tolerance).points.into_iter(),
-                    );
-                    let points = (0..group.len())
-                        .map(|k| {
-                            if k % SCOUT_STRIDE == 0 {
-                                scout_points.next()
-                            } else {
-                                rest_points.next()
-                            }
-                            .expect("every point measured once")
-                        })
-                        .collect();
-                    Measured { points, tolerance }
-                }
-                _ => compare(group, tolerance),
-            };
-            let figure = measured.smallest_figure(with_p99);
-            let needed = tolerance_for(figure, finest);
-            // Settled within a factor of two of what the figures call for (or NaN: nothing to
-            // refine).
-            if !figure.is_finite() || needed >= 0.5 * tolerance {
-                return measured;
-            }
-            tolerance = needed;
-        }
-    };
-
-    let mut node_group = measure(&nodes, false);
+    let mut node_group = comparison.measure(&nodes, false);
     // Against a table of the same layout, node k is compared with its node k (a lookup at the
     // physical point of the `alpha = 0` row of an adaptive axis, computed at alpha = 1e-7, would
     // sit a hair off that row).
@@ -392,7 +300,7 @@ pub fn audit(
             p.0.error = (p.0.table - p.0.reference).abs();
         }
     }
-    let lookup_group = measure(&lookups, true);
+    let lookup_group = comparison.measure(&lookups, true);
 
     let storage_cost = settings
         .storage
@@ -436,6 +344,120 @@ pub fn audit(
         storage_cost,
         node_points: node_group.points.iter().map(|p| p.0).collect(),
         lookup_points_compared: lookup_group.points.iter().map(|p| p.0).collect(),
+    }
+}
+
+/// What [`audit`] compares a group of values with, and how: the truth of the table's integral
+/// (or another table), its roughness convention, and the caller's progress.
+struct Comparison<'a> {
+    against: &'a Against<'a>,
+    integral: Integral,
+    convention: RoughnessConvention,
+    progress: &'a (dyn Fn(Progress) + Sync),
+}
+
+impl Comparison<'_> {
+    /// One group's values against the truth, with its error estimate, at `tolerance`.
+    fn compare(&self, group: &[(Coordinates, f64)], tolerance: f64) -> Measured {
+        (self.progress)(Progress::Planned(group.len() as u64));
+        let points = group
+            .par_iter()
+            .map(|&(at, value)| {
+                let (reference, error_estimate, converged) = match self.against {
+                    Against::Reference(finest) | Against::ReferenceAt(finest) => {
+                        let settings = ReferenceSettings {
+                            tolerance,
+                            ..*finest
+                        };
+                        let r = self.integral.reference(at, &settings);
+                        (r.value, r.error, r.converged)
+                    }
+                    Against::Table(other) => {
+                        let theirs = other.spec.roughness_convention().from_alpha(at.alpha);
+                        let eta = at.eta.unwrap_or(1.0);
+                        let v = other.lookup_eta(at.mu.unwrap_or(1.0), theirs, eta);
+                        (v, 0.0, true)
+                    }
+                };
+                (self.progress)(Progress::Compared);
+                let Coordinates { alpha, mu, eta } = at;
+                let point = Point {
+                    mu,
+                    eta,
+                    roughness: self.convention.from_alpha(alpha),
+                    alpha,
+                    table: value,
+                    reference,
+                    error: (value - reference).abs(),
+                };
+                (point, error_estimate, converged)
+            })
+            .collect();
+        Measured { points, tolerance }
+    }
+
+    /// A group against the reference at the tolerance its figures call for: a scout of every
+    /// `SCOUT_STRIDE`-th point first, then the whole group, refined until the tolerance is
+    /// within a factor of two of what its figures call for.
+    fn measure(&self, group: &[(Coordinates, f64)], with_p99: bool) -> Measured {
+        let finest = match self.against {
+            Against::Reference(finest) => finest,
+            Against::ReferenceAt(fixed) => return self.compare(group, fixed.tolerance),
+            Against::Table(_) => return self.compare(group, 0.0),
+        };
+        let finest = finest.tolerance;
+        let mut tolerance = finest;
+        let mut scouted = None;
+        if group.len() >= 4 * SCOUT_STRIDE && finest < SCOUT_TOLERANCE {
+            let sample: Vec<(Coordinates, f64)> =
+                group.iter().copied().step_by(SCOUT_STRIDE).collect();
+            let scout = self.compare(&sample, SCOUT_TOLERANCE);
+            let figure = scout.smallest_figure(with_p99);
+            tolerance = if figure.is_finite() {
+                tolerance_for(figure, finest)
+            } else {
+                SCOUT_TOLERANCE
+            };
+            scouted = Some(scout);
+        }
+        loop {
+            let measured = match scouted.take() {
+                // The scouted points already hold the truth at this tolerance or a finer one:
+                // only the rest.
+                Some(scout) if tolerance >= scout.tolerance => {
+                    let rest: Vec<(Coordinates, f64)> = group
+                        .iter()
+                        .enumerate()
+                        .filter(|(k, _)| k % SCOUT_STRIDE != 0)
+                        .map(|(_, p)| *p)
+                        .collect();
+                    let (mut scout_points, mut rest_points) = (
+                        scout.points.into_iter(),
+                        self.compare(&rest, tolerance).points.into_iter(),
+                    );
+                    let points = (0..group.len())
+                        .map(|k| {
+                            if k % SCOUT_STRIDE == 0 {
+                                scout_points.next()
+                            } else {
+                                rest_points.next()
+                            }
+                            .expect("every point measured once")
+                        })
+                        .collect();
+                    Measured { points, tolerance }
+                }
+                _ => self.compare(group, tolerance),
+            };
+            let figure = measured.smallest_figure(with_p99);
+            let needed = tolerance_for(figure, finest);
+            // Settled within a factor of two of what the figures call for (or NaN: nothing to
+            // refine).
+            if !figure.is_finite() || needed >= 0.5 * tolerance {
+                return measured;
+            }
+            tolerance = needed;
+        }
     }
 }
 

@@ -114,50 +114,12 @@ pub fn verdict(table: &Table, report: &Report, storage: &Storage) -> Option<Verd
         );
     }
     let (lattice_rows, lattice_columns) = lattice(rows, columns);
-    let settings = ReferenceSettings {
-        tolerance: (0.01 * step).max(1e-9),
-        ..ReferenceSettings::default()
-    };
     let convention = spec.roughness_convention();
     let points: Vec<(usize, usize)> = lattice_rows
         .iter()
         .flat_map(|&i| lattice_columns.iter().map(move |&j| (i, j)))
         .collect();
-    // The truth at each lattice texel, and at `alpha = r` there (perceptual axes only).
-    let truths: Vec<(f64, Option<f64>)> = points
-        .par_iter()
-        .map(|&(i, j)| {
-            let k = i * columns + j;
-            let (alpha, mu) = spec.texel_coordinates(k);
-            let integral = spec.integral();
-            let truth = integral
-                .reference(
-                    Coordinates {
-                        alpha,
-                        mu,
-                        eta: None,
-                    },
-                    &settings,
-                )
-                .value;
-            let alpha_is_r = (convention == RoughnessConvention::Perceptual).then(|| {
-                let r = convention.from_alpha(alpha);
-                integral
-                    .reference(
-                        Coordinates {
-                            alpha: r,
-                            mu,
-                            eta: None,
-                        },
-                        &settings,
-                    )
-                    .value
-            });
-            (truth, alpha_is_r)
-        })
-        .collect();
-    let truth_at: std::collections::HashMap<(usize, usize), (f64, Option<f64>)> =
-        points.iter().copied().zip(truths).collect();
+    let truth_at = lattice_truths(spec, &points, step);
     let at = |i: usize, j: usize| truth_at[&(i, j)];
     let file = |i: usize, j: usize| table.value[i * columns + j];
     let max_over = |f: &dyn Fn(usize, usize) -> f64| {
@@ -221,18 +183,9 @@ pub fn verdict(table: &Table, report: &Report, storage: &Storage) -> Option<Verd
     // Noise: the error's sign changes between neighbours on the lattice's rows far more often
     // than a smooth (model) error's would; only differences above the floor count.
     let significant = |d: f64| d.abs() > floor.max(0.5 * step) * 1.5;
-    let (mut changes, mut pairs) = (0usize, 0usize);
-    for &i in &lattice_rows {
-        let row: Vec<f64> = lattice_columns
-            .iter()
-            .map(|&j| file(i, j) - at(i, j).0)
-            .filter(|&d| significant(d))
-            .collect();
-        for w in row.windows(2) {
-            pairs += 1;
-            changes += usize::from(w[0].signum() != w[1].signum());
-        }
-    }
+    let (changes, pairs) = sign_changes(&lattice_rows, &lattice_columns, &|i, j| {
+        Some(file(i, j) - at(i, j).0).filter(|&d| significant(d))
+    });
     if pairs >= 8 && changes * 10 >= pairs * 3 {
         let rms =
             (differences.iter().map(|d| d * d).sum::<f64>() / differences.len() as f64).sqrt();
@@ -256,4 +209,71 @@ pub fn verdict(table: &Table, report: &Report, storage: &Storage) -> Option<Verd
             storage.name
         ),
     )
+}
+
+/// The truth at each lattice texel of `spec`'s table, and at `alpha = r` there (perceptual axes
+/// only), with the reference to a hundredth of the storage's `step` (at most 1e-9).
+fn lattice_truths(
+    spec: &crate::table::TableSpec,
+    points: &[(usize, usize)],
+    step: f64,
+) -> std::collections::HashMap<(usize, usize), (f64, Option<f64>)> {
+    let settings = ReferenceSettings {
+        tolerance: (0.01 * step).max(1e-9),
+        ..ReferenceSettings::default()
+    };
+    let convention = spec.roughness_convention();
+    let columns = spec.shape().get(1).copied().unwrap_or(1);
+    // The truth at each lattice texel, and at `alpha = r` there (perceptual axes only).
+    let truths: Vec<(f64, Option<f64>)> = points
+        .par_iter()
+        .map(|&(i, j)| {
+            let k = i * columns + j;
+            let (alpha, mu) = spec.texel_coordinates(k);
+            let integral = spec.integral();
+            let truth = integral
+                .reference(
+                    Coordinates {
+                        alpha,
+                        mu,
+                        eta: None,
+                    },
+                    &settings,
+                )
+                .value;
+            let alpha_is_r = (convention == RoughnessConvention::Perceptual).then(|| {
+                let r = convention.from_alpha(alpha);
+                integral
+                    .reference(
+                        Coordinates {
+                            alpha: r,
+                            mu,
+                            eta: None,
+                        },
+                        &settings,
+                    )
+                    .value
+            });
+            (truth, alpha_is_r)
+        })
+        .collect();
+    points.iter().copied().zip(truths).collect()
+}
+
+/// Sign changes between neighbours along each lattice row of the significant differences
+/// (`difference(i, j)`, `None` where not significant), and the neighbouring pairs counted.
+fn sign_changes(
+    rows: &[usize],
+    columns: &[usize],
+    difference: &dyn Fn(usize, usize) -> Option<f64>,
+) -> (usize, usize) {
+    let (mut changes, mut pairs) = (0usize, 0usize);
+    for &i in rows {
+        let row: Vec<f64> = columns.iter().filter_map(|&j| difference(i, j)).collect();
+        for w in row.windows(2) {
+            pairs += 1;
+            changes += usize::from(w[0].signum() != w[1].signum());
+        }
+    }
+    (changes, pairs)
 }

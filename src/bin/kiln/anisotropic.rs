@@ -83,13 +83,11 @@ pub fn run(args: AnisotropicArgs) -> kiln::Result<bool> {
         anisotropy: args.size[3],
     };
     let quiet = args.quiet || args.json;
-    kiln::verify::anisotropic_table::check_min_roughness(args.min_roughness).map_err(invalid)?;
+    kiln::verify::anisotropic_table::check_min_roughness(args.min_roughness)?;
     if let Some(out) = &args.bake {
-        sizes.check().map_err(invalid)?;
-        kiln::table::anisotropic::check_tolerance(args.tolerance).map_err(invalid)?;
-        args.convention
-            .check_anisotropy(args.max_anisotropy)
-            .map_err(invalid)?;
+        sizes.check()?;
+        kiln::table::anisotropic::check_tolerance(args.tolerance)?;
+        args.convention.check_anisotropy(args.max_anisotropy)?;
         kiln::format::check_output_dir(out)?;
         crate::announce_cost(sizes.len() as f64 * SECONDS_PER_TEXEL, quiet);
         let rows = (sizes.roughness * sizes.anisotropy) as u64;
@@ -100,12 +98,10 @@ pub fn run(args: AnisotropicArgs) -> kiln::Result<bool> {
             sizes,
             args.tolerance,
             &|done| bar.set_position(done),
-        )
-        .map_err(invalid)?;
+        )?;
         bar.finish_and_clear();
         let furnace =
-            anisotropic_furnace(&table, args.points as usize, args.min_roughness, args.seed)
-                .map_err(invalid)?;
+            anisotropic_furnace(&table, args.points as usize, args.min_roughness, args.seed)?;
         let command = format!(
             "kiln anisotropic --bake {} --convention {} --max-anisotropy {} --size {},{},{},{} \
              --tolerance {:e} --points {} --seed {}",
@@ -171,8 +167,7 @@ pub fn run(args: AnisotropicArgs) -> kiln::Result<bool> {
     };
     let bytes = kiln::format::read_file(path)?;
     let table = kiln::format::anisotropic::decode(&bytes, &path.display().to_string())?;
-    let furnace = anisotropic_furnace(&table, args.points as usize, args.min_roughness, args.seed)
-        .map_err(invalid)?;
+    let furnace = anisotropic_furnace(&table, args.points as usize, args.min_roughness, args.seed)?;
     let worst = furnace.max_turquin.max(furnace.max_kulla_conty);
     let gate = crate::gate::Gate {
         json: args.json,

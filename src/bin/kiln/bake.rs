@@ -25,7 +25,18 @@ use std::time::Instant;
                   texel from independent scrambles. The metadata of every file states the model, \
                   axes, grid, method, error and the command that reproduces it. Output is \
                   byte-identical for any thread count.",
-    after_help = SEE_CONVENTIONS
+    after_help = SEE_CONVENTIONS,
+    // What a scene file or a preset sets for itself: given with --scene or --preset, an error.
+    group(clap::ArgGroup::new("table_spec").multiple(true).args([
+        "ndf", "masking", "quantity", "size", "samples", "avg_samples", "scrambles", "seed",
+        "format", "precision", "roughness_axis", "roughness_spacing", "mu_axis", "grid",
+        "ior_size", "ior_axis", "ior_max", "transmission", "method", "no_reference_check",
+        "fresnel", "f0", "f90", "ior", "eta", "k",
+    ])),
+    // A method named (or its samples): with --max-error, which picks the method, an error.
+    group(clap::ArgGroup::new("explicit_method").multiple(true).args([
+        "method", "samples", "avg_samples", "no_reference_check",
+    ]))
 )]
 pub struct BakeArgs {
     /// Normal distributions to bake, comma-separated: ggx,beckmann for both (Beckmann's
@@ -119,13 +130,7 @@ pub struct BakeArgs {
     out: Option<PathBuf>,
     /// Bake what a scene file's materials need (see `kiln plan`), reusing unchanged tables from
     /// the cache in OUT/.kiln-cache; the scene's [output] sets formats, precision and max_error.
-    #[arg(
-        long,
-        conflicts_with_all = ["ndf", "masking", "quantity", "size", "samples", "avg_samples",
-            "scrambles", "seed", "format", "precision", "roughness_axis", "roughness_spacing", "mu_axis",
-            "grid", "ior_size", "ior_axis", "ior_max", "transmission", "fresnel", "f0", "f90", "ior", "eta", "k",
-            "method", "no_reference_check", "max_error", "texels"]
-    )]
+    #[arg(long, conflicts_with_all = ["table_spec", "max_error", "texels"])]
     scene: Option<PathBuf>,
     /// Bake an engine's table in that engine's own layout, to drop in for its file: cycles
     /// (shader.tables: table_ggx_E, table_ggx_Eavg and the four glass arrays, in Cycles'
@@ -141,10 +146,7 @@ pub struct BakeArgs {
         long,
         value_enum,
         hide_possible_values = true,
-        conflicts_with_all = ["scene", "ndf", "masking", "quantity", "size", "samples",
-            "avg_samples", "scrambles", "seed", "format", "precision", "roughness_axis",
-            "roughness_spacing", "mu_axis", "grid", "method", "no_reference_check", "ior_size", "ior_axis", "ior_max", "transmission", "fresnel",
-            "f0", "f90", "ior", "eta", "k"]
+        conflicts_with_all = ["scene", "table_spec"]
     )]
     preset: Option<kiln::preset::Preset>,
     /// With --preset cycles: copy the arrays kiln does not compute (table_sheen_ltc, an LTC
@@ -210,7 +212,7 @@ pub struct BakeArgs {
         long,
         value_parser = crate::args::parse_error_bound,
         allow_negative_numbers = true,
-        conflicts_with_all = ["method", "samples", "avg_samples", "no_reference_check"]
+        conflicts_with = "explicit_method"
     )]
     max_error: Option<f64>,
     /// Replace tables of the same name in --out that another bake made to a different spec
@@ -314,8 +316,7 @@ pub fn run(args: BakeArgs) -> kiln::Result<()> {
                 kiln::shard::ShardIndex::from_environment(&|name| std::env::var(name).ok(), None)
             }
             text => kiln::shard::ShardIndex::parse(text),
-        }
-        .map_err(kiln::Error::InvalidInput)?;
+        }?;
         let bake = kiln::shard::ShardedBake {
             options,
             formats,

@@ -23,7 +23,13 @@ use kiln::{Masking, Model, Ndf, RoughnessConvention};
                   walks glass instead (a rough dielectric interface: where the light goes, \
                   reflected or transmitted, against Turquin's split); --lobe measures where \
                   the added light goes; --bake writes kiln's own compensation for engines.",
-    after_help = SEE_CONVENTIONS
+    after_help = SEE_CONVENTIONS,
+    // The audit's grid and report: with --bake, which writes a table instead, an error.
+    group(clap::ArgGroup::new("audit").multiple(true).args([
+        "compensation", "roughness", "mu", "f0", "f90", "json",
+    ])),
+    // A conductor's Fresnel and its compensations: with --ior (glass), an error.
+    group(clap::ArgGroup::new("conductor").multiple(true).args(["compensation", "f0", "f90"]))
 )]
 pub struct CompensationArgs {
     /// The compensations to measure [default: all three; with --lobe kulla-conty and turquin,
@@ -52,7 +58,7 @@ pub struct CompensationArgs {
     /// Bake kiln's compensation into this folder instead: its four coefficients at every texel
     /// of the E layout of --size (fitted to walks seeded from --seed and the texel) and their
     /// averages over mu, as one JSON file (NDF-MASKING-kiln-compensation.json).
-    #[arg(long, value_name = "DIR", conflicts_with_all = ["table", "compensation", "roughness", "mu", "f0", "f90", "json"])]
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["table", "audit"])]
     bake: Option<std::path::PathBuf>,
     /// With --bake: the files to write, comma-separated [default: all; with --ior json,exr]:
     /// json (the checked document every audit reads), exr, ktx2 and dds (the coefficients as an
@@ -97,7 +103,7 @@ pub struct CompensationArgs {
     /// glass compensation with --table. With --bake: bake kiln's glass compensation at this one
     /// index (scale factors for the BSDF's reflection and transmission lobes, from outside and
     /// from inside).
-    #[arg(long, value_delimiter = ',', value_parser = crate::args::parse_number, allow_negative_numbers = true, conflicts_with_all = ["lobe", "compensation", "f0", "f90"])]
+    #[arg(long, value_delimiter = ',', value_parser = crate::args::parse_number, allow_negative_numbers = true, conflicts_with_all = ["lobe", "conductor"])]
     ior: Vec<f64>,
     /// The normal distribution of the microsurface (its masking is the walk's own,
     /// height-correlated).
@@ -240,18 +246,15 @@ fn bake(args: &CompensationArgs, out: &std::path::Path) -> kiln::Result<()> {
             }
             CompensationFormat::Exr => (
                 "exr",
-                kiln::format::exr::encode_texture(&texture(), &stem, Precision::F32)
-                    .map_err(kiln::Error::InvalidInput)?,
+                kiln::format::exr::encode_texture(&texture(), &stem, Precision::F32)?,
             ),
             CompensationFormat::Ktx2 => (
                 "ktx2",
-                kiln::format::ktx2::encode(&texture(), Precision::F32)
-                    .map_err(kiln::Error::InvalidInput)?,
+                kiln::format::ktx2::encode(&texture(), Precision::F32)?,
             ),
             CompensationFormat::Dds => (
                 "dds",
-                kiln::format::dds::encode(&texture(), Precision::F32)
-                    .map_err(kiln::Error::InvalidInput)?,
+                kiln::format::dds::encode(&texture(), Precision::F32)?,
             ),
             CompensationFormat::Wgsl => (
                 "wgsl",
@@ -478,8 +481,7 @@ fn bake_glass(args: &CompensationArgs, out: &std::path::Path) -> kiln::Result<()
         let (extension, bytes) = match format {
             CompensationFormat::Exr => (
                 "exr",
-                kiln::format::exr::encode_texture(&file::texture(&table), &stem, Precision::F32)
-                    .map_err(kiln::Error::InvalidInput)?,
+                kiln::format::exr::encode_texture(&file::texture(&table), &stem, Precision::F32)?,
             ),
             _ => ("json", file::encode(&table, &command)),
         };
@@ -660,7 +662,7 @@ fn read_checked<T>(
 
 /// `kiln compensation --lobe`.
 fn lobes(args: &CompensationArgs) -> kiln::Result<()> {
-    use kiln::verify::compensation::{LobeAuditGrid, LobeExtreme, audit_lobes};
+    use kiln::verify::compensation::{LobeAuditGrid, audit_lobes};
     let table = read_table(args.table.as_deref(), args.model())?;
     // kiln's lobe needs its table's M_avg; at F = 1 it is Kulla-Conty's anyway.
     let compensations = if args.compensation.is_empty() {
@@ -689,7 +691,7 @@ fn lobes(args: &CompensationArgs) -> kiln::Result<()> {
     };
     let settings = args.walk_settings(1 << 20)?;
     let model = args.model();
-    let svg = crate::verify::plot_kind_of(args.plot.as_deref())?;
+    let svg = crate::report::plot_kind_of(args.plot.as_deref())?;
     let panels = grid.alphas.len() * grid.views.len();
     if svg.is_some() && panels > 12 {
         return Err(kiln::Error::InvalidInput(format!(
@@ -726,32 +728,8 @@ fn lobes(args: &CompensationArgs) -> kiln::Result<()> {
         &|done| bar.set_position(done),
     )?;
     if let (Some(path), Some(svg)) = (&args.plot, svg) {
-        let mut profiles = Vec::new();
-        for &alpha in &grid.alphas {
-            for &view in &grid.views {
-                profiles.push(kiln::verify::compensation::lobe_profile(
-                    model,
-                    alpha,
-                    view,
-                    grid.f0s[0],
-                    &compensations,
-                    table.as_ref(),
-                    &settings,
-                )?);
-                bar.inc(1);
-            }
-        }
-        let names: Vec<&str> = compensations.iter().map(|c| c.name()).collect();
-        let fresnel = if grid.f0s[0] == 1.0 {
-            "at F = 1".to_string()
-        } else {
-            format!("with Schlick F0 = {}", grid.f0s[0])
-        };
-        let title = format!(
-            "The lobe added {fresnel} against the microsurface walk's (GGX, {} walks a view)",
-            settings.walks
-        );
-        crate::verify::write_plot(path, svg, crate::plot::lobe_plot(&title, &profiles, &names))?;
+        let lobe = (model, &compensations[..], table.as_ref());
+        draw_lobes(path, svg, &grid, lobe, &settings, &bar)?;
     }
     bar.finish_and_clear();
     if args.json {
@@ -761,6 +739,60 @@ fn lobes(args: &CompensationArgs) -> kiln::Result<()> {
         );
         return Ok(());
     }
+    print_lobe_audit(&audit, &grid, &compensations, model);
+    Ok(())
+}
+
+/// Draws the lobe added by each compensation against the walk's, a panel per roughness and
+/// view, at the grid's first F0.
+fn draw_lobes(
+    path: &std::path::Path,
+    svg: bool,
+    grid: &kiln::verify::compensation::LobeAuditGrid,
+    (model, compensations, table): (
+        Model,
+        &[Compensation],
+        Option<&kiln::table::compensation::CompensationTable>,
+    ),
+    settings: &kiln::integrate::walk::WalkSettings,
+    bar: &indicatif::ProgressBar,
+) -> kiln::Result<()> {
+    let mut profiles = Vec::new();
+    for &alpha in &grid.alphas {
+        for &view in &grid.views {
+            profiles.push(kiln::verify::compensation::lobe_profile(
+                model,
+                alpha,
+                view,
+                grid.f0s[0],
+                compensations,
+                table,
+                settings,
+            )?);
+            bar.inc(1);
+        }
+    }
+    let names: Vec<&str> = compensations.iter().map(|c| c.name()).collect();
+    let fresnel = if grid.f0s[0] == 1.0 {
+        "at F = 1".to_string()
+    } else {
+        format!("with Schlick F0 = {}", grid.f0s[0])
+    };
+    let title = format!(
+        "The lobe added {fresnel} against the microsurface walk's (GGX, {} walks a view)",
+        settings.walks
+    );
+    crate::report::write_plot(path, svg, crate::plot::lobe_plot(&title, &profiles, &names))
+}
+
+/// The text report of the lobe audit: the deviation's extremes per compensation and roughness.
+fn print_lobe_audit(
+    audit: &kiln::verify::compensation::LobeAudit,
+    grid: &kiln::verify::compensation::LobeAuditGrid,
+    compensations: &[Compensation],
+    model: Model,
+) {
+    use kiln::verify::compensation::LobeExtreme;
     let white = grid.f0s == [1.0];
     let fresnel = if white {
         "at F = 1".to_string()
@@ -836,5 +868,4 @@ fn lobes(args: &CompensationArgs) -> kiln::Result<()> {
             );
         }
     }
-    Ok(())
 }

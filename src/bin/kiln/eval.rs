@@ -152,7 +152,7 @@ pub fn run(args: EvalArgs) -> kiln::Result<()> {
         ndf: args.ndf,
         masking: args.masking,
     };
-    model.validate().map_err(kiln::Error::InvalidInput)?;
+    model.validate()?;
     let Some(alpha) = args.alpha_given()? else {
         return Err(kiln::Error::InvalidInput(format!(
             "--quantity {} needs --alpha A or --roughness R",
@@ -196,8 +196,26 @@ pub fn run(args: EvalArgs) -> kiln::Result<()> {
         return fresnel_weighted(&args, model, fresnel, alpha, mu);
     }
     let start = Instant::now();
-    // (value, one_minus_value, error, samples or evaluations, converged)
-    let (value, one_minus_value, error, samples, converged) = match args.method {
+    let evaluated = evaluate(&args, quantity, model, alpha, mu)?;
+    print_value(
+        &args,
+        (quantity, model, alpha, mu),
+        evaluated,
+        start.elapsed().as_secs_f64(),
+    );
+    Ok(())
+}
+
+/// `E` or `E_avg` at one point by `--method`: (value, 1 - value, error, samples or
+/// evaluations, whether the quadrature converged).
+fn evaluate(
+    args: &EvalArgs,
+    quantity: Quantity,
+    model: Model,
+    alpha: f64,
+    mu: Option<f64>,
+) -> kiln::Result<(f64, f64, f64, u64, bool)> {
+    Ok(match args.method {
         Method::Qmc => {
             let samples = args.samples.unwrap_or(if quantity.has_mu() {
                 QmcSettings::DEFAULT_SAMPLES
@@ -209,7 +227,7 @@ pub fn run(args: EvalArgs) -> kiln::Result<()> {
                 scrambles: args.scrambles.unwrap_or(QmcSettings::DEFAULT_SCRAMBLES),
                 seed: args.seed,
             };
-            settings.validate().map_err(kiln::Error::InvalidInput)?;
+            settings.validate()?;
             let waiting = args.announce_qmc(quantity, model, samples);
             let e = match mu {
                 Some(mu) => kiln::albedo(model, alpha, mu, &settings),
@@ -233,8 +251,16 @@ pub fn run(args: EvalArgs) -> kiln::Result<()> {
                 r.converged,
             )
         }
-    };
-    let seconds = start.elapsed().as_secs_f64();
+    })
+}
+
+/// Prints one value of [`evaluate`] (JSON, or a line of text) with what it took.
+fn print_value(
+    args: &EvalArgs,
+    (quantity, model, alpha, mu): (Quantity, Model, f64, Option<f64>),
+    (value, one_minus_value, error, samples, converged): (f64, f64, f64, u64, bool),
+    seconds: f64,
+) {
     let method = args.method.name();
     let symbol = quantity.symbol();
     if args.json {
@@ -254,7 +280,7 @@ pub fn run(args: EvalArgs) -> kiln::Result<()> {
             "converged": converged,
             "kiln_version": kiln::format::metadata::KILN_VERSION,
         });
-        print_json(&args, object);
+        print_json(args, object);
     } else {
         let at = mu
             .map(|mu| format!("mu = {}, ", kiln::error::brief(mu)))
@@ -275,7 +301,6 @@ pub fn run(args: EvalArgs) -> kiln::Result<()> {
             );
         }
     }
-    Ok(())
 }
 
 /// `kiln eval --quantity f-avg`: `F_avg` per channel for the `--fresnel` model.
@@ -353,7 +378,7 @@ fn fresnel_weighted(
                     scrambles: args.scrambles.unwrap_or(QmcSettings::DEFAULT_SCRAMBLES),
                     seed: args.seed,
                 };
-                settings.validate().map_err(kiln::Error::InvalidInput)?;
+                settings.validate()?;
                 // Fresnel-weighted integrals run at the split-sum channels' rate.
                 let waiting = args.announce_qmc(Quantity::EScale, model, settings.samples);
                 let e = weighted_albedo(model, alpha, mu, channel(j), &settings);
@@ -457,7 +482,7 @@ fn dielectric(
                 scrambles: args.scrambles.unwrap_or(QmcSettings::DEFAULT_SCRAMBLES),
                 seed: args.seed,
             };
-            settings.validate().map_err(kiln::Error::InvalidInput)?;
+            settings.validate()?;
             let waiting = args.announce_qmc(Quantity::EDielectric, model, settings.samples);
             let e = match mu {
                 Some(mu) => dielectric_albedo_with(model, alpha, mu, eta, convention, &settings),
@@ -680,7 +705,7 @@ impl EvalArgs {
     }
 
     /// Announces a QMC estimate of `samples` samples that will take more than a few seconds
-    /// ([`crate::announce_cost`], at [`kiln::bake::qmc_seconds_per_point`]'s kernel rates) and
+    /// ([`crate::announce_cost`], at [`kiln::integrate::cost::qmc_seconds_per_point`]'s kernel rates) and
     /// returns a spinner with the time spent, cleared when the estimate is in (hidden with
     /// --quiet or --json, or when the estimate is short).
     fn announce_qmc(
@@ -690,7 +715,7 @@ impl EvalArgs {
         samples: u64,
     ) -> indicatif::ProgressBar {
         let quiet = self.quiet || self.json;
-        let seconds = kiln::bake::qmc_seconds_per_point(quantity, model, samples);
+        let seconds = kiln::integrate::cost::qmc_seconds_per_point(quantity, model, samples);
         crate::announce_cost(seconds, quiet);
         let threads = rayon::current_num_threads() as f64;
         crate::spinner(quiet || seconds / threads <= 2.0, "integrating")

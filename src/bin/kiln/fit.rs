@@ -15,7 +15,7 @@ use std::path::PathBuf;
 /// and r, alpha = r^2), or a rational 1 - t^2 P / Q in coordinates of the same kind (t = (mu
 /// (1 + alpha) / (mu + alpha))^0.3 and r^3.2), chosen in the maximum norm against kiln's
 /// reference, written as a formula file and as WGSL, GLSL, HLSL, Rust and C functions. The
-/// maximum error printed and written beside each fit is the audit's (`kiln verify --fit` of the
+/// maximum error printed and written beside each fit is the audit's (`kiln verify-fit` of the
 /// formula file written), over mu in [0, 1] and r in [0, 1], both ends included. `--sweep`
 /// prints what each size costs instead. See docs/fits.md.
 #[derive(Args, Debug)]
@@ -136,7 +136,7 @@ const RATIONAL_SWEEP: [RationalShape; 6] = [
 /// polynomial fit's least squares take no time to speak of.
 fn estimated_seconds(model: Model, shapes: &[Shape]) -> f64 {
     let threads = rayon::current_num_threads() as f64;
-    let e = |digits| kiln::bake::reference_seconds(kiln::Quantity::E, model, digits);
+    let e = |digits| kiln::integrate::cost::reference_seconds(kiln::Quantity::E, model, digits);
     let truth = kiln::fit::polynomial::truth_point_count() as f64 * e(8);
     let audit_points = FitAuditSettings::default().points.pow(2) as f64;
     let fits: f64 = shapes
@@ -202,9 +202,9 @@ pub fn run(args: FitArgs) -> kiln::Result<()> {
         ndf: args.ndf.unwrap_or(Ndf::Ggx),
         masking: args.masking.unwrap_or(Masking::HeightCorrelated),
     };
-    model.validate().map_err(kiln::Error::InvalidInput)?;
+    model.validate()?;
     // A bad --plot or --out is refused before the reference is computed.
-    let svg = crate::verify::plot_kind_of(args.plot.as_deref())?;
+    let svg = crate::report::plot_kind_of(args.plot.as_deref())?;
     let out = args.out.clone().unwrap_or_else(|| PathBuf::from("fits"));
     if !args.sweep {
         kiln::format::check_output_dir(&out)?;
@@ -254,7 +254,7 @@ pub fn run(args: FitArgs) -> kiln::Result<()> {
                     .map(|a| (a.fit.coefficients(), a.max_error))
                     .collect()
             };
-            crate::verify::write_plot(
+            crate::report::write_plot(
                 path,
                 svg,
                 crate::plot::fit_sweep_plot(&model.to_string(), &points(false), &points(true)),

@@ -120,7 +120,7 @@ impl FresnelArgs {
                 k: self.k.ok_or_else(|| missing("--k"))?,
             },
         };
-        model.validate().map_err(bad)?;
+        model.validate()?;
         Ok(model)
     }
 }

@@ -1,4 +1,37 @@
-//! A report gated by `--max-error`: how the audits that can fail print their verdict.
+//! A report gated by `--max-error`: the flags of the audits that can fail, and how they print
+//! their verdict.
+
+use crate::args::parse_error_bound;
+use clap::Args;
+
+/// The flags of an audit's verdict: its bound, JSON, or nothing but a failure.
+#[derive(Args, Debug, Clone)]
+pub struct GateArgs {
+    /// Exit with status 1 when the report's worst figure (the largest error or deviation its
+    /// verdict line names) exceeds this.
+    #[arg(long, value_parser = parse_error_bound, allow_negative_numbers = true)]
+    pub max_error: Option<f64>,
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    pub json: bool,
+    /// Print nothing but errors: the exit status says whether the report passed --max-error
+    /// (0 passed, 1 failed, 2 could not be made), and a failing check prints one line on
+    /// stderr. Not with --json.
+    #[arg(long, short, conflicts_with = "json")]
+    pub quiet: bool,
+}
+
+impl GateArgs {
+    /// How a report with its own `max_error` field names the bound in JSON (`bound_field`).
+    pub fn gate<'a>(&self, bound_field: &'a str) -> Gate<'a> {
+        Gate {
+            json: self.json,
+            quiet: self.quiet,
+            bound: self.max_error,
+            bound_field,
+        }
+    }
+}
 
 /// How a gated report is printed.
 pub struct Gate<'a> {

@@ -5,14 +5,20 @@ mod args;
 mod bake;
 mod compensation;
 mod eval;
+mod external;
 mod fit;
 mod fresnel_args;
+mod furnace;
 mod gate;
+mod legacy;
 mod merge;
 mod plan;
 mod plot;
+mod report;
 mod study;
 mod verify;
+mod verify_anisotropy;
+mod verify_fit;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -42,6 +48,9 @@ enum Command {
     Eval(eval::EvalArgs),
     Plan(plan::PlanArgs),
     Verify(verify::VerifyArgs),
+    Furnace(furnace::FurnaceArgs),
+    VerifyFit(verify_fit::VerifyFitArgs),
+    VerifyAnisotropy(verify_anisotropy::VerifyAnisotropyArgs),
     Study(study::StudyArgs),
     Merge(merge::MergeArgs),
     Fit(fit::FitArgs),
@@ -114,6 +123,42 @@ fn point_flag_on_bake(e: &clap::Error) -> Option<String> {
     }
 }
 
+/// A conflict with a group of flags (`--scene` with the flags a scene sets itself), said with
+/// the flags given rather than clap's list of the whole group.
+fn conflict_as_given(e: &clap::Error, args: &[std::ffi::OsString]) -> Option<String> {
+    use clap::error::{ContextKind, ContextValue};
+    if e.kind() != clap::error::ErrorKind::ArgumentConflict {
+        return None;
+    }
+    let Some(ContextValue::String(invalid)) = e.get(ContextKind::InvalidArg) else {
+        return None;
+    };
+    let prior = match e.get(ContextKind::PriorArg)? {
+        ContextValue::Strings(all) => all.clone(),
+        ContextValue::String(one) => vec![one.clone()],
+        _ => return None,
+    };
+    let given = |shown: &String| {
+        let flag = shown.split([' ', '=']).next().unwrap_or(shown);
+        args.iter().filter_map(|a| a.to_str()).any(|a| {
+            a == flag
+                || a.strip_prefix(flag)
+                    .is_some_and(|rest| rest.starts_with('='))
+        })
+    };
+    let named: Vec<String> = prior
+        .iter()
+        .filter(|p| given(p))
+        .map(|p| format!("'{p}'"))
+        .collect();
+    (named.len() < prior.len() && !named.is_empty()).then(|| {
+        format!(
+            "the argument '{invalid}' cannot be used with {}",
+            named.join(", ")
+        )
+    })
+}
+
 /// `0.4 s`, `12 s`, `3.5 min`, `1.2 h`.
 pub fn human_seconds(seconds: f64) -> String {
     if seconds < 10.0 {
@@ -155,7 +200,12 @@ fn main() -> ExitCode {
     unsafe {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
-    let cli = match Cli::try_parse() {
+    let (args, note) = legacy::rewrite(std::env::args_os().collect());
+    let quiet = args.iter().any(|a| a == "-q" || a == "--quiet");
+    if let (Some(note), false) = (note, quiet) {
+        eprintln!("kiln: {note}");
+    }
+    let cli = match Cli::try_parse_from(&args) {
         Ok(cli) => cli,
         Err(e) => {
             use clap::error::ErrorKind;
@@ -176,7 +226,9 @@ fn main() -> ExitCode {
                 .copied()
                 .take_while(|line| !line.is_empty())
                 .collect();
-            eprintln!("kiln: {}", message.join(" ").trim_start_matches("error: "));
+            let said = conflict_as_given(&e, &args)
+                .unwrap_or_else(|| message.join(" ").trim_start_matches("error: ").to_string());
+            eprintln!("kiln: {said}");
             let point = point_flag_on_bake(&e);
             for line in &lines[message.len()..] {
                 // clap's look-alike (`--roughness-axis` for `--roughness`) is not what someone
@@ -206,6 +258,9 @@ fn main() -> ExitCode {
         Command::Eval(args) => eval::run(args).map(|()| true),
         Command::Plan(args) => plan::run(args).map(|()| true),
         Command::Verify(args) => verify::run(args),
+        Command::Furnace(args) => furnace::run(args),
+        Command::VerifyFit(args) => verify_fit::run(args),
+        Command::VerifyAnisotropy(args) => verify_anisotropy::run(args),
         Command::Study(args) => study::run(args).map(|()| true),
         Command::Merge(args) => merge::run(args).map(|()| true),
         Command::Fit(args) => fit::run(args).map(|()| true),

@@ -242,7 +242,7 @@ pub fn fit_sweep_plot(
     render(
         &format!("Texture-free fits of {model} E: size against accuracy"),
         "coefficients",
-        "max error over mu, r in [0, 1] (kiln verify --fit)",
+        "max error over mu, r in [0, 1] (kiln verify-fit)",
         &series,
         None,
     )

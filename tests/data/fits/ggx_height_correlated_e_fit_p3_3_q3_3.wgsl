@@ -1,4 +1,4 @@
-// E of ggx height-correlated (F = 1) as the rational 1 - t^2 P(u, s) / Q(u, s), P of degree 3 in u = 2 t - 1 and 3 in s = 2 r^3.2 - 1, Q of degrees 3 and 3 with constant term 1 (31 coefficients), t = (mu (1 + alpha) / (mu + alpha))^0.3, alpha = r^2; max error 8.38e-4 over mu in [0, 1], r in [0, 1] against kiln's reference (kiln verify --fit); made by `kiln fit --ndf ggx --masking height-correlated --degrees 3,3/3,3`
+// E of ggx height-correlated (F = 1) as the rational 1 - t^2 P(u, s) / Q(u, s), P of degree 3 in u = 2 t - 1 and 3 in s = 2 r^3.2 - 1, Q of degrees 3 and 3 with constant term 1 (31 coefficients), t = (mu (1 + alpha) / (mu + alpha))^0.3, alpha = r^2; max error 8.38e-4 over mu in [0, 1], r in [0, 1] against kiln's reference (kiln verify-fit); made by `kiln fit --ndf ggx --masking height-correlated --degrees 3,3/3,3`
 fn ggx_height_correlated_e_fit_p3_3_q3_3(mu: f32, r: f32) -> f32 {
     let k = r * r;
     let t = pow(min(mu * (1.0 + k) / max(mu + k, 1e-30), 1.0), 0.3);

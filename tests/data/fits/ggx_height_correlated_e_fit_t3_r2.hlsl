@@ -1,4 +1,4 @@
-// E of ggx height-correlated (F = 1) as a polynomial of degree 3 in u = 2 t - 1 and 2 in v = 2 r - 1 (12 coefficients), t = (mu (1 + 4 alpha) / (mu + 4 alpha))^0.4, alpha = r^2 (kiln's adaptive axis); max error 2.78e-2 over mu in [0, 1], r in [0, 1] against kiln's reference (kiln verify --fit); made by `kiln fit --ndf ggx --masking height-correlated --degrees 3,2`
+// E of ggx height-correlated (F = 1) as a polynomial of degree 3 in u = 2 t - 1 and 2 in v = 2 r - 1 (12 coefficients), t = (mu (1 + 4 alpha) / (mu + 4 alpha))^0.4, alpha = r^2 (kiln's adaptive axis); max error 2.78e-2 over mu in [0, 1], r in [0, 1] against kiln's reference (kiln verify-fit); made by `kiln fit --ndf ggx --masking height-correlated --degrees 3,2`
 float ggx_height_correlated_e_fit_t3_r2(float mu, float r) {
     float k = 4e0 * r * r;
     float t = pow(min(mu * (1.0 + k) / max(mu + k, 1e-30), 1.0), 0.4);

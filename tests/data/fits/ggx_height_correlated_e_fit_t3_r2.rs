@@ -1,4 +1,4 @@
-// E of ggx height-correlated (F = 1) as a polynomial of degree 3 in u = 2 t - 1 and 2 in v = 2 r - 1 (12 coefficients), t = (mu (1 + 4 alpha) / (mu + 4 alpha))^0.4, alpha = r^2 (kiln's adaptive axis); max error 2.78e-2 over mu in [0, 1], r in [0, 1] against kiln's reference (kiln verify --fit); made by `kiln fit --ndf ggx --masking height-correlated --degrees 3,2`
+// E of ggx height-correlated (F = 1) as a polynomial of degree 3 in u = 2 t - 1 and 2 in v = 2 r - 1 (12 coefficients), t = (mu (1 + 4 alpha) / (mu + 4 alpha))^0.4, alpha = r^2 (kiln's adaptive axis); max error 2.78e-2 over mu in [0, 1], r in [0, 1] against kiln's reference (kiln verify-fit); made by `kiln fit --ndf ggx --masking height-correlated --degrees 3,2`
 #[allow(clippy::all)]
 pub fn ggx_height_correlated_e_fit_t3_r2(mu: f32, r: f32) -> f32 {
     let k = 4e0_f32 * r * r;

@@ -84,9 +84,7 @@ pub fn run(args: &EvalArgs) -> kiln::Result<()> {
                     "--anisotropy needs the lobe's roughness: --alpha A or --roughness R".into(),
                 ));
             };
-            lobe.anisotropy_convention
-                .checked_alphas(alpha, a)
-                .map_err(invalid)?
+            lobe.anisotropy_convention.checked_alphas(alpha, a)?
         }
         _ => {
             return Err(invalid(
@@ -102,9 +100,9 @@ pub fn run(args: &EvalArgs) -> kiln::Result<()> {
             "--quantity e needs --mu (cos(theta) in [0, 1])".into(),
         ));
     };
-    check_anisotropic(ndf, mu).map_err(invalid)?;
+    check_anisotropic(ndf, mu)?;
     if let Some(phi) = lobe.phi {
-        check_azimuth(phi).map_err(invalid)?;
+        check_azimuth(phi)?;
     }
     let start = Instant::now();
     let (value, error, samples, converged) = match args.method {
@@ -114,7 +112,7 @@ pub fn run(args: &EvalArgs) -> kiln::Result<()> {
                 scrambles: args.scrambles.unwrap_or(QmcSettings::DEFAULT_SCRAMBLES),
                 seed: args.seed,
             };
-            settings.validate().map_err(invalid)?;
+            settings.validate()?;
             let e = anisotropic_albedo(ndf, mu, lobe.phi, &settings);
             (e.value, e.std_error, e.samples, true)
         }

@@ -1,32 +1,53 @@
-//! `kiln verify --anisotropy-convention`: how far an engine's isotropic `E` table, read at its
+//! `kiln verify-anisotropy`: how far an engine's isotropic `E` table, read at its
 //! single roughness, is from its anisotropic lobe's albedo ([`kiln::verify::anisotropy`]).
 
-use super::{VerifyArgs, plot_kind, write_plot};
+use crate::report::{plot_kind_of, write_plot};
+use clap::Args;
 use kiln::model::AnisotropyConvention;
 use kiln::verify::anisotropy::{
     AnisotropyAudit, AnisotropyGrid, AnisotropyPoint, anisotropy_maps, audit_anisotropy,
 };
 
 /// Seconds of one core per compared point at the audit's tolerance (both references), measured
-/// over the standard grid: about 5 ms (`kiln verify --anisotropy-convention kulla-conty`,
+/// over the standard grid: about 5 ms (`kiln verify-anisotropy kulla-conty`,
 /// 2026-12-07).
 const SECONDS_PER_POINT: f64 = 5e-3;
 
-pub fn run(args: &VerifyArgs, convention: AnisotropyConvention) -> kiln::Result<bool> {
-    if args.fresnel.given() || args.ndf.is_some() || args.masking.is_some() {
-        return Err(kiln::Error::InvalidInput(
-            "--anisotropy-convention audits GGX with height-correlated masking and F = 1 (the \
-             lobe engines make anisotropic): drop --ndf, --masking and the Fresnel flags"
-                .into(),
-        ));
-    }
-    let svg = plot_kind(args)?;
+/// Audit how an engine compensates an anisotropic GGX lobe with its isotropic E table.
+#[derive(Args, Debug, Clone)]
+#[command(
+    long_about = "Audit how an engine compensates an anisotropic GGX lobe (height-correlated \
+                  masking, F = 1) with its isotropic E table, read at one roughness: compares \
+                  the isotropic reference with the anisotropic lobe's over r, anisotropy, mu and \
+                  the view's azimuth, and reports the maximum error and where (--plot: a map per \
+                  anisotropy). kiln's own anisotropic table is `kiln anisotropic`. Was `kiln \
+                  verify --anisotropy-convention`, which still works in this release."
+)]
+pub struct VerifyAnisotropyArgs {
+    /// The engine's convention: kulla-conty (Filament, Unreal: the arithmetic mean of alpha_x
+    /// and alpha_y; alias arithmetic-mean), disney (Cycles, Enterprise PBR: the geometric mean;
+    /// alias geometric-mean), gltf (KHR_materials_anisotropy: the bitangent's roughness; alias
+    /// minimum), openpbr (the root mean square; alias rms).
+    #[arg(value_enum, hide_possible_values = true)]
+    convention: AnisotropyConvention,
+    /// Draw |E_read - E| over (mu, r), the worst over the azimuth, per anisotropy into this
+    /// .svg or .png file.
+    #[arg(long)]
+    plot: Option<std::path::PathBuf>,
+    #[command(flatten)]
+    gate: crate::gate::GateArgs,
+}
+
+pub fn run(args: VerifyAnisotropyArgs) -> kiln::Result<bool> {
+    let convention = args.convention;
+    let args = &args;
+    let svg = plot_kind_of(args.plot.as_deref())?;
     let grid = AnisotropyGrid::standard(convention);
     let points = grid.roughness.len() * grid.anisotropy.len() * grid.mu.len() * grid.phi.len();
-    let quiet = args.quiet || args.json;
+    let quiet = args.gate.quiet || args.gate.json;
     crate::announce_cost(points as f64 * SECONDS_PER_POINT, quiet);
     let spinner = crate::spinner(quiet, "verifying");
-    let audit = audit_anisotropy(convention, &grid).map_err(kiln::Error::InvalidInput)?;
+    let audit = audit_anisotropy(convention, &grid)?;
     spinner.finish_and_clear();
     if let (Some(svg), Some(path)) = (svg, &args.plot) {
         let title = format!(
@@ -36,13 +57,8 @@ pub fn run(args: &VerifyArgs, convention: AnisotropyConvention) -> kiln::Result<
         let maps = anisotropy_maps(&audit, &grid);
         write_plot(path, svg, crate::plot::error_map_plot(&title, &maps))?;
     }
-    let gate = crate::gate::Gate {
-        json: args.json,
-        quiet: args.quiet,
-        bound: args.max_error,
-        bound_field: "max_error_bound",
-    };
-    let subject = format!("--anisotropy-convention {convention}");
+    let gate = args.gate.gate("max_error_bound");
+    let subject = format!("verify-anisotropy {convention}");
     let passed = gate.print(
         &audit,
         || text(&audit, &grid),

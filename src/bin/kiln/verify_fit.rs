@@ -1,14 +1,52 @@
-//! `kiln verify --fit`: the audit of a texture-free fit, an engine's or one given as a formula
+//! `kiln verify-fit`: the audit of a texture-free fit, an engine's or one given as a formula
 //! file ([`kiln::verify::fit`]).
 
-use super::{VerifyArgs, plot_kind, write_plot};
+use crate::report::{plot_kind_of, write_plot};
+use clap::Args;
 use kiln::fit::engine::EngineFit;
 use kiln::fit::{Fit, FormulaFit};
-use kiln::verify::fit::{FitAuditSettings, FitReport, audit_fit, fit_audit_points};
+use kiln::verify::fit::{
+    FitAuditSettings, FitReport, audit_fit, fit_audit_core_seconds, fit_audit_points,
+};
 use kiln::{Masking, Model, Ndf};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-/// The fit `--fit` names: a built-in one, or a formula file.
+/// Audit a texture-free fit of E against the reference.
+#[derive(Args, Debug, Clone)]
+#[command(
+    long_about = "Audit a texture-free fit instead of a table: an engine's (karis: UE4 mobile \
+                  EnvBRDFApprox; materialx: mx_ggx_dir_albedo_analytic; unreal: UE5's analytic \
+                  GGXEnergyLookup) or a formula file (TOML: name = \"...\", optional define = \
+                  [\"k = max(r, 1e-3)\", ...], and formulas E, E_scale and/or E_bias in mu, r and \
+                  alpha = r^2; see docs/fits.md). Reports each quantity's maximum error over mu \
+                  and r in [0, 1] against the reference for the model of --ndf and --masking \
+                  (default GGX height-correlated), and where it is. Fits of E and its split-sum \
+                  terms are for F = 1 (E_scale and E_bias are Schlick's weights). Was `kiln \
+                  verify --fit`, which still works in this release."
+)]
+pub struct VerifyFitArgs {
+    /// The fit: karis, materialx, unreal, or a formula file.
+    #[arg(value_name = "NAME|FILE.toml")]
+    fit: String,
+    /// Points per axis of the (sqrt(mu), r) grid the fit is compared on, the ends included; a
+    /// finer grid then surrounds each quantity's worst point.
+    #[arg(long, default_value_t = 129, value_parser = clap::value_parser!(u32).range(2..=1025))]
+    points: u32,
+    /// The normal distribution [default: ggx].
+    #[arg(long, value_enum)]
+    ndf: Option<Ndf>,
+    /// The Smith G2 form [default: height-correlated].
+    #[arg(long, value_enum)]
+    masking: Option<Masking>,
+    /// Draw |fit - reference| over (mu, r) for each quantity into this .svg or .png file, the
+    /// worst point ringed.
+    #[arg(long)]
+    plot: Option<PathBuf>,
+    #[command(flatten)]
+    gate: crate::gate::GateArgs,
+}
+
+/// The fit named: a built-in one, or a formula file.
 fn fit_named(name: &str) -> kiln::Result<Fit> {
     if let Some(fit) = EngineFit::ALL.into_iter().find(|f| f.name() == name) {
         return Ok(Fit::Engine(fit));
@@ -17,43 +55,30 @@ fn fit_named(name: &str) -> kiln::Result<Fit> {
     if !path.exists() {
         let names: Vec<&str> = EngineFit::ALL.iter().map(|f| f.name()).collect();
         return Err(kiln::Error::InvalidInput(format!(
-            "--fit {name}: neither a fit kiln knows ({}) nor a formula file",
+            "{name}: neither a fit kiln knows ({}) nor a formula file",
             names.join(", ")
         )));
     }
     Ok(Fit::Formula(FormulaFit::read(path)?))
 }
 
-pub fn run(args: &VerifyArgs, name: &str) -> kiln::Result<bool> {
-    if args.fresnel.given() {
-        return Err(kiln::Error::InvalidInput(
-            "--fit audits fits of E and its split-sum terms, which are for F = 1 (E_scale, \
-             E_bias are Schlick's weights): drop the Fresnel flags"
-                .into(),
-        ));
-    }
-    let fit = fit_named(name)?;
+pub fn run(args: VerifyFitArgs) -> kiln::Result<bool> {
+    let args = &args;
+    let fit = fit_named(&args.fit)?;
     let model = Model {
         ndf: args.ndf.unwrap_or(Ndf::Ggx),
         masking: args.masking.unwrap_or(Masking::HeightCorrelated),
     };
-    model.validate().map_err(kiln::Error::InvalidInput)?;
-    let svg = plot_kind(args)?;
+    model.validate()?;
+    let svg = plot_kind_of(args.plot.as_deref())?;
     let settings = FitAuditSettings {
         model,
         points: args.points as usize,
         ..FitAuditSettings::default()
     };
-    let quiet = args.quiet || args.json;
-    // Every point costs the reference of each quantity the fit gives, at the audit's tolerance.
-    let digits = (-settings.tolerance.log10()).round().max(1.0) as u32;
-    let per_point: f64 = fit
-        .quantities()
-        .into_iter()
-        .map(|q| kiln::bake::reference_seconds(q, model, digits))
-        .sum();
+    let quiet = args.gate.quiet || args.gate.json;
+    crate::announce_cost(fit_audit_core_seconds(&fit, &settings), quiet);
     let points = fit_audit_points(&fit, &settings);
-    crate::announce_cost(points as f64 * per_point, quiet);
     let bar = crate::progress_bar(quiet, points, "verifying");
     let report = audit_fit(&fit, &settings, &|| bar.inc(1));
     bar.finish_and_clear();
@@ -67,13 +92,8 @@ pub fn run(args: &VerifyArgs, name: &str) -> kiln::Result<bool> {
         write_plot(path, svg, crate::plot::error_map_plot(&title, &maps))?;
     }
     let worst = kiln::stats::max_or_nan(report.quantities.iter().map(|q| q.max_error));
-    let gate = crate::gate::Gate {
-        json: args.json,
-        quiet: args.quiet,
-        bound: args.max_error,
-        bound_field: "max_error",
-    };
-    let subject = format!("--fit {}", kiln::error::escaped(&report.fit));
+    let gate = args.gate.gate("max_error");
+    let subject = kiln::error::escaped(&report.fit);
     let passed = gate.print(&report, || text(&report), worst, "max error", &subject);
     Ok(passed)
 }
