@@ -312,7 +312,7 @@ fn eval_f_avg_json_and_fresnel_flags() {
     }
 }
 
-/// `kiln plan --scene`: one model, both NDFs, duplicates merged, no materials; a bad scene file
+/// `kiln plan`: one model, both NDFs, duplicates merged, no materials; a bad scene file
 /// gets its line and column, status 2.
 #[test]
 fn plan_lists_each_needed_table_once() {
@@ -320,7 +320,7 @@ fn plan_lists_each_needed_table_once() {
     let plan = |name: &str, text: &str| -> (Output, serde_json::Value) {
         let path = dir.path().join(name);
         std::fs::write(&path, text).unwrap();
-        let output = kiln(&["plan", "--scene", path.to_str().unwrap(), "--json"]);
+        let output = kiln(&["plan", path.to_str().unwrap(), "--json"]);
         let json = serde_json::from_slice(&output.stdout).unwrap_or(serde_json::Value::Null);
         (output, json)
     };

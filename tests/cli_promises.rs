@@ -385,9 +385,11 @@ fn messages_teach() {
         assert!(all.contains(word), "{all}");
     }
     refused(
-        &["plan", "scene.toml"],
+        &["bake", "scene.toml"],
         &["tip: name a scene file with --scene scene.toml"],
     );
+    // `kiln plan` takes the scene as its argument, and names a missing one.
+    refused(&["plan", "scene.toml"], &["cannot read scene.toml"]);
     refused(&["bake", "--scen", "x"], &["tip:", "--scene"]);
     refused(
         &["eval", "--alpha", "-1", "--mu", "0.5"],
@@ -410,12 +412,12 @@ fn messages_teach() {
     )
     .unwrap();
     refused(
-        &["plan", "--scene", scene.to_str().unwrap()],
+        &["plan", scene.to_str().unwrap()],
         &["line 5", "schlick = { f0 = 0.04 }", "dielectric"],
     );
     // An empty scene warns.
     std::fs::write(&scene, "").unwrap();
-    let output = kiln(&["plan", "--scene", scene.to_str().unwrap()]);
+    let output = kiln(&["plan", scene.to_str().unwrap()]);
     assert!(output.status.success());
     assert!(stderr(&output).contains("warning"), "{}", stderr(&output));
     // The furnace of an E_avg file asks for the E file.
@@ -461,7 +463,7 @@ fn a_long_bake_says_how_long_on_any_stderr() {
          fresnel = { dielectric = { ior = 1.5 } }\ntransmission = true\n",
     )
     .unwrap();
-    let output = kiln(&["plan", "--scene", scene.to_str().unwrap(), "--json"]);
+    let output = kiln(&["plan", scene.to_str().unwrap(), "--json"]);
     let plan: Value = serde_json::from_slice(&output.stdout).unwrap();
     let costs: Vec<f64> = plan["tables"]
         .as_array()
@@ -940,7 +942,7 @@ fn numbers_and_counts_read_as_written() {
          false\nimage_based_lighting = true\n",
     )
     .unwrap();
-    let plan = ok(&["plan", "--scene", scene.to_str().unwrap()]);
+    let plan = ok(&["plan", scene.to_str().unwrap()]);
     let text = String::from_utf8(plan.stdout).unwrap();
     assert!(text.contains("1 material needs 2 tables"), "{text}");
 }
@@ -1171,4 +1173,52 @@ fn a_conflict_names_the_flags_given() {
         &["bake", "--max-error", "1e-3", "--samples", "64"],
         &["cannot be used with '--samples <SAMPLES>'"],
     );
+}
+
+/// `kiln bake --json` says what it wrote: every file it lists is in the folder and every file in
+/// the folder is listed, each table's id names its files, and its stated node error is the one
+/// its JSON sidecar records.
+#[test]
+fn bake_json_lists_what_it_wrote() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("t");
+    let output = kiln(&[
+        "bake",
+        "--size",
+        "8",
+        "--quantity",
+        "e,e-avg",
+        "--texels",
+        "nodes",
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let report: Value = serde_json::from_slice(&output.stdout).unwrap();
+    let listed: Vec<String> = report["files"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f.as_str().unwrap().to_string())
+        .collect();
+    let mut on_disk: Vec<String> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().path().display().to_string())
+        .collect();
+    on_disk.sort();
+    let mut sorted = listed.clone();
+    sorted.sort();
+    assert_eq!(sorted, on_disk);
+    let tables = report["tables"].as_array().unwrap();
+    assert_eq!(tables.len(), 2);
+    for table in tables {
+        let id = table["id"].as_str().unwrap();
+        let sidecar: Value =
+            serde_json::from_slice(&std::fs::read(out.join(format!("{id}.json"))).unwrap())
+                .unwrap();
+        let recorded = &sidecar["node_max_error"];
+        assert!(recorded.is_number(), "{id}: {sidecar}");
+        assert_eq!(&table["node_errors"]["max"], recorded, "{id}");
+    }
 }

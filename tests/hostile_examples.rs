@@ -110,7 +110,7 @@ fn inputs_outside_the_physical_domain_are_refused_up_front() {
     )
     .unwrap();
     refused(
-        &kiln(&["plan", "--scene", scene.to_str().unwrap()]),
+        &kiln(&["plan", scene.to_str().unwrap()]),
         "ior must be between",
     );
 }
@@ -265,15 +265,12 @@ fn headers_that_claim_too_much_are_refused_before_allocating() {
     assert!(stderr(&o).contains("1048577 x 1048577"), "{}", stderr(&o));
 }
 
-/// `kiln verify /dev/zero` and `kiln plan --scene /dev/zero` read until memory ran out.
+/// `kiln verify /dev/zero` and `kiln plan /dev/zero` read until memory ran out.
 #[cfg(unix)]
 #[test]
 fn devices_are_not_read() {
     refused(&kiln(&["verify", "/dev/zero"]), "not a regular file");
-    refused(
-        &kiln(&["plan", "--scene", "/dev/zero"]),
-        "not a regular file",
-    );
+    refused(&kiln(&["plan", "/dev/zero"]), "not a regular file");
 }
 
 /// `kiln verify … | head` panicked on the broken pipe (exit 101).
@@ -307,7 +304,7 @@ fn names_and_messages_hold_no_control_characters() {
         "[[material]]\nname = \"steel\\u202egnp.exe\"\nndf = \"ggx\"\nroughness = 0.5\n",
     )
     .unwrap();
-    let o = kiln(&["plan", "--scene", scene.to_str().unwrap()]);
+    let o = kiln(&["plan", scene.to_str().unwrap()]);
     refused(&o, "bidirectional");
     assert!(!stderr(&o).contains('\u{202e}'));
     std::fs::write(
@@ -315,7 +312,7 @@ fn names_and_messages_hold_no_control_characters() {
         "[[material]]\nname = \"a\\u0000b\"\nndf = \"ggx\"\nroughness = 0.5\n",
     )
     .unwrap();
-    let o = kiln(&["plan", "--scene", scene.to_str().unwrap()]);
+    let o = kiln(&["plan", scene.to_str().unwrap()]);
     refused(&o, "control characters");
     assert!(!stderr(&o).contains('\0'));
     // A text table with an escape sequence where a number should be.

@@ -329,7 +329,7 @@ fn kiln_plan_prints_no_control_characters_from_the_scene() {
     )
     .unwrap();
     let output = std::process::Command::new(env!("CARGO_BIN_EXE_kiln"))
-        .args(["plan", "--scene"])
+        .args(["plan"])
         .arg(&file)
         .output()
         .unwrap();

@@ -146,6 +146,18 @@ impl BakeOptions {
     /// The smallest `--max-error` accepted (the reference itself is good to 1e-10).
     pub const MIN_MAX_ERROR: f64 = 1e-10;
 
+    /// The smallest `max_error` baked by QMC ([`BakeOptions::resolved`]): below it the
+    /// quadrature is cheaper at every accuracy (`kiln study`).
+    pub const QMC_MIN_MAX_ERROR: f64 = 1e-3;
+
+    /// Whether a bake to `max_error` runs the deterministic quadrature ([`BakeOptions::resolved`]):
+    /// below [`BakeOptions::QMC_MIN_MAX_ERROR`], and for any bound when it bakes `glass` tables
+    /// (over the IOR).
+    #[must_use]
+    pub fn max_error_takes_quadrature(max_error: f64, glass: bool) -> bool {
+        max_error < Self::QMC_MIN_MAX_ERROR || glass
+    }
+
     /// The options `bake` runs with: these, or for a `max_error` the cheapest method that meets
     /// it, by what `kiln study` measured (GGX, 32 x 32, kiln's axes; README "What accuracy
     /// costs"): from 1e-3 up (glass excepted, `BakeOptions::bakes_glass`), QMC with
@@ -171,7 +183,7 @@ impl BakeOptions {
         };
         let mut options = self.clone();
         options.check_against_reference = true;
-        if max_error >= 1e-3 && !self.bakes_glass() {
+        if !Self::max_error_takes_quadrature(max_error, self.bakes_glass()) {
             let needed = (2.0 / max_error).powf(1.0 / 0.9).ceil() as u64;
             let samples = needed.next_power_of_two().max(64);
             options.method = Method::Qmc;
@@ -227,7 +239,9 @@ impl BakeOptions {
     /// `10^-digits` (see [`BakeOptions::resolved`]).
     #[must_use]
     pub fn reference_digits(&self) -> Option<u32> {
-        let max_error = self.max_error.filter(|&x| x < 1e-3 || self.bakes_glass())?;
+        let max_error = self
+            .max_error
+            .filter(|&x| Self::max_error_takes_quadrature(x, self.bakes_glass()))?;
         Some((-max_error.log10() - 1e-9).ceil() as u32)
     }
 
@@ -236,7 +250,14 @@ impl BakeOptions {
     /// reflection tables' rule missed the bound from inside (measured node error 2.0e-3 at
     /// `--max-error 1e-3`, 1.1e-2 at 1e-2 in Cycles' convention; issue 40).
     fn bakes_glass(&self) -> bool {
-        self.quantities
+        Self::any_glass(&self.quantities)
+    }
+
+    /// Whether `quantities` hold a glass table (over the IOR; `F_avg`, a 1-D integral, is not
+    /// one), which a bake to a max error computes by the quadrature.
+    #[must_use]
+    pub fn any_glass(quantities: &[Quantity]) -> bool {
+        quantities
             .iter()
             .any(|q| q.has_ior() && *q != Quantity::FAvg)
     }

@@ -66,6 +66,13 @@ impl AnisotropicSizes {
         self.mu * self.azimuth * self.roughness * self.anisotropy
     }
 
+    /// The estimated cost of baking a table of these sizes at the default tolerance, in seconds
+    /// of one core: 3e-4 a texel (the 32 x 16 x 32 x 16 table in 40 s on two cores, 2026-12-07).
+    #[must_use]
+    pub fn core_seconds(&self) -> f64 {
+        self.len() as f64 * 3.0e-4
+    }
+
     /// Whether the table holds nothing (never, once checked).
     #[must_use]
     pub fn is_empty(&self) -> bool {

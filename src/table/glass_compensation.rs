@@ -56,6 +56,14 @@ pub struct GlassCompensationTable {
 }
 
 impl GlassCompensationTable {
+    /// The estimated cost of baking `texels` texels with `walks` walks each, in seconds of one
+    /// core: two sides a texel, about a second per 2^20 walks each, and the references (the
+    /// 32 x 32 table at 2^15: 48 s on two cores, 2026-12-07).
+    #[must_use]
+    pub fn bake_core_seconds(texels: u64, walks: u64) -> f64 {
+        texels as f64 * 2.0 * (0.01 + 1.1 * walks as f64 / f64::from(1 << 20))
+    }
+
     /// Walks every texel of `spec` (an `E` layout of `model`) from both sides of an interface of
     /// relative index `eta` with `settings` (the seed of texel `k` is `settings.seed + k`).
     /// `progress` hears the number of texels done.

@@ -198,6 +198,28 @@ pub fn fit_audit_core_seconds(fit: &Fit, settings: &FitAuditSettings) -> f64 {
     fit_audit_points(fit, settings) as f64 * per_point
 }
 
+/// The estimated wall time of `kiln fit` on `threads` threads, in seconds: the polynomial
+/// fit's truth points (the reference to 1e-8, in parallel), then for each of `polynomials`
+/// polynomial fits and each rational fit of `rationals` its audit over the default grid (the
+/// reference to 1e-7, in parallel), and each rational fit's own solve
+/// ([`crate::fit::rational::estimated_seconds`], one thread).
+#[must_use]
+pub fn fits_seconds(
+    model: Model,
+    polynomials: usize,
+    rationals: &[crate::fit::rational::RationalShape],
+    threads: f64,
+) -> f64 {
+    let e = |digits| crate::integrate::cost::reference_seconds(Quantity::E, model, digits);
+    let truth = crate::fit::polynomial::truth_point_count() as f64 * e(8);
+    let audit = FitAuditSettings::default().points.pow(2) as f64 * e(7) / threads;
+    let solves: f64 = rationals
+        .iter()
+        .map(|&shape| crate::fit::rational::estimated_seconds(shape))
+        .sum();
+    truth / threads + (polynomials + rationals.len()) as f64 * audit + solves
+}
+
 /// Audits `fit` against the reference for `settings.model` (see the module docs);
 /// `progress` hears of each point compared.
 ///

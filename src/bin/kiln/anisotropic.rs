@@ -64,10 +64,6 @@ pub struct AnisotropicArgs {
     quiet: bool,
 }
 
-/// Seconds of one core per texel at the default tolerance (the 32 x 16 x 32 x 16 table in 40 s
-/// on two cores, 2026-12-07).
-const SECONDS_PER_TEXEL: f64 = 3.0e-4;
-
 pub fn run(args: AnisotropicArgs) -> kiln::Result<bool> {
     let invalid = kiln::Error::InvalidInput;
     if args.size.len() != 4 {
@@ -89,7 +85,7 @@ pub fn run(args: AnisotropicArgs) -> kiln::Result<bool> {
         kiln::table::anisotropic::check_tolerance(args.tolerance)?;
         args.convention.check_anisotropy(args.max_anisotropy)?;
         kiln::format::check_output_dir(out)?;
-        crate::announce_cost(sizes.len() as f64 * SECONDS_PER_TEXEL, quiet);
+        crate::announce_cost(sizes.core_seconds(), quiet);
         let rows = (sizes.roughness * sizes.anisotropy) as u64;
         let bar = crate::progress_bar(quiet, rows, "integrating");
         let table = AnisotropicTable::bake(

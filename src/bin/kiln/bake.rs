@@ -227,6 +227,11 @@ pub struct BakeArgs {
     /// JOB_COMPLETION_INDEX with KILN_SHARD_COUNT.
     #[arg(long, value_name = "I/N|auto", conflicts_with_all = ["scene", "preset"])]
     shard: Option<String>,
+    /// Print one JSON object instead of the summary: each table (id, quantity, shape,
+    /// max_std_error, node_errors, lookup_fit), the files written, the folder and the seconds.
+    /// For kiln's own tables (not with --scene, --preset or --shard).
+    #[arg(long, conflicts_with_all = ["scene", "preset", "shard"])]
+    json: bool,
     /// No progress bar and no summary.
     #[arg(long, short)]
     quiet: bool,
@@ -334,7 +339,10 @@ pub fn run(args: BakeArgs) -> kiln::Result<()> {
     bar.finish_and_clear();
     let seconds = start.elapsed().as_secs_f64();
     let written = format::write_tables(&out, &tables, &formats, args.precision, replace)?;
-    if !args.quiet {
+    if args.json {
+        let object = crate::report::tables_written_json(&tables, &written, &out, Some(seconds));
+        println!("{object}");
+    } else if !args.quiet {
         for table in &tables {
             let shape: Vec<String> = table.spec.shape().iter().map(|n| n.to_string()).collect();
             let measured = match (table.lookup_fit, table.node_errors) {
@@ -445,8 +453,10 @@ fn check_method_flags(args: &BakeArgs) -> kiln::Result<()> {
     let max_error = args
         .max_error
         .or((!explicit_method).then_some(BakeOptions::DEFAULT_MAX_ERROR));
+    let glass = args.quantity.as_deref().is_some_and(BakeOptions::any_glass);
     let by_quadrature = args.method == Some(Method::Reference)
-        || (args.method.is_none() && max_error.is_some_and(|x| x < 1e-3));
+        || (args.method.is_none()
+            && max_error.is_some_and(|x| BakeOptions::max_error_takes_quadrature(x, glass)));
     if by_quadrature && args.method != Some(Method::Reference) {
         let qmc_only = crate::args::given(&[
             ("--scrambles", args.scrambles.is_some()),
@@ -455,8 +465,8 @@ fn check_method_flags(args: &BakeArgs) -> kiln::Result<()> {
         if !qmc_only.is_empty() {
             return Err(kiln::Error::InvalidInput(format!(
                 "{} {} QMC's sampling, but --max-error {} is baked by the deterministic \
-                 quadrature, which has neither (kiln uses QMC from 1e-3 up): drop {}, or add \
-                 --method qmc --samples N to bake by QMC",
+                 quadrature, which has neither (kiln uses QMC from 1e-3 up, glass excepted): drop {}, or \
+                 add --method qmc --samples N to bake by QMC",
                 qmc_only.join(", "),
                 if qmc_only.len() == 1 { "sets" } else { "set" },
                 kiln::error::shown(max_error.unwrap_or(BakeOptions::DEFAULT_MAX_ERROR)),

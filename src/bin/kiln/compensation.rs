@@ -214,10 +214,8 @@ fn bake(args: &CompensationArgs, out: &std::path::Path) -> kiln::Result<()> {
     let mut specs = options.resolved().specs().into_iter();
     let (spec, average_spec) = (specs.next().expect("E"), specs.next().expect("E_avg"));
     let texels = spec.len() as u64;
-    // About 0.025 s a texel per 2^16 walks on two cores, the fit's references included (the
-    // 32 x 32 table: 25.2 s at 2^16, 49.5 s at 2^17, one run each, 2026-12-07).
     crate::announce_cost(
-        texels as f64 * 0.05 * settings.walks as f64 / f64::from(1 << 16),
+        CompensationTable::bake_core_seconds(texels, settings.walks),
         args.quiet,
     );
     let bar = crate::progress_bar(args.quiet, texels, "walking");
@@ -352,14 +350,8 @@ pub fn run(args: CompensationArgs) -> kiln::Result<()> {
     let model = args.model();
     let views = (grid.alphas.len() * grid.mus.len()) as u64;
     if !args.quiet {
-        // About 0.5 s a view per 2^20 walks on two cores, walks and references (measured
-        // 2026-12-07: 16 s for the default 32 views), twice that with kiln's own fit.
-        let fits = if compensations.contains(&Compensation::Kiln) && table.is_none() {
-            2.0
-        } else {
-            1.0
-        };
-        let seconds = views as f64 * 0.5 * fits * walks as f64 / f64::from(1 << 20);
+        let fits_kiln = compensations.contains(&Compensation::Kiln) && table.is_none();
+        let seconds = kiln::verify::compensation::audit_seconds(views, walks, fits_kiln);
         if seconds > 5.0 {
             eprintln!(
                 "kiln: {views} views of {} walks, about {} (fewer with --walks)",
@@ -457,10 +449,11 @@ fn bake_glass(args: &CompensationArgs, out: &std::path::Path) -> kiln::Result<()
     options.validate()?;
     let spec = options.resolved().specs().remove(0);
     let texels = spec.len() as u64;
-    // Two sides a texel, about a second of one core per 2^20 walks each, and the references
-    // (the 32 x 32 table at 2^15: 48 s on two cores, 2026-12-07).
     crate::announce_cost(
-        texels as f64 * 2.0 * (0.01 + 1.1 * settings.walks as f64 / f64::from(1 << 20)),
+        kiln::table::glass_compensation::GlassCompensationTable::bake_core_seconds(
+            texels,
+            settings.walks,
+        ),
         args.quiet,
     );
     let bar = crate::progress_bar(args.quiet, texels, "walking");
@@ -535,10 +528,8 @@ fn glass(args: &CompensationArgs) -> kiln::Result<()> {
     }
     let settings = args.walk_settings(1 << 20)?;
     let views = (grid.etas.len() * grid.alphas.len() * grid.mus.len()) as u64;
-    // About a second of one core a view per 2^20 walks (0.54 s on two cores at r = 0.7,
-    // mu = 0.5, 2.6 vertices a walk; 0.65 s at r = 1, mu = 0.2; measured 2026-12-07).
     crate::announce_cost(
-        views as f64 * 1.1 * settings.walks as f64 / f64::from(1 << 20),
+        kiln::verify::glass_compensation::audit_core_seconds(views, settings.walks),
         args.quiet,
     );
     let bar = crate::progress_bar(args.quiet, views, "walking");
@@ -704,12 +695,9 @@ fn lobes(args: &CompensationArgs) -> kiln::Result<()> {
     let views = (grid.alphas.len() * grid.views.len() * grid.f0s.len()) as u64
         * if svg.is_some() { 2 } else { 1 };
     if !args.quiet {
-        // Measured 2026-12-07 on two cores: 2^20 walks from a view, evaluated at 8 exits x
-        // (5 azimuths + 8 strata), take about 1.5 s.
         let directions = grid.exits.len() * (grid.azimuths.len() + 8);
         let seconds =
-            views as f64 * (0.3 + 1.2 * directions as f64 / 104.0) * settings.walks as f64
-                / f64::from(1 << 20);
+            kiln::verify::compensation::lobe_audit_seconds(views, directions, settings.walks);
         if seconds > 5.0 {
             eprintln!(
                 "kiln: {views} views of {} walks, about {} (fewer with --walks)",

@@ -511,7 +511,7 @@ fn dielectric(
                     eta,
                     convention,
                     &ReferenceSettings {
-                        tolerance: 1e-9,
+                        tolerance: kiln::integrate::dielectric::AVERAGE_POINT_TOLERANCE,
                         ..settings
                     },
                 ),

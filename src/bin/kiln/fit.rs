@@ -130,28 +130,6 @@ const RATIONAL_SWEEP: [RationalShape; 6] = [
     rational((3, 3), (3, 3), false),
 ];
 
-/// The estimated wall time of `kiln fit` making and auditing `shapes`, in seconds: the
-/// reference at the fit's points (1e-8) and at each audit's (1e-7) on every thread, and each
-/// rational fit's linear programs on one ([`kiln::fit::rational::estimated_seconds`]); a
-/// polynomial fit's least squares take no time to speak of.
-fn estimated_seconds(model: Model, shapes: &[Shape]) -> f64 {
-    let threads = rayon::current_num_threads() as f64;
-    let e = |digits| kiln::integrate::cost::reference_seconds(kiln::Quantity::E, model, digits);
-    let truth = kiln::fit::polynomial::truth_point_count() as f64 * e(8);
-    let audit_points = FitAuditSettings::default().points.pow(2) as f64;
-    let fits: f64 = shapes
-        .iter()
-        .map(|shape| {
-            let audit = audit_points * e(7) / threads;
-            match shape {
-                Shape::Polynomial(_) => audit,
-                Shape::Rational(shape) => audit + kiln::fit::rational::estimated_seconds(*shape),
-            }
-        })
-        .sum();
-    truth / threads + fits
-}
-
 /// A fit and its audit: the formula file's text and the audited maximum.
 struct Audited {
     fit: MadeFit,
@@ -219,7 +197,19 @@ pub fn run(args: FitArgs) -> kiln::Result<()> {
     } else {
         vec![args.degrees]
     };
-    crate::announce_seconds(estimated_seconds(model, &shapes), quiet);
+    let rationals: Vec<RationalShape> = shapes
+        .iter()
+        .filter_map(|s| match s {
+            Shape::Rational(shape) => Some(*shape),
+            Shape::Polynomial(_) => None,
+        })
+        .collect();
+    let polynomials = shapes.len() - rationals.len();
+    let threads = rayon::current_num_threads() as f64;
+    crate::announce_seconds(
+        kiln::verify::fit::fits_seconds(model, polynomials, &rationals, threads),
+        quiet,
+    );
     let bar = crate::progress_bar(
         quiet,
         kiln::fit::polynomial::truth_point_count() as u64,

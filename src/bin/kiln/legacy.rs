@@ -14,8 +14,9 @@ struct Renamed {
     new: &'static str,
 }
 
-/// The renamed modes (2026-12: `kiln verify`'s modes that took other inputs).
-const RENAMED: [Renamed; 3] = [
+/// The renamed modes (2026-12: `kiln verify`'s modes that took other inputs, and `kiln plan`'s
+/// scene, now its argument as `kiln verify`'s table is).
+const RENAMED: [Renamed; 4] = [
     Renamed {
         command: "verify",
         flag: "--furnace",
@@ -33,6 +34,12 @@ const RENAMED: [Renamed; 3] = [
         flag: "--anisotropy-convention",
         takes_value: true,
         new: "verify-anisotropy",
+    },
+    Renamed {
+        command: "plan",
+        flag: "--scene",
+        takes_value: true,
+        new: "plan",
     },
 ];
 
@@ -102,6 +109,7 @@ mod tests {
                 "kiln verify --anisotropy-convention disney -q",
                 "kiln verify-anisotropy disney -q",
             ),
+            ("kiln plan --scene s.toml --json", "kiln plan s.toml --json"),
         ];
         for (old, new) in cases {
             let (args, note) = rewrite(words(old));

@@ -89,7 +89,7 @@ pub fn spinner(quiet: bool, what: &str) -> indicatif::ProgressBar {
     bar
 }
 
-/// A `.toml` file given where no positional argument is taken (`kiln plan scene.toml`).
+/// A `.toml` file given where no positional argument is taken (`kiln bake scene.toml`).
 fn stray_scene_file(e: &clap::Error) -> Option<String> {
     use clap::error::{ContextKind, ContextValue};
     if e.kind() != clap::error::ErrorKind::UnknownArgument {

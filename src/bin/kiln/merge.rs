@@ -25,6 +25,10 @@ pub struct MergeArgs {
     /// Replace tables of the same name made to a different spec (as `kiln bake --force`).
     #[arg(long)]
     force: bool,
+    /// Print one JSON object instead of the summary: each table (id, quantity, shape,
+    /// max_std_error, node_errors, lookup_fit), the files written and the folder.
+    #[arg(long, conflicts_with = "quiet")]
+    json: bool,
     /// No summary.
     #[arg(long, short)]
     quiet: bool,
@@ -59,7 +63,10 @@ pub fn run(args: MergeArgs) -> kiln::Result<()> {
         Replace::Refuse
     };
     let written = format::write_tables(&out, &tables, &formats, bake.precision, replace)?;
-    if !args.quiet {
+    if args.json {
+        let object = crate::report::tables_written_json(&tables, &written, &out, None);
+        println!("{object}");
+    } else if !args.quiet {
         println!(
             "merged {} into {}; wrote {} to {}",
             kiln::error::count(shards.len(), "shard"),

@@ -27,7 +27,7 @@ A scene file (TOML; unknown keys are errors):
   transmission = false           # glass: the dielectric tables (a dielectric fresnel)
   sheen = false                  # cloth albedo: only in filament's and godot's textures
 
-Then `kiln bake --scene FILE` bakes exactly what `kiln plan --scene FILE` lists. Example:
+Then `kiln bake --scene FILE` bakes exactly what `kiln plan FILE` lists. Example:
 examples/scene.toml; the format in full: docs/scenes.md.";
 
 /// Show the minimal set of tables a scene needs.
@@ -54,17 +54,23 @@ examples/scene.toml; the format in full: docs/scenes.md.";
     after_long_help = SCENE_FORMAT
 )]
 pub struct PlanArgs {
-    /// The scene file.
-    #[arg(long)]
+    /// The scene file (was --scene FILE, which still works in this release).
     scene: PathBuf,
     /// Print one JSON object instead of text.
     #[arg(long)]
     json: bool,
+    /// Print nothing but errors: the exit status says whether the scene is one kiln bakes (0)
+    /// or not (2). For a build step that checks a scene. Not with --json.
+    #[arg(long, short, conflicts_with = "json")]
+    quiet: bool,
 }
 
 pub fn run(args: PlanArgs) -> kiln::Result<()> {
     let scene = Scene::read(&args.scene)?;
     let plan = scene.plan();
+    if args.quiet {
+        return Ok(());
+    }
     if args.json {
         println!(
             "{}",

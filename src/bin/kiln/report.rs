@@ -90,3 +90,34 @@ pub fn write_plot(
     kiln::format::write_files(dir.unwrap_or(Path::new(".")), &[(name.to_string(), bytes)])?;
     Ok(())
 }
+
+/// What a bake or a merge wrote, as one JSON object: each table (its id, shape, largest
+/// standard error, the node errors measured against the reference and what its lookup fit
+/// measured, where there are), the files and the folder, and the seconds taken.
+pub fn tables_written_json(
+    tables: &[kiln::Table],
+    written: &[std::path::PathBuf],
+    out: &Path,
+    seconds: Option<f64>,
+) -> serde_json::Value {
+    let tables: Vec<serde_json::Value> = tables
+        .iter()
+        .map(|t| {
+            serde_json::json!({
+                "id": t.spec.id(),
+                "quantity": t.spec.quantity.symbol(),
+                "shape": t.spec.shape(),
+                "max_std_error": t.max_std_error(),
+                "node_errors": t.node_errors,
+                "lookup_fit": t.lookup_fit,
+            })
+        })
+        .collect();
+    let files: Vec<String> = written.iter().map(|p| p.display().to_string()).collect();
+    serde_json::json!({
+        "tables": tables,
+        "files": files,
+        "out": out.display().to_string(),
+        "seconds": seconds,
+    })
+}

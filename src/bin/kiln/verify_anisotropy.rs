@@ -8,11 +8,6 @@ use kiln::verify::anisotropy::{
     AnisotropyAudit, AnisotropyGrid, AnisotropyPoint, anisotropy_maps, audit_anisotropy,
 };
 
-/// Seconds of one core per compared point at the audit's tolerance (both references), measured
-/// over the standard grid: about 5 ms (`kiln verify-anisotropy kulla-conty`,
-/// 2026-12-07).
-const SECONDS_PER_POINT: f64 = 5e-3;
-
 /// Audit how an engine compensates an anisotropic GGX lobe with its isotropic E table.
 #[derive(Args, Debug, Clone)]
 #[command(
@@ -43,9 +38,8 @@ pub fn run(args: VerifyAnisotropyArgs) -> kiln::Result<bool> {
     let args = &args;
     let svg = plot_kind_of(args.plot.as_deref())?;
     let grid = AnisotropyGrid::standard(convention);
-    let points = grid.roughness.len() * grid.anisotropy.len() * grid.mu.len() * grid.phi.len();
     let quiet = args.gate.quiet || args.gate.json;
-    crate::announce_cost(points as f64 * SECONDS_PER_POINT, quiet);
+    crate::announce_cost(grid.audit_core_seconds(), quiet);
     let spinner = crate::spinner(quiet, "verifying");
     let audit = audit_anisotropy(convention, &grid)?;
     spinner.finish_and_clear();
