@@ -53,3 +53,38 @@ pub fn first_stderr_line(args: &[&str], env: &[(&str, &str)]) -> String {
     child.wait().expect("kiln is reaped");
     line
 }
+
+/// `kiln COMMAND --json ARGS`: the exit status and the report (`Null` if none).
+#[allow(dead_code)] // not every test that includes this file reads JSON
+pub fn json_of(command: &str, args: &[&str]) -> (Option<i32>, serde_json::Value) {
+    let mut all = vec![command, "--json"];
+    all.extend_from_slice(args);
+    let output = kiln(&all);
+    let report = serde_json::from_slice(&output.stdout).unwrap_or(serde_json::Value::Null);
+    assert!(
+        report != serde_json::Value::Null || output.status.code() == Some(2),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    (output.status.code(), report)
+}
+
+/// Runs kiln with `args` and asserts that it exits 0, showing its stderr if not.
+#[allow(dead_code)] // not every test that includes this file runs a command to success
+pub fn succeeded(args: &[&str]) {
+    let output = kiln(args);
+    assert_eq!(
+        output.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+}
+
+/// The number `field` of a JSON report.
+#[allow(dead_code)] // not every test that includes this file reads reports
+pub fn number(report: &serde_json::Value, field: &str) -> f64 {
+    report[field]
+        .as_f64()
+        .unwrap_or_else(|| panic!("no {field} in {report}"))
+}
