@@ -5,11 +5,12 @@ use kiln::format::replace::Replace;
 use kiln::format::{self, Format};
 use std::path::PathBuf;
 
-/// Merge the shard files of one sharded bake (`kiln bake ... --shard I/N`) into its tables:
-/// checks that they are all the shards of the same bake, whole and each once, finishes the
-/// tables as the unsharded bake would (the check against the reference to --max-error, the
-/// derived f_ms_norm) and writes them byte for byte as it would have. Nothing is written if any
-/// check fails.
+/// Merge the shard files of one sharded bake into its tables
+///
+/// The shards of `kiln bake ... --shard I/N`: checks that they are all the shards of the same
+/// bake, whole and each once, finishes the tables as the unsharded bake would (the check
+/// against the reference to --max-error, the derived f_ms_norm) and writes them byte for byte
+/// as it would have. Nothing is written if any check fails.
 #[derive(Args, Debug)]
 #[command(arg_required_else_help = true)]
 pub struct MergeArgs {
