@@ -477,16 +477,7 @@ pub fn merge(shards: &[(PathBuf, ShardFile)]) -> Result<(ShardedBake, Vec<Table>
             });
         }
         confirm_shares(&spec, &shares, plan.as_ref())?;
-        let table = Table {
-            spec,
-            value,
-            one_minus_value,
-            std_error,
-            command,
-            node_errors: None,
-            requested_max_error: None,
-            lookup_fit: None,
-        };
+        let table = Table::unmeasured(spec, [value, one_minus_value, std_error], command);
         // The check's texels are in ascending order and the shards' ranges too: the
         // concatenation is the unsharded bake's sequence of terms, summed in the same order.
         let terms = plan.map(|_| check);

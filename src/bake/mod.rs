@@ -590,16 +590,12 @@ pub fn bake_table(spec: TableSpec, command: String, progress: &(dyn Fn(u64) + Sy
             estimate
         })
         .collect();
-    Table {
-        value: estimates.iter().map(|e| e.value).collect(),
-        one_minus_value: estimates.iter().map(|e| e.one_minus_value).collect(),
-        std_error: estimates.iter().map(|e| e.std_error).collect(),
-        spec,
-        command,
-        node_errors: None,
-        requested_max_error: None,
-        lookup_fit: None,
-    }
+    let channels = [
+        estimates.iter().map(|e| e.value).collect(),
+        estimates.iter().map(|e| e.one_minus_value).collect(),
+        estimates.iter().map(|e| e.std_error).collect(),
+    ];
+    Table::unmeasured(spec, channels, command)
 }
 
 /// The estimate of one texel (row-major index, slowest axis first): the spec's integral

@@ -589,15 +589,9 @@ impl Preset {
                 let spec = specs.iter().find(|s| s.quantity == quantity)?.clone();
                 Some((spec, value))
             })
-            .map(|(spec, value)| Table {
-                one_minus_value: value.iter().map(|v| 1.0 - v).collect(),
-                std_error: vec![0.0; value.len()],
-                value,
-                spec,
-                command: format!("{origin}, read in the {} layout", self.name()),
-                node_errors: None,
-                requested_max_error: None,
-                lookup_fit: None,
+            .map(|(spec, value)| {
+                let command = format!("{origin}, read in the {} layout", self.name());
+                Table::of_values(spec, value, command)
             })
             .collect();
         for table in &tables {

@@ -595,21 +595,41 @@ impl Table {
         ]
     }
 
-    /// A table of `spec` whose channels are zero: its layout, for looking up channels laid out
-    /// like it ([`Table::lookup_channel`]) that it does not hold.
+    /// A table of `spec` with these channels and nothing measured of it yet (no node errors,
+    /// no requested bound, no lookup fit): what a bake, a merge or a reader starts from.
     #[must_use]
-    pub fn layout_of(spec: TableSpec) -> Self {
-        let n = spec.len();
+    pub fn unmeasured(
+        spec: TableSpec,
+        [value, one_minus_value, std_error]: [Vec<f64>; 3],
+        command: String,
+    ) -> Self {
         Self {
             spec,
-            value: vec![0.0; n],
-            one_minus_value: vec![0.0; n],
-            std_error: vec![0.0; n],
-            command: String::new(),
+            value,
+            one_minus_value,
+            std_error,
+            command,
             node_errors: None,
             requested_max_error: None,
             lookup_fit: None,
         }
+    }
+
+    /// [`Table::unmeasured`] of values read without their other channels (an engine's file, an
+    /// external table): `1 - value` computed from them, no standard errors.
+    #[must_use]
+    pub fn of_values(spec: TableSpec, value: Vec<f64>, command: String) -> Self {
+        let one_minus_value = value.iter().map(|v| 1.0 - v).collect();
+        let std_error = vec![0.0; value.len()];
+        Self::unmeasured(spec, [value, one_minus_value, std_error], command)
+    }
+
+    /// A table of `spec` whose channels are zero: its layout, for looking up channels laid out
+    /// like it ([`Table::lookup_channel`]) that it does not hold.
+    #[must_use]
+    pub fn layout_of(spec: TableSpec) -> Self {
+        let zeros = vec![0.0; spec.len()];
+        Self::unmeasured(spec, [zeros.clone(), zeros.clone(), zeros], String::new())
     }
 
     /// The channels in storage order, matching [`Table::channel_names`].

@@ -296,16 +296,8 @@ pub fn derive(e: &Table, command: String) -> Table {
         })
         .collect();
     let (value, std_error): (Vec<f64>, Vec<f64>) = entries.into_iter().unzip();
-    Table {
-        one_minus_value: value.iter().map(|v| 1.0 - v).collect(),
-        value,
-        std_error,
-        spec,
-        command,
-        node_errors: None,
-        requested_max_error: None,
-        lookup_fit: None,
-    }
+    let one_minus_value = value.iter().map(|v| 1.0 - v).collect();
+    Table::unmeasured(spec, [value, one_minus_value, std_error], command)
 }
 
 /// What a normalisation table that stores `(1 - Ē) / x` divides by at `roughness` (in the

@@ -73,16 +73,7 @@ fn check_finite(path: &Path, values: &[f64]) -> Result<()> {
 }
 
 pub(super) fn table_from_channel(spec: TableSpec, values: Vec<f64>, command: String) -> Table {
-    Table {
-        one_minus_value: values.iter().map(|v| 1.0 - v).collect(),
-        std_error: vec![0.0; values.len()],
-        value: values,
-        spec,
-        command,
-        node_errors: None,
-        requested_max_error: None,
-        lookup_fit: None,
-    }
+    Table::of_values(spec, values, command)
 }
 
 fn channel(path: &Path, channels: &[(String, Vec<f64>)], name: &str) -> Result<Vec<f64>> {
