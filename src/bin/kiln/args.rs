@@ -134,3 +134,13 @@ pub fn parse_error_bound(text: &str) -> Result<f64, String> {
         Err(format!("an error bound must be positive (got {text})"))
     }
 }
+
+/// `--clamp-min`: the smallest coordinate a table was computed at, in [0, 1).
+pub fn parse_clamp(text: &str) -> Result<f64, String> {
+    let value = parse_number(text)?;
+    if (0.0..1.0).contains(&value) {
+        Ok(value)
+    } else {
+        Err(format!("clamp-min must be in [0, 1) (got {text})"))
+    }
+}

@@ -41,6 +41,10 @@ pub struct FurnaceArgs {
     /// lookup audit; Kulla-Conty's: the roughness ladder).
     #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=64))]
     density: u32,
+    /// The smallest coordinate the table was actually computed at, on both axes (Turquin's
+    /// form compares the truth there) [default: 0].
+    #[arg(long, value_parser = crate::args::parse_clamp, allow_negative_numbers = true)]
+    clamp_min: Option<f64>,
     /// Draw the deviation of each form over (mu, r) into this .svg or .png file (a glass table:
     /// over mu and eta, the worst over roughness), the worst point ringed.
     #[arg(long)]
@@ -65,7 +69,7 @@ impl FurnaceArgs {
 
     fn audit_settings(&self) -> AuditSettings {
         AuditSettings {
-            clamp_min: 0.0,
+            clamp_min: self.clamp_min.unwrap_or(0.0),
             density: self.density as usize,
             storage: None,
         }

@@ -105,10 +105,10 @@ fn stray_scene_file(e: &clap::Error) -> Option<String> {
 
 /// A point's flag (`--roughness`, `--mu`, `--alpha`, `--eta`) given to `kiln bake`, which takes
 /// none: the user wants `kiln eval`.
-fn point_flag_on_bake(e: &clap::Error) -> Option<String> {
+fn point_flag_on_bake(e: &clap::Error, args: &[std::ffi::OsString]) -> Option<String> {
     use clap::error::{ContextKind, ContextValue};
     if e.kind() != clap::error::ErrorKind::UnknownArgument
-        || std::env::args().nth(1).as_deref() != Some("bake")
+        || args.get(1).and_then(|a| a.to_str()) != Some("bake")
     {
         return None;
     }
@@ -229,7 +229,7 @@ fn main() -> ExitCode {
             let said = conflict_as_given(&e, &args)
                 .unwrap_or_else(|| message.join(" ").trim_start_matches("error: ").to_string());
             eprintln!("kiln: {said}");
-            let point = point_flag_on_bake(&e);
+            let point = point_flag_on_bake(&e, &args);
             for line in &lines[message.len()..] {
                 // clap's look-alike (`--roughness-axis` for `--roughness`) is not what someone
                 // who names a point wants: the tip below replaces it.

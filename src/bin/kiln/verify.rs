@@ -1,7 +1,7 @@
 //! `kiln verify`: the audit of a table, kiln's or an engine's, against the reference or another
 //! table ([`kiln::verify::audit`]).
 
-use crate::args::{SEE_CONVENTIONS, parse_error_bound, parse_number};
+use crate::args::{SEE_CONVENTIONS, parse_clamp, parse_error_bound};
 use crate::external::ExternalLayout;
 use crate::report::{
     FileGate, json_report, plot_kind_of, print_verdict, quiet_verdict, write_plot,
@@ -80,15 +80,6 @@ pub struct VerifyArgs {
     /// stderr. For build gates. Not with --json, which prints the report.
     #[arg(long, short, conflicts_with = "json")]
     quiet: bool,
-}
-
-fn parse_clamp(text: &str) -> Result<f64, String> {
-    let value = parse_number(text)?;
-    if (0.0..1.0).contains(&value) {
-        Ok(value)
-    } else {
-        Err(format!("clamp-min must be in [0, 1) (got {text})"))
-    }
 }
 
 impl VerifyArgs {

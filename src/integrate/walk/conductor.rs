@@ -113,6 +113,37 @@ impl Tallies {
     }
 }
 
+/// The probability that an upward direction with `Lambda = lambda` leaves the microsurface from
+/// the height of `ln C1 = log_c1`: `C1^Lambda` (Heitz et al. 2016). At the very top (a grazing
+/// entry that met the surface at once) and on a mirror every upward direction leaves; `inf * 0`
+/// would say otherwise.
+#[inline(always)]
+fn escape_probability(lambda: f64, log_c1: f64, mirror: bool) -> f64 {
+    if log_c1 == 0.0 || mirror {
+        1.0
+    } else {
+        (lambda * log_c1).exp()
+    }
+}
+
+/// What is tallied as leaving at an upward vertex whose escape has `probability`: the
+/// probability itself ([`super::Escape::Expected`]), or, for the analog walk, all of the
+/// throughput or none of it, drawn.
+#[inline(always)]
+fn escaped_share(escape: super::Escape, probability: f64, random: &mut WalkRandom<'_>) -> f64 {
+    match escape {
+        super::Escape::Expected => probability,
+        super::Escape::Sampled if probability >= 1.0 => 1.0,
+        super::Escape::Sampled => {
+            if random.uniform() < probability {
+                1.0
+            } else {
+                0.0
+            }
+        }
+    }
+}
+
 /// What a walk tallies beside the orders.
 #[derive(Clone, Copy, Debug)]
 pub struct Asked<'a> {
@@ -148,8 +179,14 @@ pub fn walk<N: MicrofacetDistribution>(
     let lobe = asked.lobe.filter(|_| !tallies.lobe.is_empty());
     let rotations = lobe.map(|l| l.rotations(random)).unwrap_or_default();
     let to_the_end = *fresnel != Fresnel::None || polynomial.is_some() || lobe.is_some();
+    // The throughput's coefficients of F0^0 ..= F0^degree.
+    let mut coefficients = [0.0; MAX_DEGREE + 1];
+    coefficients[0] = 1.0;
+    let mut degree = 0;
     let tallied = tallies.orders.len() as u32;
-    let mut throughput = Throughput::new();
+    // Throughput with F = 1 (for the orders) and with the Fresnel factors (per channel).
+    let mut plain = 1.0;
+    let mut coloured: Rgb = [1.0; 3];
     // The first hit, travelling down from above the surface (ln C1 = 0).
     let mut w = Vec3::new(-wi.x, -wi.y, -wi.z);
     let mut h = heights.height(log_c1_of_hit_below(0.0, ndf.lambda(wi), random.uniform()));
@@ -160,16 +197,16 @@ pub fn walk<N: MicrofacetDistribution>(
         let log_c1 = heights.log_c1(h);
         let v = Vec3::new(-w.x, -w.y, -w.z);
         if let Some(lobe) = lobe {
-            let carried = if lobe.has_fresnel() {
-                throughput.coloured[0]
+            let throughput = if lobe.has_fresnel() {
+                coloured[0]
             } else {
-                throughput.plain
+                plain
             };
             lobe.add(
                 ndf,
                 v,
                 log_c1,
-                carried,
+                throughput,
                 vertex,
                 &rotations,
                 &mut tallies.lobe,
@@ -185,11 +222,23 @@ pub fn walk<N: MicrofacetDistribution>(
         };
         let cosine = v.dot(m);
         if let Some(f90) = polynomial {
-            throughput.times_schlick(f90, cosine, &mut tallies.dropped[0]);
+            // Times F0 (1 - s) + F90 s, s = (1 - c)^5: every coefficient moves up a power.
+            let s = (1.0 - cosine.clamp(0.0, 1.0)).powi(5);
+            let (a, b) = (1.0 - s, f90 * s);
+            if degree == MAX_DEGREE {
+                tallies.dropped[0] += a * coefficients[MAX_DEGREE];
+            } else {
+                degree += 1;
+                coefficients[degree] = 0.0;
+            }
+            for j in (1..=degree).rev() {
+                coefficients[j] = a * coefficients[j - 1] + b * coefficients[j];
+            }
+            coefficients[0] *= b;
         }
         if *fresnel != Fresnel::None {
             let f = fresnel.reflectance(cosine);
-            for (c, f) in throughput.coloured.iter_mut().zip(f) {
+            for (c, f) in coloured.iter_mut().zip(f) {
                 *c *= f;
             }
         }
@@ -199,35 +248,29 @@ pub fn walk<N: MicrofacetDistribution>(
         // `MAX_VERTICES` steps.
         if w.z > 0.0 || mirror {
             let lambda = ndf.lambda(w);
-            // At the very top (a grazing entry that met the surface at once) every upward
-            // direction leaves; `inf * 0` would say otherwise.
-            let probability = if log_c1 == 0.0 || mirror {
-                1.0
+            let probability = escape_probability(lambda, log_c1, mirror);
+            let escape = escaped_share(asked.escape, probability, random);
+            if vertex <= tallied {
+                tallies.orders[vertex as usize - 1] += plain * escape;
             } else {
-                (lambda * log_c1).exp()
-            };
-            // What is tallied as leaving: the probability itself, or (the analog walk) all of
-            // the throughput or none of it.
-            let escape = match asked.escape {
-                super::Escape::Expected => probability,
-                super::Escape::Sampled if probability >= 1.0 => 1.0,
-                super::Escape::Sampled => {
-                    if random.uniform() < probability {
-                        1.0
-                    } else {
-                        0.0
-                    }
+                tallies.beyond += plain * escape;
+            }
+            for (a, c) in tallies.albedo.iter_mut().zip(coloured) {
+                *a += c * escape;
+            }
+            if polynomial.is_some() {
+                for (t, c) in tallies.polynomial.iter_mut().zip(&coefficients[..=degree]) {
+                    *t += c * escape;
                 }
-            };
-            throughput.tally_escape(tallies, vertex, escape, polynomial.is_some());
+            }
             if escape >= 1.0 {
                 return false;
             }
-            throughput.plain *= 1.0 - escape;
-            for c in &mut throughput.coloured {
+            plain *= 1.0 - escape;
+            for c in &mut coloured {
                 *c *= 1.0 - escape;
             }
-            for c in throughput.polynomial_mut() {
+            for c in &mut coefficients[..=degree] {
                 *c *= 1.0 - escape;
             }
             // A hit below h given no escape: C1(h') = C1(h) / (1 - u (1 - P))^(1 / Lambda),
@@ -238,96 +281,28 @@ pub fn walk<N: MicrofacetDistribution>(
             h = heights.height(log_c1_of_hit_below(log_c1, ndf.lambda(w), random.uniform()));
         }
         if !to_the_end && vertex == tallied {
-            tallies.beyond += throughput.plain;
+            tallies.beyond += plain;
             return false;
         }
         if vertex >= MAX_VERTICES {
-            for (d, c) in tallies.dropped.iter_mut().zip(throughput.coloured) {
+            for (d, c) in tallies.dropped.iter_mut().zip(coloured) {
                 *d += c;
             }
             if polynomial.is_some() {
-                tallies.dropped[0] += throughput.polynomial_mut().iter().sum::<f64>();
+                tallies.dropped[0] += coefficients[..=degree].iter().sum::<f64>();
             }
             return true;
         }
-        if throughput.plain < ROULETTE {
-            let Some(survive) = survives(throughput.plain, random) else {
+        if plain < ROULETTE {
+            let Some(survive) = survives(plain, random) else {
                 return false;
             };
-            throughput.plain = ROULETTE;
-            for c in &mut throughput.coloured {
+            plain = ROULETTE;
+            for c in &mut coloured {
                 *c /= survive;
             }
-            for c in throughput.polynomial_mut() {
+            for c in &mut coefficients[..=degree] {
                 *c /= survive;
-            }
-        }
-    }
-}
-
-/// A walk's throughput: with `F = 1` (for the orders), with the Fresnel factors (per channel),
-/// and as a polynomial in `F0` (its coefficients of `F0^0 ..= F0^degree`).
-struct Throughput {
-    plain: f64,
-    coloured: Rgb,
-    coefficients: [f64; MAX_DEGREE + 1],
-    degree: usize,
-}
-
-impl Throughput {
-    /// All of the light, before the first vertex.
-    fn new() -> Self {
-        let mut coefficients = [0.0; MAX_DEGREE + 1];
-        coefficients[0] = 1.0;
-        Self {
-            plain: 1.0,
-            coloured: [1.0; 3],
-            coefficients,
-            degree: 0,
-        }
-    }
-
-    /// The polynomial's coefficients in use, `F0^0 ..= F0^degree`.
-    fn polynomial_mut(&mut self) -> &mut [f64] {
-        &mut self.coefficients[..=self.degree]
-    }
-
-    /// Times Schlick's `F0 (1 - s) + F90 s`, `s = (1 - c)^5`: every coefficient moves up a
-    /// power; at [`MAX_DEGREE`] the top one's `F0` share is added to `dropped` instead.
-    fn times_schlick(&mut self, f90: f64, cosine: f64, dropped: &mut f64) {
-        let s = (1.0 - cosine.clamp(0.0, 1.0)).powi(5);
-        let (a, b) = (1.0 - s, f90 * s);
-        if self.degree == MAX_DEGREE {
-            *dropped += a * self.coefficients[MAX_DEGREE];
-        } else {
-            self.degree += 1;
-            self.coefficients[self.degree] = 0.0;
-        }
-        for j in (1..=self.degree).rev() {
-            self.coefficients[j] = a * self.coefficients[j - 1] + b * self.coefficients[j];
-        }
-        self.coefficients[0] *= b;
-    }
-
-    /// Tallies the share `escape` of the throughput that leaves after `vertex`: to its order
-    /// (or beyond the orders tallied), to the albedo per channel, and to the polynomial's
-    /// coefficients when the walk carries one.
-    fn tally_escape(&self, tallies: &mut Tallies, vertex: u32, escape: f64, polynomial: bool) {
-        if vertex <= tallies.orders.len() as u32 {
-            tallies.orders[vertex as usize - 1] += self.plain * escape;
-        } else {
-            tallies.beyond += self.plain * escape;
-        }
-        for (a, c) in tallies.albedo.iter_mut().zip(self.coloured) {
-            *a += c * escape;
-        }
-        if polynomial {
-            for (t, c) in tallies
-                .polynomial
-                .iter_mut()
-                .zip(&self.coefficients[..=self.degree])
-            {
-                *t += c * escape;
             }
         }
     }
