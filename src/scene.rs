@@ -27,6 +27,7 @@
 //! roughness = 0.1
 //! fresnel = { dielectric = { ior = 1.5 } }
 //! transmission = true           # glass: light refracts through (needs a dielectric fresnel)
+//! ior_varies = false            # true: a textured IOR, read from the tables over the IOR
 //! image_based_lighting = true   # the split-sum tables (default false)
 //! multiple_scattering = true    # Kulla-Conty's tables (the default)
 //! ```
@@ -44,9 +45,13 @@
 //! compensation of glass, [`crate::model::dielectric`]), and per material the scalars it needs:
 //! `F_avg` per channel ([`crate::Fresnel::average`]) for the lobe's colour term.
 //!
-//! The dielectric tables are [`DIELECTRIC_SIZE`] samples per axis (Cycles' 16 x 16 x 16), with an
-//! IOR axis from 1 to the larger of 3 and the scene's highest `max(ior, 1 / ior)`; they are baked
-//! as a bake of their own, so adding a glass material never re-bakes the `E` tables.
+//! A glass material of one IOR gets, for each distinct IOR, the four dielectric tables at exactly
+//! that IOR: [`ONE_IOR_SIZE`] x [`ONE_IOR_SIZE`] over (roughness, `mu`) from both sides, fitted
+//! for the bilinear lookup as `E` is ([`crate::table::TableSpec::fixed_ior`]). A glass material
+//! whose IOR varies (`ior_varies = true`: textured, animated) gets them over the IOR instead,
+//! [`DIELECTRIC_SIZE`] samples per axis (Cycles' 16 x 16 x 16), with an IOR axis from 1 to the
+//! larger of 3 and the highest `max(ior, 1 / ior)` of those materials. Each is a bake of its own,
+//! so adding a glass material never re-bakes the `E` tables.
 
 use crate::error::{Error, Result};
 use crate::format::{Format, Precision};
@@ -62,8 +67,12 @@ use std::path::Path;
 /// colour multiplier.
 pub const MATERIALS_FILE: &str = "materials.json";
 
-/// Samples per axis of a scene's dielectric tables (IOR, roughness and `mu`).
+/// Samples per axis of a scene's dielectric tables over the IOR (IOR, roughness and `mu`), for
+/// the glass materials whose IOR varies.
 pub const DIELECTRIC_SIZE: usize = 16;
+
+/// Samples per axis (roughness and `mu`) of a scene's dielectric tables at one IOR.
+pub const ONE_IOR_SIZE: usize = 32;
 
 /// The dielectric tables a transmissive material's model needs.
 pub const DIELECTRIC_QUANTITIES: [Quantity; 4] = [
@@ -116,6 +125,11 @@ pub struct Material {
     /// dielectric tables. Needs a dielectric Fresnel.
     #[serde(default)]
     pub transmission: bool,
+    /// Whether a glass material's IOR varies over the surface or in time (textured, animated):
+    /// its dielectric tables are then those over the IOR, which a renderer reads at each
+    /// shading point's IOR; otherwise the tables at its one IOR. Needs `transmission`.
+    #[serde(default)]
+    pub ior_varies: bool,
     /// Whether the renderer compensates the energy single scattering loses (Kulla-Conty: `E`,
     /// `E_avg`, `f_ms_norm`). On unless turned off.
     #[serde(default = "on")]
@@ -140,6 +154,16 @@ impl Material {
         Model {
             ndf: self.ndf,
             masking: self.masking,
+        }
+    }
+
+    /// The IOR of a glass material whose IOR does not vary: its dielectric tables are at that
+    /// IOR alone. `None` for a material that does not refract or whose IOR varies.
+    #[must_use]
+    pub fn one_ior(&self) -> Option<f64> {
+        match self.fresnel {
+            FresnelSpec::Dielectric { ior } if self.transmission && !self.ior_varies => Some(ior),
+            _ => None,
         }
     }
 
@@ -382,6 +406,14 @@ impl Scene {
                     m.name
                 )));
             }
+            if m.ior_varies && !m.transmission {
+                return Err(bad(format!(
+                    "material '{}': ior_varies = true chooses the glass tables over the IOR, \
+                     and needs transmission = true (a material that does not refract has no \
+                     glass tables)",
+                    m.name
+                )));
+            }
         }
         if let Some(preset) = self.preset() {
             self.validate_for(preset).map_err(|e| bad(e.to_string()))?;
@@ -556,6 +588,11 @@ impl Scene {
         }
         let ior_max = self.ior_max();
         let mut needs = Vec::new();
+        let glass_materials = |model: Model| {
+            self.materials
+                .iter()
+                .filter(move |m| m.transmission && m.model() == model)
+        };
         for model in self.models() {
             let base = crate::BakeOptions {
                 ndfs: vec![model.ndf],
@@ -576,7 +613,24 @@ impl Scene {
                 };
                 needs.push((split_sum, Some(Effect::ImageBasedLighting), model));
             }
-            if asked(Effect::Transmission) {
+            // The tables at each distinct IOR, in order of first appearance, then those over
+            // the IOR for the materials whose IOR varies.
+            let mut iors: Vec<f64> = Vec::new();
+            for ior in glass_materials(model).filter_map(Material::one_ior) {
+                if !iors.contains(&ior) {
+                    iors.push(ior);
+                }
+            }
+            for ior in iors {
+                let glass = crate::BakeOptions {
+                    quantities: DIELECTRIC_QUANTITIES.to_vec(),
+                    size: ONE_IOR_SIZE,
+                    fresnel: Some(Fresnel::Dielectric { eta: ior }),
+                    ..base.clone()
+                };
+                needs.push((glass, Some(Effect::Transmission), model));
+            }
+            if glass_materials(model).any(|m| m.ior_varies) {
                 let glass = crate::BakeOptions {
                     quantities: DIELECTRIC_QUANTITIES.to_vec(),
                     size: DIELECTRIC_SIZE,
@@ -602,13 +656,14 @@ impl Scene {
         }
     }
 
-    /// The top of the dielectric tables' IOR axis: 3, or the scene's highest
-    /// `max(ior, 1 / ior)` of a transmissive material if that is higher.
+    /// The top of the dielectric tables' IOR axis: 3, or the highest `max(ior, 1 / ior)` of a
+    /// transmissive material whose IOR varies if that is higher (the others have tables at
+    /// their own IOR).
     #[must_use]
     pub fn ior_max(&self) -> f64 {
         self.materials
             .iter()
-            .filter(|m| m.transmission)
+            .filter(|m| m.transmission && m.ior_varies)
             .filter_map(|m| match m.fresnel {
                 FresnelSpec::Dielectric { ior } => Some(ior.max(1.0 / ior)),
                 _ => None,
@@ -641,6 +696,17 @@ impl Scene {
                     .collect(),
             };
             let materials = match effect {
+                // A glass bake serves the materials of its IOR, or those whose IOR varies.
+                Some(Effect::Transmission) if self.preset().is_none() => self
+                    .materials
+                    .iter()
+                    .filter(|m| m.transmission && m.model() == model)
+                    .filter(|m| match options.fresnel {
+                        Some(Fresnel::Dielectric { eta }) => m.one_ior() == Some(eta),
+                        _ => m.ior_varies,
+                    })
+                    .map(|m| m.name.clone())
+                    .collect(),
                 Some(effect) => self.asking(Some(model), &[effect]),
                 None => self.asking(Some(model), &engine_effects),
             };
@@ -879,7 +945,8 @@ impl Scene {
         let materials: Vec<serde_json::Value> = plan
             .materials
             .iter()
-            .map(|m| {
+            .zip(&self.materials)
+            .map(|(m, material)| {
                 let average = tables.iter().find(|t| {
                     t.spec.quantity == Quantity::EAvg
                         && t.spec.model.ndf == m.ndf
@@ -895,6 +962,20 @@ impl Scene {
                     "f_avg": m.f_avg,
                     "e_avg_table": average.map(|t| t.spec.id()),
                 });
+                if material.transmission && self.preset().is_none() {
+                    // The glass tables this material reads: at its IOR, or over the IOR.
+                    let glass: serde_json::Map<String, serde_json::Value> = tables
+                        .iter()
+                        .filter(|t| {
+                            DIELECTRIC_QUANTITIES.contains(&t.spec.quantity)
+                                && t.spec.model == material.model()
+                                && t.spec.fixed_ior() == material.one_ior()
+                        })
+                        .map(|t| (t.spec.quantity.symbol().to_string(), t.spec.id().into()))
+                        .collect();
+                    object["glass_tables"] = glass.into();
+                    object["ior_varies"] = material.ior_varies.into();
+                }
                 if let (Some(table), [lo, hi]) = (average, m.roughness)
                     && lo == hi
                 {
@@ -915,6 +996,9 @@ impl Scene {
             "colour_multiplier": "per channel, F_avg^2 E_avg / (1 - F_avg (1 - E_avg)): the \
                                   factor of the Kulla-Conty lobe f_ms (E_avg looked up in \
                                   e_avg_table at the material's roughness)",
+            "glass_tables": "per glass material, the dielectric tables it reads, by quantity: \
+                             at its one IOR (2-D, over roughness and mu), or over the IOR for a \
+                             material whose IOR varies (ior_varies)",
             "materials": materials,
         });
         let mut bytes = serde_json::to_vec_pretty(&document).unwrap_or_default();
@@ -1051,6 +1135,8 @@ fresnel = { schlick = { f0 = 0.04 } }
         assert_eq!(plan.materials[0].roughness, [0.2, 0.6]);
     }
 
+    /// A glass of one IOR gets the four tables at that IOR, 32 x 32; a glass whose IOR varies
+    /// those over the IOR, up to its index; each for its own model, each bake of its own.
     #[test]
     fn glass_adds_the_dielectric_tables_for_its_model_only() {
         let scene = Scene::parse(
@@ -1058,7 +1144,9 @@ fresnel = { schlick = { f0 = 0.04 } }
              [[material]]\nname = \"window\"\nndf = \"ggx\"\nroughness = 0.1\n\
              fresnel = { dielectric = { ior = 1.5 } }\ntransmission = true\n\n\
              [[material]]\nname = \"gem\"\nndf = \"ggx\"\nroughness = 0.0\n\
-             fresnel = { dielectric = { ior = 3.4 } }\ntransmission = true\n\n\
+             fresnel = { dielectric = { ior = 3.4 } }\ntransmission = true\nior_varies = true\n\n\
+             [[material]]\nname = \"pane\"\nndf = \"ggx\"\nroughness = 0.2\n\
+             fresnel = { dielectric = { ior = 1.5 } }\ntransmission = true\n\n\
              [[material]]\nname = \"tile\"\nndf = \"beckmann\"\nroughness = 0.3\n\
              fresnel = { dielectric = { ior = 1.5 } }\n",
             "glass.toml",
@@ -1077,19 +1165,30 @@ fresnel = { schlick = { f0 = 0.04 } }
                 (Ndf::Ggx, Quantity::EDielectricInside),
                 (Ndf::Ggx, Quantity::EAvgDielectric),
                 (Ndf::Ggx, Quantity::EAvgDielectricInside),
+                (Ndf::Ggx, Quantity::EDielectric),
+                (Ndf::Ggx, Quantity::EDielectricInside),
+                (Ndf::Ggx, Quantity::EAvgDielectric),
+                (Ndf::Ggx, Quantity::EAvgDielectricInside),
                 (Ndf::Beckmann, Quantity::E),
                 (Ndf::Beckmann, Quantity::EAvg),
                 (Ndf::Beckmann, Quantity::FMsNorm),
             ]
         );
-        assert_eq!(plan.tables[0].materials, ["steel", "window", "gem"]);
-        assert_eq!(plan.tables[3].materials, ["window", "gem"]);
-        assert!(plan.materials[1].transmission && !plan.materials[3].transmission);
+        assert_eq!(plan.tables[0].materials, ["steel", "window", "gem", "pane"]);
+        // The window and the pane share the tables at 1.5; the gem reads those over the IOR.
+        assert_eq!(
+            plan.tables[3].id,
+            "ggx-height-correlated-E_dielectric-ior-1.5"
+        );
+        assert_eq!(plan.tables[3].materials, ["window", "pane"]);
+        assert_eq!(plan.tables[7].id, "ggx-height-correlated-E_dielectric");
+        assert_eq!(plan.tables[7].materials, ["gem"]);
+        assert!(plan.materials[1].transmission && !plan.materials[4].transmission);
         // The IOR axis reaches the gem's 3.4; the E tables' options are those of a scene
         // without glass (their cache keys do not change when glass is added).
         assert_eq!(scene.ior_max(), 3.4);
         let options = scene.bake_options();
-        assert_eq!(options.len(), 3);
+        assert_eq!(options.len(), 4);
         assert_eq!(options[0], {
             let no_glass = Scene {
                 materials: vec![scene.materials[0].clone()],
@@ -1099,8 +1198,29 @@ fresnel = { schlick = { f0 = 0.04 } }
             no_glass.bake_options()[0].clone()
         });
         assert_eq!(options[1].quantities, DIELECTRIC_QUANTITIES);
-        assert_eq!(options[1].ior_max, 3.4);
-        assert_eq!(options[1].size, DIELECTRIC_SIZE);
+        assert_eq!(options[1].fresnel, Some(Fresnel::Dielectric { eta: 1.5 }));
+        assert_eq!(options[1].size, ONE_IOR_SIZE);
+        assert_eq!(options[2].quantities, DIELECTRIC_QUANTITIES);
+        assert_eq!(options[2].ior_max, 3.4);
+        assert_eq!(options[2].size, DIELECTRIC_SIZE);
+        assert_eq!(options[2].fresnel, None);
+    }
+
+    /// `ior_varies` describes a glass: on a material that does not refract it is refused by
+    /// name.
+    #[test]
+    fn ior_varies_needs_transmission() {
+        let error = Scene::parse(
+            "[[material]]\nname = \"cup\"\nndf = \"ggx\"\nroughness = 0.1\n\
+             fresnel = { dielectric = { ior = 1.5 } }\nior_varies = true\n",
+            "cup.toml",
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            error.contains("cup") && error.contains("ior_varies") && error.contains("transmission"),
+            "{error}"
+        );
     }
 
     #[test]

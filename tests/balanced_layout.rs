@@ -53,9 +53,10 @@ fn hidden_points() -> Vec<(f64, f64)> {
 
 /// C++ stand-ins for the HLSL the generated lookup uses, with a 2-D texture sampled as a GPU
 /// samples it (bilinear, clamp to edge, texel centres at `(i + 0.5) / N`).
-const PRELUDE: &str = "#include <cmath>
+pub(crate) const HLSL_2D_PRELUDE: &str = "#include <cmath>
 #include <cstdio>
 #include <vector>
+using std::atan;
 using std::exp;
 using std::pow;
 inline float min(float a, float b) { return a < b ? a : b; }
@@ -116,7 +117,7 @@ fn the_fitted_32x32_lookup_meets_2_5e_4_through_the_generated_code() {
         .zip(&table.one_minus_value)
         .flat_map(|(v, w)| [format!("{:?}f", *v as f32), format!("{:?}f", *w as f32)])
         .collect();
-    let mut source = format!("{PRELUDE}{hlsl}\nint main() {{\n");
+    let mut source = format!("{HLSL_2D_PRELUDE}{hlsl}\nint main() {{\n");
     let _ = writeln!(source, "  Tex2 tex{{32, 32, {{{}}}}};", texels.join(", "));
     for &(mu, r) in &points {
         let _ = writeln!(

@@ -8,7 +8,7 @@ use kiln::{BakeOptions, Grid, MuMapping, Quantity, Table};
 
 /// Tables of every shape and axis kind: E on the adaptive axis with nodes and on the sqrt axis
 /// with centres, E_avg (1-D), E_dielectric (3-D, IOR axis) and F_avg (1-D over the IOR), and
-/// kiln's balanced, split-sum and glass layouts.
+/// kiln's balanced, split-sum, glass and one-IOR glass layouts.
 fn tables() -> Vec<Table> {
     let base = BakeOptions {
         size: 3,
@@ -43,6 +43,17 @@ fn tables() -> Vec<Table> {
         BakeOptions {
             quantities: vec![Quantity::EScale, Quantity::EBias],
             mu_mapping: Some(MuMapping::SplitSum),
+            ..base.clone()
+        }
+        .bake(&|_| {})
+        .unwrap(),
+    );
+    // kiln's layout of glass at one IOR, from both sides (the inside one with its critical
+    // angle's step).
+    tables.extend(
+        BakeOptions {
+            quantities: vec![Quantity::EDielectric, Quantity::EDielectricInside],
+            fresnel: Some(kiln::Fresnel::Dielectric { eta: 1.5 }),
             ..base.clone()
         }
         .bake(&|_| {})
@@ -251,7 +262,8 @@ fn gpu_filtering_at_the_generated_coordinates_equals_the_table_lookup() {
         for a in 0..=20 {
             for b in 0..=20 {
                 let (mu, r) = (a as f64 / 20.0, b as f64 / 20.0);
-                let t_mu = mapping.coordinate(mu, r * r, size);
+                // At the table's own index (a glass table at one IOR lays mu out by it).
+                let t_mu = mapping.coordinate_at(mu, r * r, table.spec.mapping_eta(1.0), size);
                 let t_r = spacing.coordinate(r, convention);
                 let sampled = gpu_sample(table, gpu(t_mu, mu_axis), gpu(t_r, r_axis));
                 let expected = table.lookup(mu, r);

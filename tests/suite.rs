@@ -47,6 +47,7 @@ mod fresnel;
 mod furnace;
 mod generated_rust;
 mod glass_layout;
+mod glass_one_ior;
 mod gpu_shaders;
 mod hard_cases;
 mod hard_grid;

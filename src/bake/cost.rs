@@ -111,7 +111,9 @@ pub fn estimated_core_seconds(spec: &TableSpec) -> f64 {
 /// each at 0.45 of a texel's figure of
 /// [`crate::integrate::cost::reference_seconds`] (the fit's points are between the texels, where the
 /// integrands are tamer; measured on 32 x 32 and 64 x 64 `E` bakes, 3.4 s and 5.3 s whole
-/// process on 2 cores, 2026-12-04), and its Lawson iterations, each a banded Cholesky solve of
+/// process on 2 cores, 2026-12-04; a glass albedo's at 1.3 of it: the two 32 x 32 tables at
+/// one IOR, 1.5, fitted in 15.6 s of a 17.7 s bake on 2 cores, 2026-12-08, where the figure at
+/// 0.45 said 6.4 s), and its Lawson iterations, each a banded Cholesky solve of
 /// about `texels x (band + 1)^2` multiply-adds at 1.2 ns (fitted to a 128 x 128 bake, 26 s).
 #[must_use]
 pub fn lookup_fit_core_seconds(spec: &TableSpec) -> f64 {
@@ -123,7 +125,13 @@ pub fn lookup_fit_core_seconds(spec: &TableSpec) -> f64 {
     let settings = lookup_fit_settings(spec);
     let solve = settings.iterations as f64 * spec.len() as f64 * band * band * 1.2e-9;
     let digits = (-settings.tolerance.log10()).round().max(1.0) as u32;
-    0.45 * evaluations as f64
+    let share = if spec.quantity.is_glass_albedo() {
+        1.3
+    } else {
+        0.45
+    };
+    share
+        * evaluations as f64
         * crate::integrate::cost::reference_seconds(spec.quantity, spec.model, digits)
         + solve
 }

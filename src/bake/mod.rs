@@ -200,7 +200,27 @@ impl BakeOptions {
     #[must_use]
     pub fn mu_mapping_for(&self, quantity: Quantity) -> MuMapping {
         self.mu_mapping
-            .unwrap_or_else(|| MuMapping::kiln_default(quantity))
+            .unwrap_or_else(|| MuMapping::kiln_default(quantity, self.over_ior(quantity)))
+    }
+
+    /// The material's index of refraction of `quantity`'s table when it is a glass albedo
+    /// at one IOR: a dielectric Fresnel model named beside a glass quantity (`--ior 1.5`), a 2-D
+    /// table at that index (`TableSpec::fixed_ior`); `None` otherwise.
+    #[must_use]
+    pub fn fixed_ior_for(&self, quantity: Quantity) -> Option<f64> {
+        match self.fresnel {
+            Some(crate::model::Fresnel::Dielectric { eta }) if quantity.is_glass_albedo() => {
+                Some(eta)
+            }
+            _ => None,
+        }
+    }
+
+    /// Whether `quantity`'s table has an IOR axis: `F_avg` and the glass albedos but those at
+    /// one IOR ([`BakeOptions::fixed_ior_for`]).
+    #[must_use]
+    pub fn over_ior(&self, quantity: Quantity) -> bool {
+        quantity.has_ior() && self.fixed_ior_for(quantity).is_none()
     }
 
     /// The roughness spacing of `quantity`'s table: the one named, or the one that goes with
@@ -223,7 +243,7 @@ impl BakeOptions {
         if quantity == Quantity::FAvg {
             return Texels::Nodes;
         }
-        if quantity.has_ior() {
+        if self.over_ior(quantity) {
             return self.texels.unwrap_or(Texels::Nodes);
         }
         self.texels.unwrap_or_else(|| {
@@ -257,9 +277,7 @@ impl BakeOptions {
     /// one), which a bake to a max error computes by the quadrature.
     #[must_use]
     pub fn any_glass(quantities: &[Quantity]) -> bool {
-        quantities
-            .iter()
-            .any(|q| q.has_ior() && *q != Quantity::FAvg)
+        quantities.iter().any(|q| q.is_glass_albedo())
     }
 
     /// The models baked, in a fixed order.
@@ -339,24 +357,26 @@ impl BakeOptions {
                             lookup_of: None,
                             refined_start: None,
                             texels: self.texels_for(quantity),
-                            transmission: if quantity.has_ior() && quantity != Quantity::FAvg {
+                            transmission: if quantity.is_glass_albedo() {
                                 self.transmission
                             } else {
                                 TransmissionConvention::SingleScattering
                             },
                             model,
                             quantity,
-                            ior: quantity.has_ior().then_some(
+                            ior: self.over_ior(quantity).then_some(
                                 if glass_layout && quantity == Quantity::FAvg {
                                     f_avg_ior
                                 } else {
                                     ior
                                 },
                             ),
-                            fresnel: self.fresnel.filter(|_| quantity == Quantity::EF),
+                            fresnel: self.fresnel.filter(|_| {
+                                quantity == Quantity::EF || self.fixed_ior_for(quantity).is_some()
+                            }),
                             roughness: quantity.has_roughness().then(|| roughness(quantity)),
                             mu: quantity.has_mu().then_some(
-                                if glass_layout && quantity.has_ior() {
+                                if glass_layout && self.over_ior(quantity) {
                                     glass_mu
                                 } else {
                                     mu(quantity)
@@ -406,7 +426,7 @@ impl BakeOptions {
         if let Some(fresnel) = self.fresnel {
             flag += &format!(" {}", fresnel.flags());
         }
-        if quantities.iter().any(|q| q.has_ior()) {
+        if quantities.iter().any(|&q| self.over_ior(q)) {
             flag += &format!(
                 " --ior-size {} --ior-axis {} --ior-max {}",
                 self.ior_size,

@@ -27,11 +27,9 @@ impl BakeOptions {
                 crate::error::shown(self.ior_max)
             )));
         }
-        if let Some(q) = self
-            .quantities()
-            .into_iter()
-            .find(|&q| q.has_ior() && self.roughness_spacing_for(q) == RoughnessSpacing::Balanced)
-        {
+        if let Some(q) = self.quantities().into_iter().find(|&q| {
+            self.over_ior(q) && self.roughness_spacing_for(q) == RoughnessSpacing::Balanced
+        }) {
             return Err(Error::InvalidInput(format!(
                 "--roughness-spacing balanced (the default with --mu-axis balanced) lays out the \
                  tables over roughness and mu; {} is over the IOR too, whose rows stay linear: \
@@ -39,11 +37,7 @@ impl BakeOptions {
                 q.symbol()
             )));
         }
-        if !self.transmission.is_default()
-            && !self
-                .quantities()
-                .iter()
-                .any(|q| q.has_ior() && *q != Quantity::FAvg)
+        if !self.transmission.is_default() && !self.quantities().iter().any(|q| q.is_glass_albedo())
         {
             return Err(Error::InvalidInput(format!(
                 "transmission {} applies to the dielectric tables only (e-dielectric, \
@@ -63,7 +57,7 @@ impl BakeOptions {
         }
         if self.ior_mapping == IorMapping::Glass
             && let Some(q) = self.quantities.iter().find(|&&q| {
-                q.has_ior() && q.has_mu() && self.mu_mapping_for(q) != MuMapping::Adaptive
+                self.over_ior(q) && q.has_mu() && self.mu_mapping_for(q) != MuMapping::Adaptive
             })
         {
             let mapping = self.mu_mapping_for(*q);
@@ -94,6 +88,13 @@ impl BakeOptions {
                 }
             )));
         }
+        let one_ior = self
+            .quantities
+            .iter()
+            .any(|&q| self.fixed_ior_for(q).is_some());
+        if let Some(ior) = self.quantities.iter().find_map(|&q| self.fixed_ior_for(q)) {
+            crate::table::check::check_fixed_ior(ior)?;
+        }
         match (self.quantities.contains(&Quantity::EF), self.fresnel) {
             (true, None) => {
                 return Err(Error::InvalidInput(
@@ -110,10 +111,12 @@ impl BakeOptions {
                         .into(),
                 ));
             }
+            (false, Some(_)) if one_ior => {}
             (false, Some(_)) => {
                 return Err(Error::InvalidInput(
-                    "a Fresnel model applies to the Fresnel-weighted table: add --quantity e-f \
-                     (the other tables are for F = 1, or over the IOR for glass)"
+                    "a Fresnel model applies to the Fresnel-weighted table (add --quantity e-f) \
+                     and, as --ior, to the glass tables at one IOR (--quantity e-dielectric and \
+                     the others); the other tables are for F = 1"
                         .into(),
                 ));
             }

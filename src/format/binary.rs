@@ -90,6 +90,7 @@ fn axis_descriptor(axis: Option<&Axis>) -> [u32; 4] {
                 MuMapping::Glass => 3,
                 MuMapping::Balanced => 4,
                 MuMapping::SplitSum => 5,
+                MuMapping::OneIor => 6,
             };
             [1, m, grid(g), 0]
         }
@@ -134,7 +135,9 @@ pub fn encode(table: &Table, precision: Precision) -> Vec<u8> {
     let count = table.spec.len();
     let names = table.channel_names();
     let dtypes = [precision, precision, Precision::F32];
-    let v2 = table.spec.ior.is_some();
+    // Version 2's longer names hold the glass channels' (`one_minus_E_dielectric_inside`),
+    // also for a glass table at one IOR, which has two axes.
+    let v2 = table.spec.ior.is_some() || names.iter().any(|name| name.len() > NAME_BYTES);
     let (fixed, entry_size, name_bytes) = if v2 {
         (FIXED_HEADER_IOR, CHANNEL_ENTRY_IOR, NAME_BYTES_IOR)
     } else {

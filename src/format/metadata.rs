@@ -191,16 +191,28 @@ impl Metadata {
                     "Schlick weight Fc = (1 - o.h)^5 (or 1 - Fc) on F = 1; see description"
                         .to_string()
                 }
-                (None, true) => format!(
-                    "exact dielectric, relative index {} (eta from the eta axis)",
-                    if spec.quantity.from_inside() {
-                        "1 / eta"
-                    } else {
-                        "eta"
-                    }
-                ),
+                (None, true) => match spec.fixed_ior() {
+                    Some(ior) => format!(
+                        "exact dielectric at one IOR, {ior}: relative index {}",
+                        if spec.quantity.from_inside() {
+                            format!("1 / {ior}")
+                        } else {
+                            ior.to_string()
+                        }
+                    ),
+                    None => format!(
+                        "exact dielectric, relative index {} (eta from the eta axis)",
+                        if spec.quantity.from_inside() {
+                            "1 / eta"
+                        } else {
+                            "eta"
+                        }
+                    ),
+                },
             },
-            transmission: (spec.quantity.has_ior() && spec.quantity != Quantity::FAvg)
+            transmission: spec
+                .quantity
+                .is_glass_albedo()
                 .then(|| spec.transmission.describe().to_string()),
             roughness_convention: match spec.roughness {
                 Some(_) => spec.roughness_convention().name().to_string(),

@@ -12,6 +12,7 @@ use crate::table::axis::{
 };
 use crate::table::balanced_layout::BalancedLayout;
 use crate::table::glass_layout;
+use crate::table::one_ior_layout::OneIorLayout;
 use crate::table::split_sum_layout::SplitSumLayout;
 use std::fmt::Write as _;
 
@@ -22,10 +23,19 @@ const GLASS: glass_layout::GlassLayout = glass_layout::GlassLayout::KILN;
 /// (`1 - E(1, alpha = 1) = ln 2`), which clippy would flag in the including crate.
 const ALLOW: &str = "#[allow(clippy::approx_constant)]";
 
-/// The constant name of a table's values: `GGX_HEIGHT_CORRELATED_E`.
+/// The constant name of a table's values: `GGX_HEIGHT_CORRELATED_E`; every character of the
+/// table's name that cannot be in an identifier becomes `_` (`..._E_DIELECTRIC_IOR_1_5` for
+/// `...-E_dielectric-ior-1.5`: the dot of a parameter in the name, as in `E_F`'s
+/// `-dielectric-1.5`, made the generated Rust, C and shaders fail to compile before).
 #[must_use]
 pub fn const_prefix(table: &Table) -> String {
-    table.spec.id().to_uppercase().replace('-', "_")
+    table
+        .spec
+        .id()
+        .to_uppercase()
+        .chars()
+        .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
+        .collect()
 }
 
 /// The constant name of a table's `1 - value` channel: `GGX_HEIGHT_CORRELATED_E_ONE_MINUS`
@@ -128,6 +138,29 @@ fn coordinate_code(axis: &Axis) -> String {
                     l.scale as f32,
                     l.power as f32,
                     (1.0 - l.share) as f32,
+                )
+            }
+            MuMapping::OneIor => {
+                // `critical_share` and `critical_mu` come from the lookup (its one IOR).
+                let l = OneIorLayout::KILN;
+                let b = l.base();
+                format!(
+                    "{{\n        let k = {:?} * alpha * (1.0 + {:?} * alpha);\n        \
+                     let u = if mu <= 0.0 {{ 0.0 }} else if k > 0.0 {{ (mu * (1.0 + k) / (mu + k)).min(1.0) }} else {{ 1.0 }};\n        \
+                     let eps = {:?} * (-{:?} * alpha).exp();\n        \
+                     let low = eps.powf({p:?});\n        \
+                     let base = ((u + eps).powf({p:?}) - low) / ((1.0 + eps).powf({p:?}) - low);\n        \
+                     let s = {:?} * alpha + {:?};\n        \
+                     let at = |x: f32| ((x - critical_mu) / s).atan();\n        \
+                     let step = ((at(mu.clamp(0.0, 1.0)) - at(0.0)) / (at(1.0) - at(0.0))).clamp(0.0, 1.0);\n        \
+                     (1.0 - critical_share) * base + critical_share * step\n    }}",
+                    b.scale as f32,
+                    b.scale_growth as f32,
+                    b.offset_at(0.0, size) as f32,
+                    b.offset_decay as f32,
+                    l.critical_scale as f32,
+                    l.critical_floor as f32,
+                    p = b.power as f32,
                 )
             }
             MuMapping::Glass => {
@@ -306,6 +339,24 @@ fn write_lookup(out: &mut String, table: &Table, prefix: &str, ty: &str) {
             );
             if spec.coordinates_depend_on_roughness() {
                 let _ = writeln!(out, "    let alpha = {alpha};");
+            }
+            if let (
+                Some(ior),
+                Axis::Mu {
+                    mapping: MuMapping::OneIor,
+                    ..
+                },
+            ) = (spec.fixed_ior(), mu_axis)
+            {
+                // The one-IOR layout's critical angle, from inside only (its share 0 outside).
+                let eta = spec.relative_eta(ior);
+                let l = OneIorLayout::KILN;
+                let _ = writeln!(
+                    out,
+                    "    let (critical_share, critical_mu) = ({:?}_f32, {:?}_f32);",
+                    l.critical_share_at(eta) as f32,
+                    OneIorLayout::critical_mu(eta.min(1.0)) as f32
+                );
             }
             let _ = writeln!(out, "    let t_mu = {};", coordinate_code(&mu_axis));
             if let Some(line) = &t_r_line {

@@ -25,6 +25,7 @@ use crate::table::axis::{
 use crate::table::balanced_layout::BalancedLayout;
 use crate::table::compensation::CompensationTable;
 use crate::table::glass_layout;
+use crate::table::one_ior_layout::OneIorLayout;
 use crate::table::split_sum_layout::SplitSumLayout;
 use std::fmt::Write as _;
 
@@ -139,6 +140,29 @@ fn coordinate(language: Language, axis: &Axis) -> String {
                         ADAPTIVE_POWER
                     )
                 )
+            }
+            MuMapping::OneIor => {
+                // `balanced_k`, `balanced_eps`, `critical_share`, `critical_mu` and
+                // `critical_s` come from the preamble.
+                let p = literal(OneIorLayout::KILN.base().power);
+                let u = language.select(
+                    "mu <= 0.0",
+                    "0.0",
+                    "min(mu * (1.0 + balanced_k) / max(mu + balanced_k, 1e-30), 1.0)",
+                );
+                let base = format!(
+                    "(pow({u} + balanced_eps, {p}) - pow(balanced_eps, {p})) / (pow(1.0 + \
+                     balanced_eps, {p}) - pow(balanced_eps, {p}))"
+                );
+                let at = |x: &str| format!("atan(({x} - critical_mu) / critical_s)");
+                let step = format!(
+                    "min(max(({} - {}) / ({} - {}), 0.0), 1.0)",
+                    at("min(max(mu, 0.0), 1.0)"),
+                    at("0.0"),
+                    at("1.0"),
+                    at("0.0")
+                );
+                format!("(1.0 - critical_share) * ({base}) + critical_share * {step}")
             }
             MuMapping::Glass => {
                 // `layer_share` and `kappa` come from the preamble.
@@ -333,6 +357,50 @@ fn preamble(language: Language, table: &Table) -> String {
                 "{} * exp(-{} * alpha)",
                 literal(l.offset_at(0.0, size)),
                 literal(l.offset_decay)
+            ),
+        );
+    }
+    if let (
+        Some(ior),
+        Some(Axis::Mu {
+            mapping: MuMapping::OneIor,
+            size,
+            ..
+        }),
+    ) = (spec.fixed_ior(), spec.mu)
+    {
+        // The one-IOR layout's base (balanced, its offset scaled) and critical angle (from
+        // inside only: its share is 0 outside), at the table's relative index.
+        let l = OneIorLayout::KILN;
+        let b = l.base();
+        let eta = spec.relative_eta(ior);
+        out += &language.local(
+            "balanced_k",
+            &format!(
+                "{} * alpha * (1.0 + {} * alpha)",
+                literal(b.scale),
+                literal(b.scale_growth)
+            ),
+        );
+        out += &language.local(
+            "balanced_eps",
+            &format!(
+                "{} * exp(-{} * alpha)",
+                literal(b.offset_at(0.0, size)),
+                literal(b.offset_decay)
+            ),
+        );
+        out += &language.local("critical_share", &literal(l.critical_share_at(eta)));
+        out += &language.local(
+            "critical_mu",
+            &literal(OneIorLayout::critical_mu(eta.min(1.0))),
+        );
+        out += &language.local(
+            "critical_s",
+            &format!(
+                "{} * alpha + {}",
+                literal(l.critical_scale),
+                literal(l.critical_floor)
             ),
         );
     }

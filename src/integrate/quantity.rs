@@ -202,6 +202,14 @@ impl Quantity {
         )
     }
 
+    /// Whether the quantity is a rough dielectric's energy albedo (`E_dielectric`, from either
+    /// side, and their averages): over the IOR axis, or at one IOR a table's Fresnel model names
+    /// ([`crate::table::TableSpec::fixed_ior`]).
+    #[must_use]
+    pub fn is_glass_albedo(self) -> bool {
+        self.has_ior() && self != Quantity::FAvg
+    }
+
     /// Whether the table still varies with `mu` on a mirror (`roughness = 0`), so that it needs a
     /// `mu` axis independent of the roughness (not the adaptive one): the split-sum channels
     /// and `E_F`, which equal `h(mu)` and `F(mu)` there.

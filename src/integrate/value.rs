@@ -42,7 +42,9 @@ use crate::model::{Fresnel, Model};
 pub struct Integral {
     pub model: Model,
     pub quantity: Quantity,
-    /// The grey Fresnel model of an `E_F` integral (`None` for every other quantity).
+    /// The grey Fresnel model of an `E_F` integral; for a glass albedo at one IOR its
+    /// dielectric (the material's IOR, [`Integral::fixed_eta`]); `None` for every other
+    /// integral.
     pub fresnel: Option<Fresnel>,
     /// How a dielectric integral counts a refraction that ends on the incident side (ignored by
     /// the other quantities).
@@ -70,16 +72,35 @@ impl Integral {
         }
     }
 
+    /// The relative index of a glass albedo at one IOR (a table without an IOR axis, whose
+    /// Fresnel model names the material's index): that index from outside, its inverse from
+    /// inside; `None` for every other integral, whose `eta` (if any) comes with the point.
+    #[must_use]
+    pub fn fixed_eta(&self) -> Option<f64> {
+        match self.fresnel {
+            Some(Fresnel::Dielectric { eta }) if self.quantity.is_glass_albedo() => {
+                Some(if self.quantity.from_inside() {
+                    1.0 / eta
+                } else {
+                    eta
+                })
+            }
+            _ => None,
+        }
+    }
+
     /// The reference value at `at` (see the module docs for the rule of each quantity).
     ///
     /// # Panics
-    /// If `at` lacks a coordinate the quantity needs (`eta` for the tables over IOR, `mu` for
-    /// `E_F`).
+    /// If `at` lacks a coordinate the quantity needs (`eta` for the tables over IOR, unless the
+    /// integral fixes it, [`Integral::fixed_eta`]; `mu` for `E_F`).
     #[must_use]
     pub fn reference(&self, at: Point, settings: &ReferenceSettings) -> ReferenceValue {
         let Point { alpha, mu, eta } = at;
         if self.quantity.has_ior() {
-            let eta = eta.expect("an integral over IOR needs eta");
+            let eta = eta
+                .or(self.fixed_eta())
+                .expect("an integral over IOR needs eta");
             let convention = self.transmission;
             return match (self.quantity, mu) {
                 (Quantity::FAvg, _) => {
@@ -129,7 +150,7 @@ impl Integral {
                 samples: r.evaluations,
             };
         }
-        if let Some(eta) = eta {
+        if let Some(eta) = eta.or(self.fixed_eta()) {
             let convention = self.transmission;
             return match mu {
                 Some(mu) => {

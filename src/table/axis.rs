@@ -112,6 +112,13 @@ pub enum MuMapping {
     /// more texels near `mu = 1` at moderate roughness and fewer at `mu < 1e-4`, for the lookup
     /// of fitted texels (`--texels lookup-fit`).
     Balanced,
+    /// kiln's layout of a glass table at one IOR (`table::one_ior_layout`): kiln's balanced
+    /// coordinate with shares given to the eta layer near grazing (an index close to 1) and, from
+    /// inside, to the critical angle `mu_c = sqrt(1 - eta^2)`; depends on roughness and on the
+    /// table's relative index `eta`, so only on a glass table at one IOR, which it is kiln's
+    /// layout of.
+    #[cfg_attr(feature = "cli", value(skip))]
+    OneIor,
     /// kiln's split-sum layout (`table::split_sum_layout`), for the quantities that vary with
     /// `mu` on a mirror (`e-scale`, `e-bias`, `e-f`): `t = 0.6 A(mu; 0.3, 0.5) + 0.4 A(mu; 4
     /// alpha, 0.4)` with `A(y; k, p) = (y (1 + k) / (y + k))^p`: the adaptive axis' grazing
@@ -130,6 +137,7 @@ impl MuMapping {
             MuMapping::Glass => "glass",
             MuMapping::Balanced => "balanced",
             MuMapping::SplitSum => "split-sum",
+            MuMapping::OneIor => "one-ior",
         }
     }
 
@@ -144,6 +152,7 @@ impl MuMapping {
             MuMapping::Glass => "mu-glass",
             MuMapping::Balanced => "mu-balanced",
             MuMapping::SplitSum => "mu-split-sum",
+            MuMapping::OneIor => "mu-one-ior",
         }
     }
 
@@ -151,15 +160,19 @@ impl MuMapping {
     /// named, and the one its file name leaves untagged):
     /// - [`MuMapping::SplitSum`] for the quantities that vary with `mu` on a mirror (the split-sum
     ///   channels and `E_F`: the grazing-layer axes map every `mu > 0` to `t = 1` there);
-    /// - [`MuMapping::Adaptive`] for the tables over the IOR (kiln's glass layout replaces it
-    ///   with [`MuMapping::Glass`]; Cycles' product grid keeps it);
+    /// - [`MuMapping::Adaptive`] for the tables over the IOR (`over_ior`; kiln's glass layout
+    ///   replaces it with [`MuMapping::Glass`]; Cycles' product grid keeps it);
     /// - [`MuMapping::Balanced`] for `E` and what derives from it (`E_avg`, `f_ms_norm`), whose
-    ///   texels are fitted for the lookup on it ([`crate::table::Texels::paired_with`]).
+    ///   texels are fitted for the lookup on it ([`crate::table::Texels::paired_with`]), and
+    ///   for the glass albedos at one IOR ([`crate::table::TableSpec::fixed_ior`]), fitted as
+    ///   `E` is.
     #[must_use]
-    pub fn kiln_default(quantity: crate::integrate::quantity::Quantity) -> Self {
+    pub fn kiln_default(quantity: crate::integrate::quantity::Quantity, over_ior: bool) -> Self {
         if quantity.varies_on_a_mirror() {
             MuMapping::SplitSum
-        } else if quantity.has_ior() {
+        } else if quantity.is_glass_albedo() && quantity.has_mu() && !over_ior {
+            MuMapping::OneIor
+        } else if over_ior {
             MuMapping::Adaptive
         } else {
             MuMapping::Balanced
@@ -171,7 +184,11 @@ impl MuMapping {
     pub fn depends_on_roughness(self) -> bool {
         matches!(
             self,
-            MuMapping::Adaptive | MuMapping::Glass | MuMapping::Balanced | MuMapping::SplitSum
+            MuMapping::Adaptive
+                | MuMapping::Glass
+                | MuMapping::Balanced
+                | MuMapping::SplitSum
+                | MuMapping::OneIor
         )
     }
 
@@ -215,6 +232,9 @@ impl MuMapping {
                 super::balanced_layout::BalancedLayout::KILN.mu_at(t, alpha, size)
             }
             MuMapping::SplitSum => super::split_sum_layout::SplitSumLayout::KILN.mu_at(t, alpha),
+            MuMapping::OneIor => {
+                super::one_ior_layout::OneIorLayout::KILN.mu_at(t, alpha, eta_up, size)
+            }
         }
     }
 
@@ -242,6 +262,9 @@ impl MuMapping {
             }
             MuMapping::SplitSum => {
                 super::split_sum_layout::SplitSumLayout::KILN.mu_coordinate(mu, alpha)
+            }
+            MuMapping::OneIor => {
+                super::one_ior_layout::OneIorLayout::KILN.mu_coordinate(mu, alpha, eta_up, size)
             }
         }
     }
@@ -298,6 +321,30 @@ impl MuMapping {
                     v = 1.0 - l.share,
                 )
             }
+            MuMapping::OneIor => {
+                let l = super::one_ior_layout::OneIorLayout::KILN;
+                let b = l.base();
+                format!(
+                    "lookup coordinate t = w_c C(mu) + (1 - w_c) B(mu), eta the table's relative \
+                     index (its IOR from outside, 1 / IOR from inside); B the balanced \
+                     coordinate with a tenth of its offset: B = ((u + eps)^{p} - eps^{p}) / ((1 \
+                     + eps)^{p} - eps^{p}), u = mu (1 + k) / (mu + k), k = {c} alpha (1 + {e} \
+                     alpha), eps = ({z} / 32) (32 / N)^{w} exp(-{y} alpha); from inside (eta < \
+                     1) w_c = {wc} and C(mu) = (atan((mu - mu_c) / s) - atan(-mu_c / s)) / \
+                     (atan((1 - mu_c) / s) - atan(-mu_c / s)), mu_c = sqrt(1 - eta^2), s = {cc} \
+                     alpha + {s0}; from outside w_c = 0; mu at t by bisection; the row at alpha \
+                     = 0 holds the limit alpha -> 0+ (computed at alpha = 1e-7)",
+                    p = b.power,
+                    c = b.scale,
+                    e = b.scale_growth,
+                    z = b.offset,
+                    w = b.offset_size_power,
+                    y = b.offset_decay,
+                    wc = l.critical_share,
+                    cc = l.critical_scale,
+                    s0 = l.critical_floor,
+                )
+            }
         }
     }
 }
@@ -343,7 +390,7 @@ impl RoughnessSpacing {
     #[must_use]
     pub fn paired_with(mapping: MuMapping) -> Self {
         match mapping {
-            MuMapping::Balanced => RoughnessSpacing::Balanced,
+            MuMapping::Balanced | MuMapping::OneIor => RoughnessSpacing::Balanced,
             _ => RoughnessSpacing::Linear,
         }
     }

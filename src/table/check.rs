@@ -39,9 +39,16 @@ impl TableSpec {
             ))),
             (None, false) => Ok(()),
         };
-        slot("eta", self.ior, q.has_ior(), |a| {
+        // A glass albedo at one IOR names its index in its Fresnel model instead of an axis.
+        let one_ior = q.is_glass_albedo()
+            && self.ior.is_none()
+            && matches!(self.fresnel, Some(crate::model::Fresnel::Dielectric { .. }));
+        slot("eta", self.ior, q.has_ior() && !one_ior, |a| {
             matches!(a, Axis::Ior { .. })
         })?;
+        if let Some(ior) = self.fixed_ior() {
+            check_fixed_ior(ior)?;
+        }
         slot("roughness", self.roughness, q.has_roughness(), |a| {
             matches!(a, Axis::Roughness { .. })
         })?;
@@ -83,6 +90,14 @@ impl TableSpec {
                 "its mu axis is in kiln's glass layout, which needs a glass IOR axis".into(),
             ));
         }
+        let one_ior_mu = matches!(self.mu, Some(Axis::Mu { mapping, .. }) if mapping == super::axis::MuMapping::OneIor);
+        if one_ior_mu && self.fixed_ior().is_none() {
+            return Err(crate::Error::Malformed(format!(
+                "its mu axis is in kiln's layout of a glass table at one IOR, which {} is not \
+                 (it needs a dielectric quantity and its Fresnel model's IOR, without an eta axis)",
+                q.symbol()
+            )));
+        }
         if glass_ior && self.roughness.is_none() {
             return Err(crate::Error::Malformed(format!(
                 "its eta axis is in kiln's glass layout, which needs a roughness axis ({} has none)",
@@ -109,9 +124,11 @@ impl TableSpec {
                 q.symbol()
             )));
         }
-        if (q == Quantity::EF) != self.fresnel.is_some() {
+        if (q == Quantity::EF || one_ior) != self.fresnel.is_some() {
             return Err(crate::Error::Malformed(
-                "a Fresnel model belongs to E_F tables, and only to them".into(),
+                "a Fresnel model belongs to E_F tables and to glass tables at one IOR (a \
+                 dielectric without an eta axis), and only to them"
+                    .into(),
             ));
         }
         match (&self.lookup_of, q) {
@@ -288,6 +305,24 @@ impl Table {
         }
         Ok(())
     }
+}
+
+/// The range of a glass table's one IOR ([`super::TableSpec::fixed_ior`]): finite, within
+/// `[1 / MAX_INDEX, MAX_INDEX]` as every index kiln reads, and not 1, where there is no
+/// interface (its albedo is the limit the tables over the IOR hold on their `eta = 1` slice).
+///
+/// # Errors
+/// Naming the index and the range.
+pub fn check_fixed_ior(ior: f64) -> crate::Result<()> {
+    let max = crate::model::fresnel::MAX_INDEX;
+    if !(ior.is_finite() && (1.0 / max..=max).contains(&ior)) || ior == 1.0 {
+        return Err(crate::Error::InvalidInput(format!(
+            "a glass table at one IOR needs an index in [{}, {max}] other than 1 (got {ior}): \
+             at 1 there is no interface; the tables over the IOR hold its limit",
+            1.0 / max
+        )));
+    }
+    Ok(())
 }
 
 #[cfg(test)]

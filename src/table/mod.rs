@@ -9,6 +9,7 @@ pub mod glass_compensation;
 pub mod glass_layout;
 pub mod lookup_fit;
 pub mod normalisation;
+pub mod one_ior_layout;
 pub mod split_sum_layout;
 
 use crate::integrate::QmcSettings;
@@ -112,12 +113,13 @@ impl Texels {
 
     /// The texels laid out with the `mu` axis `mapping` when none are named: fitted for the
     /// lookup on the balanced axis (kiln's layout for `E`, chosen by its measured lookup error:
-    /// 2.1e-4 at 32 x 32 against the adaptive axis' point samples' 6.5e-4), point samples on
-    /// every other axis (the engines' layouts, the split-sum axis, glass).
+    /// 2.1e-4 at 32 x 32 against the adaptive axis' point samples' 6.5e-4) and on the one-IOR
+    /// glass axis, point samples on every other axis (the engines' layouts, the split-sum axis,
+    /// glass over the IOR).
     #[must_use]
     pub fn paired_with(mapping: MuMapping) -> Self {
         match mapping {
-            MuMapping::Balanced => Texels::LookupFit,
+            MuMapping::Balanced | MuMapping::OneIor => Texels::LookupFit,
             _ => Texels::Nodes,
         }
     }
@@ -217,6 +219,29 @@ impl TableSpec {
         self.len() == 0
     }
 
+    /// The material's index of refraction of a glass albedo at one IOR: a dielectric table
+    /// (`E_dielectric` from either side, or their averages) without an IOR axis, whose Fresnel
+    /// model names the index (the table's relative index is that, or its inverse from inside,
+    /// [`crate::integrate::value::Integral::fixed_eta`]). `None` for every other table.
+    #[must_use]
+    pub fn fixed_ior(&self) -> Option<f64> {
+        match (self.quantity.is_glass_albedo(), self.ior, self.fresnel) {
+            (true, None, Some(crate::model::Fresnel::Dielectric { eta })) => Some(eta),
+            _ => None,
+        }
+    }
+
+    /// The index the axes' mappings read for a lookup at `eta`: the IOR axis' index
+    /// `max(eta, 1 / eta)`, or for a glass table at one IOR its relative index, whatever `eta`
+    /// (its `mu` axis, [`MuMapping::OneIor`], tells the sides apart by it).
+    #[must_use]
+    pub fn mapping_eta(&self, eta: f64) -> f64 {
+        match self.fixed_ior() {
+            Some(ior) => self.relative_eta(ior),
+            None => axis_index(eta),
+        }
+    }
+
     /// The roughness convention of the roughness axis (`r` for `F_avg`, which has none).
     #[must_use]
     pub fn roughness_convention(&self) -> RoughnessConvention {
@@ -234,7 +259,8 @@ impl TableSpec {
     }
 
     /// A file-name stem naming the table: `ggx-height-correlated-E` (`dielectric-F_avg` for
-    /// `F_avg`, which is the same for every model), then the Fresnel model's tag for `E_F`, then
+    /// `F_avg`, which is the same for every model), then the Fresnel model's tag for `E_F`
+    /// (`-dielectric-1.5`) or the index of a glass table at one IOR (`-ior-1.5`), then
     /// a tag for each axis convention that differs from kiln's layout for the quantity, so that
     /// tables a lookup reads differently never share a name: `-alpha` (roughness axis alpha),
     /// `-mu-linear`, `-mu-adaptive` ... (a `mu` axis other than
@@ -266,9 +292,10 @@ impl TableSpec {
                 self.quantity.symbol()
             )
         };
-        let id = match self.fresnel {
-            Some(fresnel) => format!("{id}-{}", fresnel.tag()),
-            None => id,
+        let id = match (self.fixed_ior(), self.fresnel) {
+            (Some(ior), _) => format!("{id}-ior-{ior}"),
+            (None, Some(fresnel)) => format!("{id}-{}", fresnel.tag()),
+            (None, None) => id,
         };
         match self.transmission {
             TransmissionConvention::SingleScattering => id,
@@ -298,10 +325,10 @@ impl TableSpec {
         };
         // The rows and texels are tagged against those that go with the table's mu axis (kiln's
         // axis for the quantity when the table has none, as E_avg).
-        let kiln_mu = MuMapping::kiln_default(self.quantity);
+        let kiln_mu = MuMapping::kiln_default(self.quantity, self.ior.is_some());
         match mu_mapping {
             // The glass layout's axis and the product grid's adaptive one: the IOR tag tells.
-            Some(MuMapping::Glass | MuMapping::Adaptive) if self.quantity.has_ior() => {}
+            Some(MuMapping::Glass | MuMapping::Adaptive) if self.ior.is_some() => {}
             Some(mapping) if mapping != kiln_mu => tags.push(mapping.tag()),
             _ => {}
         }
@@ -316,7 +343,7 @@ impl TableSpec {
         }
         let texels_paired = match (mu_mapping, self.roughness) {
             // Over the IOR: point samples unless a fit was asked for.
-            _ if self.quantity.has_ior() => Texels::Nodes,
+            _ if self.ior.is_some() => Texels::Nodes,
             (Some(mapping), _) => Texels::paired_with(mapping),
             // A table without a mu axis (E_avg) takes its texels' baseline from its rows:
             // fitted with balanced rows, point samples with linear ones.
@@ -525,10 +552,14 @@ impl TableSpec {
     }
 
     /// [`TableSpec::point`] at the IOR axis' index `eta_up >= 1` (only a `glass` mu axis
-    /// depends on it).
+    /// depends on it; a glass table at one IOR is at its own, [`TableSpec::fixed_ior`]).
     #[must_use]
     pub fn point_at(&self, t_roughness: f64, t_mu: f64, eta_up: f64) -> (f64, Option<f64>) {
         debug_assert!(self.roughness.is_some(), "F_avg has no roughness axis");
+        // A glass table at one IOR is laid out at that index, whatever the caller's.
+        let eta_up = self
+            .fixed_ior()
+            .map_or(eta_up, |ior| self.relative_eta(ior));
         let alpha = self.roughness_axis().alpha_at_coordinate(t_roughness);
         match self.mu {
             Some(Axis::Mu { mapping, size, .. }) => {
@@ -676,7 +707,7 @@ impl Table {
         eta: f64,
     ) -> impl Fn(f64) -> f64 + 'a {
         let alpha = self.spec.roughness_convention().to_alpha(roughness);
-        let eta_up = axis_index(eta);
+        let eta_up = self.spec.mapping_eta(eta);
         let corner =
             move |axis: Axis, x: f64, stride: usize| self.corner(axis, x, alpha, eta_up, stride);
         // Per axis, slowest first: the two samples to blend, the second's weight, the stride
@@ -742,7 +773,7 @@ impl Table {
     #[must_use]
     pub fn lookup_weights(&self, mu: f64, roughness: f64, eta: f64) -> LookupWeights {
         let alpha = self.spec.roughness_convention().to_alpha(roughness);
-        let eta_up = axis_index(eta);
+        let eta_up = self.spec.mapping_eta(eta);
         let (roughness_stride, ior_stride) = self.strides();
         let mut out = LookupWeights {
             terms: [(0, 1.0); 8],

@@ -49,7 +49,9 @@ pub fn generated_lookups(
         );
     }
     source += "}\n";
-    let values = compile_and_run(dir, &format!("{id}_lookup"), &source);
+    // A crate name is an identifier: `-ior-1.5` loses its dot.
+    let crate_name = format!("{id}_lookup").replace('.', "_");
+    let values = compile_and_run(dir, &crate_name, &source);
     assert_eq!(values.len(), points.len());
     values
 }

@@ -32,6 +32,7 @@ pub struct FresnelArgs {
     #[arg(long, value_parser = parse_rgb, allow_negative_numbers = true)]
     pub f90: Option<[f64; 3]>,
     /// Dielectric relative index of refraction, in [0.01, 100] (1.5: glass seen from air).
+    /// Beside a glass quantity (e-dielectric, ...) the tables at that IOR alone, 2-D.
     #[arg(long, value_parser = crate::args::parse_number, allow_negative_numbers = true)]
     pub ior: Option<f64>,
     /// Conductor: real part of the complex index, in [0.01, 100], per channel.

@@ -107,6 +107,8 @@ pub fn run(args: PlanArgs) -> kiln::Result<()> {
         let names: Vec<&str> = effects.iter().map(|e| e.name()).collect();
         names.join(", ")
     };
+    // Names line up at 46 columns, or at the longest (the glass tables at one IOR).
+    let width = plan.tables.iter().map(|t| t.id.len()).fold(46, usize::max);
     for t in &plan.tables {
         let why = if t.effects.is_empty() {
             " (the engine's file holds it)".to_string()
@@ -114,7 +116,7 @@ pub fn run(args: PlanArgs) -> kiln::Result<()> {
             format!(" ({})", effects(&t.effects))
         };
         println!(
-            "  {:<46} ~{:>8}  for {}{why}",
+            "  {:<width$} ~{:>8}  for {}{why}",
             t.id,
             crate::human_seconds(t.estimated_core_seconds / threads as f64),
             t.materials.join(", ")
