@@ -148,8 +148,14 @@ mod tests {
                     let t = l.mu_coordinate(mu, alpha.max(1e-7), eta, 32);
                     assert!(t >= last, "{eta} {alpha} {mu}");
                     last = t;
+                    // The inversion gives a mu of the same coordinate (near a mirror every
+                    // mu > 0 maps close to t = 1, so mu itself is ill-conditioned there).
                     let back = l.mu_at(t, alpha.max(1e-7), eta, 32);
-                    assert!((back - mu).abs() < 1e-9, "{eta} {alpha} {mu}: {back}");
+                    let again = l.mu_coordinate(back, alpha.max(1e-7), eta, 32);
+                    assert!((again - t).abs() < 1e-12, "{eta} {alpha} {mu}: {back}");
+                    if alpha >= 0.1 {
+                        assert!((back - mu).abs() < 1e-9, "{eta} {alpha} {mu}: {back}");
+                    }
                 }
             }
         }
