@@ -28,6 +28,7 @@
 //! fresnel = { dielectric = { ior = 1.5 } }
 //! transmission = true           # glass: light refracts through (needs a dielectric fresnel)
 //! ior_varies = false            # true: a textured IOR, read from the tables over the IOR
+//! coat = { ior = 1.5 }          # a clear coat: its reflection-only albedo at its IOR
 //! image_based_lighting = true   # the split-sum tables (default false)
 //! multiple_scattering = true    # Kulla-Conty's tables (the default)
 //! ```
@@ -73,6 +74,9 @@ pub const DIELECTRIC_SIZE: usize = 16;
 
 /// Samples per axis (roughness and `mu`) of a scene's dielectric tables at one IOR.
 pub const ONE_IOR_SIZE: usize = 32;
+
+/// The reflection tables a coat needs, at its IOR.
+pub const COAT_QUANTITIES: [Quantity; 2] = [Quantity::EReflection, Quantity::EAvgReflection];
 
 /// The dielectric tables a transmissive material's model needs.
 pub const DIELECTRIC_QUANTITIES: [Quantity; 4] = [
@@ -130,6 +134,11 @@ pub struct Material {
     /// shading point's IOR; otherwise the tables at its one IOR. Needs `transmission`.
     #[serde(default)]
     pub ior_varies: bool,
+    /// A clear coat over the material (`coat = { ior = 1.5 }`, glTF's clearcoat: `F0 = 0.04`):
+    /// the coat's reflection-only albedo `E_reflection` and its average at the coat's IOR,
+    /// [`ONE_IOR_SIZE`] a side, by which a renderer attenuates the base beneath it.
+    #[serde(default)]
+    pub coat: Option<Coat>,
     /// Whether the renderer compensates the energy single scattering loses (Kulla-Conty: `E`,
     /// `E_avg`, `f_ms_norm`). On unless turned off.
     #[serde(default = "on")]
@@ -175,6 +184,7 @@ impl Material {
             Effect::ImageBasedLighting,
             Effect::Sheen,
             Effect::Transmission,
+            Effect::Coat,
         ]
         .into_iter()
         .filter(|&effect| self.asks(effect))
@@ -189,8 +199,18 @@ impl Material {
             Effect::ImageBasedLighting => self.image_based_lighting,
             Effect::Sheen => self.sheen,
             Effect::Transmission => self.transmission,
+            Effect::Coat => self.coat.is_some(),
         }
     }
+}
+
+/// A clear coat: a smooth-to-rough dielectric layer of its own IOR over the material.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Coat {
+    /// The coat's index of refraction relative to the medium above (1.5: glTF's clearcoat,
+    /// `F0 = 0.04`; OpenPBR's default 1.6).
+    pub ior: f64,
 }
 
 fn default_masking() -> Masking {
@@ -406,6 +426,10 @@ impl Scene {
                     m.name
                 )));
             }
+            if let Some(coat) = m.coat {
+                crate::table::check::check_fixed_ior(coat.ior)
+                    .map_err(|e| bad(format!("material '{}': coat: {e}", m.name)))?;
+            }
             if m.ior_varies && !m.transmission {
                 return Err(bad(format!(
                     "material '{}': ior_varies = true chooses the glass tables over the IOR, \
@@ -507,6 +531,13 @@ impl Scene {
                     "material '{}': transmission = true, but {}'s layout has no glass tables \
                      (cycles has them); bake the dielectric tables in kiln's own layout (a \
                      scene without a preset)",
+                    m.name, layout.name
+                )));
+            }
+            if m.coat.is_some() {
+                return Err(crate::Error::InvalidInput(format!(
+                    "material '{}': a coat, but {}'s layout has no coat tables; bake them in \
+                     kiln's own layout (a scene without a preset)",
                     m.name, layout.name
                 )));
             }
@@ -630,6 +661,24 @@ impl Scene {
                 };
                 needs.push((glass, Some(Effect::Transmission), model));
             }
+            // A coat's reflection at each distinct coat IOR.
+            let mut coats: Vec<f64> = Vec::new();
+            for m in self.materials.iter().filter(|m| m.model() == model) {
+                if let Some(coat) = m.coat
+                    && !coats.contains(&coat.ior)
+                {
+                    coats.push(coat.ior);
+                }
+            }
+            for ior in coats {
+                let coat = crate::BakeOptions {
+                    quantities: COAT_QUANTITIES.to_vec(),
+                    size: ONE_IOR_SIZE,
+                    fresnel: Some(Fresnel::Dielectric { eta: ior }),
+                    ..base.clone()
+                };
+                needs.push((coat, Some(Effect::Coat), model));
+            }
             if glass_materials(model).any(|m| m.ior_varies) {
                 let glass = crate::BakeOptions {
                     quantities: DIELECTRIC_QUANTITIES.to_vec(),
@@ -704,6 +753,17 @@ impl Scene {
                     .filter(|m| match options.fresnel {
                         Some(Fresnel::Dielectric { eta }) => m.one_ior() == Some(eta),
                         _ => m.ior_varies,
+                    })
+                    .map(|m| m.name.clone())
+                    .collect(),
+                // A coat bake serves the materials of its coat's IOR.
+                Some(Effect::Coat) => self
+                    .materials
+                    .iter()
+                    .filter(|m| m.model() == model)
+                    .filter(|m| match (m.coat, options.fresnel) {
+                        (Some(coat), Some(Fresnel::Dielectric { eta })) => coat.ior == eta,
+                        _ => false,
                     })
                     .map(|m| m.name.clone())
                     .collect(),
@@ -976,6 +1036,19 @@ impl Scene {
                     object["glass_tables"] = glass.into();
                     object["ior_varies"] = material.ior_varies.into();
                 }
+                if let Some(coat) = material.coat {
+                    let tables: serde_json::Map<String, serde_json::Value> = tables
+                        .iter()
+                        .filter(|t| {
+                            COAT_QUANTITIES.contains(&t.spec.quantity)
+                                && t.spec.model == material.model()
+                                && t.spec.fixed_ior() == Some(coat.ior)
+                        })
+                        .map(|t| (t.spec.quantity.symbol().to_string(), t.spec.id().into()))
+                        .collect();
+                    object["coat_ior"] = coat.ior.into();
+                    object["coat_tables"] = tables.into();
+                }
                 if let (Some(table), [lo, hi]) = (average, m.roughness)
                     && lo == hi
                 {
@@ -996,6 +1069,9 @@ impl Scene {
             "colour_multiplier": "per channel, F_avg^2 E_avg / (1 - F_avg (1 - E_avg)): the \
                                   factor of the Kulla-Conty lobe f_ms (E_avg looked up in \
                                   e_avg_table at the material's roughness)",
+            "coat_tables": "per coated material, its coat's reflection-only albedo and average at \
+                            the coat's IOR (coat_ior), by quantity: the base beneath receives \
+                            1 - E_reflection(mu) of the light",
             "glass_tables": "per glass material, the dielectric tables it reads, by quantity: \
                              at its one IOR (2-D, over roughness and mu), or over the IOR for a \
                              material whose IOR varies (ior_varies)",
@@ -1133,6 +1209,44 @@ fresnel = { schlick = { f0 = 0.04 } }
         assert!((varnish.f_avg[0] - 0.091_777_959_3).abs() < 1e-9);
         assert_eq!(plan.materials[2].f_avg, [(20.0 * 0.04 + 1.0) / 21.0; 3]);
         assert_eq!(plan.materials[0].roughness, [0.2, 0.6]);
+    }
+
+    /// A coat gets its reflection tables at its IOR, per model and coat IOR, for the materials of
+    /// that coat; a coat's IOR out of range is refused by name.
+    #[test]
+    fn coats_add_their_reflection_at_their_ior() {
+        let scene = Scene::parse(
+            "[[material]]\nname = \"car\"\nndf = \"ggx\"\nroughness = 0.3\n\
+             coat = { ior = 1.5 }\n\n\
+             [[material]]\nname = \"pearl\"\nndf = \"ggx\"\nroughness = 0.2\n\
+             coat = { ior = 1.6 }\nmultiple_scattering = false\n\n\
+             [[material]]\nname = \"van\"\nndf = \"ggx\"\nroughness = 0.4\n\
+             coat = { ior = 1.5 }\nmultiple_scattering = false\n",
+            "coats.toml",
+        )
+        .unwrap();
+        let plan = scene.plan();
+        let ids: Vec<&str> = plan.tables.iter().map(|t| t.id.as_str()).collect();
+        assert_eq!(
+            ids[3..],
+            [
+                "ggx-height-correlated-E_reflection-ior-1.5",
+                "ggx-height-correlated-E_avg_reflection-ior-1.5",
+                "ggx-height-correlated-E_reflection-ior-1.6",
+                "ggx-height-correlated-E_avg_reflection-ior-1.6",
+            ]
+        );
+        assert_eq!(plan.tables[3].materials, ["car", "van"]);
+        assert_eq!(plan.tables[5].materials, ["pearl"]);
+        assert_eq!(plan.tables[3].effects, [Effect::Coat]);
+        let error = Scene::parse(
+            "[[material]]\nname = \"bad\"\nndf = \"ggx\"\nroughness = 0.3\n\
+             coat = { ior = 1.0 }\n",
+            "bad.toml",
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(error.contains("bad") && error.contains("coat"), "{error}");
     }
 
     /// A glass of one IOR gets the four tables at that IOR, 32 x 32; a glass whose IOR varies

@@ -8,7 +8,7 @@ use kiln::{BakeOptions, Grid, MuMapping, Quantity, Table};
 
 /// Tables of every shape and axis kind: E on the adaptive axis with nodes and on the sqrt axis
 /// with centres, E_avg (1-D), E_dielectric (3-D, IOR axis) and F_avg (1-D over the IOR), and
-/// kiln's balanced, split-sum, glass and one-IOR glass layouts.
+/// kiln's balanced, split-sum, glass and one-IOR glass layouts, and a coat's reflection.
 fn tables() -> Vec<Table> {
     let base = BakeOptions {
         size: 3,
@@ -59,6 +59,19 @@ fn tables() -> Vec<Table> {
         .bake(&|_| {})
         .unwrap(),
     );
+    // A coat's reflection over the IOR (the split-sum mu axis on Cycles' IOR axis) and at one
+    // IOR.
+    for fresnel in [None, Some(kiln::Fresnel::Dielectric { eta: 1.5 })] {
+        tables.extend(
+            BakeOptions {
+                quantities: vec![Quantity::EReflection, Quantity::EAvgReflection],
+                fresnel,
+                ..base.clone()
+            }
+            .bake(&|_| {})
+            .unwrap(),
+        );
+    }
     // kiln's glass layout, whose lookups compute its coordinates.
     tables.extend(
         BakeOptions {

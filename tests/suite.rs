@@ -34,6 +34,7 @@ mod balanced_layout;
 mod build_script;
 mod cli;
 mod cli_promises;
+mod coats;
 mod containers;
 mod cycles_glass;
 mod default_tables;

@@ -125,7 +125,7 @@ pub fn lookup_fit_core_seconds(spec: &TableSpec) -> f64 {
     let settings = lookup_fit_settings(spec);
     let solve = settings.iterations as f64 * spec.len() as f64 * band * band * 1.2e-9;
     let digits = (-settings.tolerance.log10()).round().max(1.0) as u32;
-    let share = if spec.quantity.is_glass_albedo() {
+    let share = if spec.quantity.is_dielectric() {
         1.3
     } else {
         0.45

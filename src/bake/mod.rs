@@ -209,7 +209,7 @@ impl BakeOptions {
     #[must_use]
     pub fn fixed_ior_for(&self, quantity: Quantity) -> Option<f64> {
         match self.fresnel {
-            Some(crate::model::Fresnel::Dielectric { eta }) if quantity.is_glass_albedo() => {
+            Some(crate::model::Fresnel::Dielectric { eta }) if quantity.is_dielectric() => {
                 Some(eta)
             }
             _ => None,
@@ -277,7 +277,7 @@ impl BakeOptions {
     /// one), which a bake to a max error computes by the quadrature.
     #[must_use]
     pub fn any_glass(quantities: &[Quantity]) -> bool {
-        quantities.iter().any(|q| q.is_glass_albedo())
+        quantities.iter().any(|q| q.is_dielectric())
     }
 
     /// The models baked, in a fixed order.
@@ -365,7 +365,11 @@ impl BakeOptions {
                             model,
                             quantity,
                             ior: self.over_ior(quantity).then_some(
-                                if glass_layout && quantity == Quantity::FAvg {
+                                // Cycles' axis for F_avg and the coats' reflection,
+                                // which kiln's glass layout (of R + T) does not fit.
+                                if glass_layout
+                                    && (quantity == Quantity::FAvg || quantity.is_reflection_only())
+                                {
                                     f_avg_ior
                                 } else {
                                     ior
@@ -376,7 +380,10 @@ impl BakeOptions {
                             }),
                             roughness: quantity.has_roughness().then(|| roughness(quantity)),
                             mu: quantity.has_mu().then_some(
-                                if glass_layout && self.over_ior(quantity) {
+                                if glass_layout
+                                    && self.over_ior(quantity)
+                                    && quantity.is_glass_albedo()
+                                {
                                     glass_mu
                                 } else {
                                     mu(quantity)

@@ -57,7 +57,10 @@ impl BakeOptions {
         }
         if self.ior_mapping == IorMapping::Glass
             && let Some(q) = self.quantities.iter().find(|&&q| {
-                self.over_ior(q) && q.has_mu() && self.mu_mapping_for(q) != MuMapping::Adaptive
+                self.over_ior(q)
+                    && q.is_glass_albedo()
+                    && q.has_mu()
+                    && self.mu_mapping_for(q) != MuMapping::Adaptive
             })
         {
             let mapping = self.mu_mapping_for(*q);

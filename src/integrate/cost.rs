@@ -34,9 +34,10 @@ pub fn reference_seconds(quantity: Quantity, model: Model, digits: u32) -> f64 {
         (Quantity::EAvg, true) => 25e-3,
         // kiln's glass layout at 1e-7, numerics version 13 (16^3 and 16^2 tables on 2 cores:
         // 1.4 s, 3.1 s, 2.5 s, 2.7 s), scaled to 8 digits.
-        (Quantity::EDielectric, _) => 0.8e-3,
+        // A coat's reflection is the same quadrature's reflected part.
+        (Quantity::EDielectric | Quantity::EReflection, _) => 0.8e-3,
         (Quantity::EDielectricInside, _) => 1.7e-3,
-        (Quantity::EAvgDielectric, _) => 22e-3,
+        (Quantity::EAvgDielectric | Quantity::EAvgReflection, _) => 22e-3,
         (Quantity::EAvgDielectricInside, _) => 24e-3,
         (Quantity::FAvg, _) => 1e-5,
         // Integrals of the E table's lookup, not of the BRDF.

@@ -46,6 +46,17 @@ pub enum Quantity {
     #[serde(rename = "E_avg_dielectric_inside")]
     #[cfg_attr(feature = "cli", value(name = "e-avg-dielectric-inside"))]
     EAvgDielectricInside,
+    /// The reflection-only albedo `E_R(mu) = ∫ F(o.h) f mu_i dω_i` of a rough dielectric
+    /// interface for light arriving from outside at relative index `eta` (exact Fresnel; what a
+    /// coat reflects, whose `1 - E_R` attenuates the base beneath it: OpenPBR, glTF's clearcoat,
+    /// Blender's Principled coat): a 3-D table over (eta, roughness, mu), or 2-D at one IOR.
+    #[serde(rename = "E_reflection")]
+    #[cfg_attr(feature = "cli", value(name = "e-reflection"))]
+    EReflection,
+    /// `2 ∫ E_reflection(mu) mu dmu`, a 2-D table over (eta, roughness), or 1-D at one IOR.
+    #[serde(rename = "E_avg_reflection")]
+    #[cfg_attr(feature = "cli", value(name = "e-avg-reflection"))]
+    EAvgReflection,
     /// The exact dielectric Fresnel average `F_avg(eta) = 2 ∫ F(mu) mu dmu` for light arriving
     /// from outside, a 1-D table over the IOR axis; from inside it is
     /// `1 - (1 - F_avg(eta)) / eta^2` (Fresnel reciprocity). The same for every model.
@@ -83,6 +94,8 @@ impl Quantity {
             Quantity::EAvgDielectric => "E_avg_dielectric",
             Quantity::EAvgDielectricInside => "E_avg_dielectric_inside",
             Quantity::FAvg => "F_avg",
+            Quantity::EReflection => "E_reflection",
+            Quantity::EAvgReflection => "E_avg_reflection",
             Quantity::EF => "E_F",
             Quantity::FMsNorm => "f_ms_norm",
         }
@@ -101,6 +114,8 @@ impl Quantity {
             Quantity::EAvgDielectric => "e-avg-dielectric",
             Quantity::EAvgDielectricInside => "e-avg-dielectric-inside",
             Quantity::FAvg => "f-avg",
+            Quantity::EReflection => "e-reflection",
+            Quantity::EAvgReflection => "e-avg-reflection",
             Quantity::EF => "e-f",
             Quantity::FMsNorm => "f-ms-norm",
         }
@@ -153,6 +168,17 @@ impl Quantity {
                  index eta; from inside: 1 - (1 - F_avg(eta)) / eta^2; one_minus_F_avg is \
                  1 - F_avg"
             }
+            Quantity::EReflection => {
+                "reflection-only albedo E_reflection(mu) = integral of F(o.h) f(o, i) mu_i over \
+                 incoming directions i, exact dielectric Fresnel at relative index eta, light \
+                 arriving from outside (a coat: the base beneath it receives 1 - E_reflection \
+                 of the light, less what the coat's single scattering loses); the reflected part \
+                 R of E_dielectric; one_minus_E_reflection is 1 - E_reflection"
+            }
+            Quantity::EAvgReflection => {
+                "average reflection-only albedo 2 * integral of E_reflection(mu) mu dmu over \
+                 [0, 1], light arriving from outside at relative index eta"
+            }
             Quantity::EF => {
                 "Fresnel-weighted albedo E_F(mu) = integral of F(o.h) f(o, i) mu_i over incoming \
                  directions i, F the table's Fresnel model (see fresnel), F = 1 inside f; \
@@ -178,6 +204,7 @@ impl Quantity {
             Quantity::EAvg
                 | Quantity::EAvgDielectric
                 | Quantity::EAvgDielectricInside
+                | Quantity::EAvgReflection
                 | Quantity::FAvg
                 | Quantity::FMsNorm
         )
@@ -198,8 +225,25 @@ impl Quantity {
                 | Quantity::EDielectricInside
                 | Quantity::EAvgDielectric
                 | Quantity::EAvgDielectricInside
+                | Quantity::EReflection
+                | Quantity::EAvgReflection
                 | Quantity::FAvg
         )
+    }
+
+    /// Whether the quantity is the reflection alone of a rough dielectric interface, a coat's
+    /// (`E_reflection`, `E_avg_reflection`).
+    #[must_use]
+    pub fn is_reflection_only(self) -> bool {
+        matches!(self, Quantity::EReflection | Quantity::EAvgReflection)
+    }
+
+    /// Whether the quantity is an albedo of a rough dielectric interface, over the IOR or at one
+    /// IOR ([`crate::table::TableSpec::fixed_ior`]): the glass albedos `R + T` and the
+    /// reflection-only ones.
+    #[must_use]
+    pub fn is_dielectric(self) -> bool {
+        self.is_glass_albedo() || self.is_reflection_only()
     }
 
     /// Whether the quantity is a rough dielectric's energy albedo (`E_dielectric`, from either
@@ -207,15 +251,21 @@ impl Quantity {
     /// ([`crate::table::TableSpec::fixed_ior`]).
     #[must_use]
     pub fn is_glass_albedo(self) -> bool {
-        self.has_ior() && self != Quantity::FAvg
+        matches!(
+            self,
+            Quantity::EDielectric
+                | Quantity::EDielectricInside
+                | Quantity::EAvgDielectric
+                | Quantity::EAvgDielectricInside
+        )
     }
 
     /// Whether the table still varies with `mu` on a mirror (`roughness = 0`), so that it needs a
-    /// `mu` axis independent of the roughness (not the adaptive one): the split-sum channels
-    /// and `E_F`, which equal `h(mu)` and `F(mu)` there.
+    /// `mu` axis independent of the roughness (not the adaptive one): the split-sum channels,
+    /// `E_F` and `E_reflection`, which equal `h(mu)` and `F(mu)` there.
     #[must_use]
     pub fn varies_on_a_mirror(self) -> bool {
-        self.weight().is_some() || self == Quantity::EF
+        self.weight().is_some() || self == Quantity::EF || self == Quantity::EReflection
     }
 
     /// Whether the light arrives from inside (relative index `1 / eta`).

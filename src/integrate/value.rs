@@ -20,6 +20,9 @@
 //! - the dielectric tables: their own quadrature or QMC ([`super::dielectric`]) in the
 //!   integral's [`TransmissionConvention`], light from inside at `1 / eta` for the `_inside`
 //!   quantities (the [`Point`]'s `eta` is the relative index itself, already inverted);
+//! - a coat's reflection (`E_reflection`, `E_avg_reflection`): the reflected part of the
+//!   dielectric quadrature, its QMC the Fresnel-weighted albedo's (the average by the
+//!   quadrature whatever the method);
 //! - `F_avg`: Gauss-Kronrod to 1e-14 whatever the method (a 1-D integral).
 
 use super::albedo::{albedo, average_albedo, weighted_albedo};
@@ -78,7 +81,7 @@ impl Integral {
     #[must_use]
     pub fn fixed_eta(&self) -> Option<f64> {
         match self.fresnel {
-            Some(Fresnel::Dielectric { eta }) if self.quantity.is_glass_albedo() => {
+            Some(Fresnel::Dielectric { eta }) if self.quantity.is_dielectric() => {
                 Some(if self.quantity.from_inside() {
                     1.0 / eta
                 } else {
@@ -113,6 +116,22 @@ impl Integral {
                         converged: true,
                     }
                 }
+                (Quantity::EReflection, Some(mu)) => fresnel_weighted_reference(
+                    self.model,
+                    Fresnel::Dielectric { eta },
+                    alpha,
+                    mu,
+                    settings,
+                ),
+                (Quantity::EAvgReflection, _) => {
+                    reflection_of(reference_dielectric_average_albedo_with(
+                        self.model,
+                        alpha,
+                        eta,
+                        TransmissionConvention::SingleScattering,
+                        settings,
+                    ))
+                }
                 (_, Some(mu)) => reference_dielectric_albedo_with(
                     self.model, alpha, mu, eta, convention, settings,
                 )
@@ -141,7 +160,22 @@ impl Integral {
     #[must_use]
     pub fn qmc(&self, at: Point, settings: &QmcSettings) -> Estimate {
         let Point { alpha, mu, eta } = at;
-        if self.quantity == Quantity::FAvg {
+        if let (Quantity::EReflection, Some(eta), Some(mu)) =
+            (self.quantity, eta.or(self.fixed_eta()), mu)
+        {
+            // A coat's reflection: the Fresnel-weighted albedo's estimator.
+            let fresnel = Fresnel::Dielectric { eta };
+            return weighted_albedo(
+                self.model,
+                alpha,
+                mu,
+                move |c| fresnel.reflectance(c)[0],
+                settings,
+            );
+        }
+        // F_avg (a 1-D integral) and the coat's average reflection (no QMC estimator of the
+        // reflection alone over both directions) by their quadratures.
+        if matches!(self.quantity, Quantity::FAvg | Quantity::EAvgReflection) {
             let r = self.reference(at, &ReferenceSettings::default());
             return Estimate {
                 value: r.value,
@@ -179,6 +213,17 @@ impl Integral {
     }
 }
 
+/// The reflected part `R` of a dielectric reference, as a value (`one_minus_value` is `1 - R`).
+fn reflection_of(r: crate::integrate::dielectric_reference::DielectricReference) -> ReferenceValue {
+    ReferenceValue {
+        value: r.reflection,
+        one_minus_value: 1.0 - r.reflection,
+        error: r.error,
+        evaluations: r.evaluations,
+        converged: r.converged,
+    }
+}
+
 /// The reference Fresnel-weighted albedo `E_F(mu)` of channel 0 of `fresnel`: for a dielectric
 /// the reflected part of the dielectric quadrature (single scattering), otherwise the reference
 /// with the weight `F(o.h)`. `one_minus_value` is `1 - E_F`.
@@ -199,13 +244,7 @@ pub fn fresnel_weighted_reference(
             TransmissionConvention::SingleScattering,
             settings,
         );
-        return ReferenceValue {
-            value: r.reflection,
-            one_minus_value: 1.0 - r.reflection,
-            error: r.error,
-            evaluations: r.evaluations,
-            converged: r.converged,
-        };
+        return reflection_of(r);
     }
     reference_weighted_albedo(model, alpha, mu, |c| fresnel.reflectance(c)[0], settings)
 }

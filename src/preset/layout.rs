@@ -50,6 +50,9 @@ pub enum Effect {
     Sheen,
     /// Light refracted through a dielectric (the dielectric tables).
     Transmission,
+    /// A clear coat over the material: its reflection-only albedo, by which the base beneath
+    /// is attenuated (`E_reflection`, `E_avg_reflection` at the coat's IOR).
+    Coat,
 }
 
 impl Effect {
@@ -61,6 +64,7 @@ impl Effect {
             Effect::ImageBasedLighting => "image-based-lighting",
             Effect::Sheen => "sheen",
             Effect::Transmission => "transmission",
+            Effect::Coat => "coat",
         }
     }
 }

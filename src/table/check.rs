@@ -40,7 +40,7 @@ impl TableSpec {
             (None, false) => Ok(()),
         };
         // A glass albedo at one IOR names its index in its Fresnel model instead of an axis.
-        let one_ior = q.is_glass_albedo()
+        let one_ior = q.is_dielectric()
             && self.ior.is_none()
             && matches!(self.fresnel, Some(crate::model::Fresnel::Dielectric { .. }));
         slot("eta", self.ior, q.has_ior() && !one_ior, |a| {
@@ -118,7 +118,7 @@ impl TableSpec {
                 q.symbol()
             )));
         }
-        if !self.transmission.is_default() && (!q.has_ior() || q == Quantity::FAvg) {
+        if !self.transmission.is_default() && !q.is_glass_albedo() {
             return Err(crate::Error::Malformed(format!(
                 "a transmission convention belongs to the dielectric tables, not {}",
                 q.symbol()
@@ -307,7 +307,7 @@ impl Table {
     }
 }
 
-/// The range of a glass table's one IOR ([`super::TableSpec::fixed_ior`]): finite, within
+/// The range of a dielectric table's one IOR ([`super::TableSpec::fixed_ior`]): finite, within
 /// `[1 / MAX_INDEX, MAX_INDEX]` as every index kiln reads, and not 1, where there is no
 /// interface (its albedo is the limit the tables over the IOR hold on their `eta = 1` slice).
 ///
@@ -317,8 +317,8 @@ pub fn check_fixed_ior(ior: f64) -> crate::Result<()> {
     let max = crate::model::fresnel::MAX_INDEX;
     if !(ior.is_finite() && (1.0 / max..=max).contains(&ior)) || ior == 1.0 {
         return Err(crate::Error::InvalidInput(format!(
-            "a glass table at one IOR needs an index in [{}, {max}] other than 1 (got {ior}): \
-             at 1 there is no interface; the tables over the IOR hold its limit",
+            "a dielectric table at one IOR needs an index in [{}, {max}] other than 1 (got \
+             {ior}): at 1 there is no interface (the tables over the IOR hold its limit)",
             1.0 / max
         )));
     }

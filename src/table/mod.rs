@@ -225,7 +225,7 @@ impl TableSpec {
     /// [`crate::integrate::value::Integral::fixed_eta`]). `None` for every other table.
     #[must_use]
     pub fn fixed_ior(&self) -> Option<f64> {
-        match (self.quantity.is_glass_albedo(), self.ior, self.fresnel) {
+        match (self.quantity.is_dielectric(), self.ior, self.fresnel) {
             (true, None, Some(crate::model::Fresnel::Dielectric { eta })) => Some(eta),
             _ => None,
         }
@@ -364,12 +364,12 @@ impl TableSpec {
                 mapping: IorMapping::Linear,
                 ..
             }) => tags.push("ior-linear"),
-            // Cycles' axis is the default of F_avg alone; kiln's glass layout the dielectric
-            // albedos'.
+            // Cycles' axis is the default of F_avg and the reflection-only albedos; kiln's
+            // glass layout the glass albedos'.
             Some(Axis::Ior {
                 mapping: IorMapping::Cycles,
                 ..
-            }) if self.quantity != Quantity::FAvg => tags.push("ior-cycles"),
+            }) if self.quantity.is_glass_albedo() => tags.push("ior-cycles"),
             Some(Axis::Ior {
                 mapping: IorMapping::Blender,
                 ..
