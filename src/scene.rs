@@ -176,6 +176,17 @@ impl Material {
         }
     }
 
+    /// The one IOR at which `effect`'s tables are baked for this material: its glass's
+    /// ([`Material::one_ior`]) for transmission, its coat's for a coat; `None` otherwise.
+    #[must_use]
+    pub fn one_ior_for(&self, effect: Effect) -> Option<f64> {
+        match effect {
+            Effect::Transmission => self.one_ior(),
+            Effect::Coat => self.coat.map(|coat| coat.ior),
+            _ => None,
+        }
+    }
+
     /// The effects the material asks for, in a fixed order.
     #[must_use]
     pub fn effects(&self) -> Vec<Effect> {
@@ -619,11 +630,6 @@ impl Scene {
         }
         let ior_max = self.ior_max();
         let mut needs = Vec::new();
-        let glass_materials = |model: Model| {
-            self.materials
-                .iter()
-                .filter(move |m| m.transmission && m.model() == model)
-        };
         for model in self.models() {
             let base = crate::BakeOptions {
                 ndfs: vec![model.ndf],
@@ -644,42 +650,36 @@ impl Scene {
                 };
                 needs.push((split_sum, Some(Effect::ImageBasedLighting), model));
             }
-            // The tables at each distinct IOR, in order of first appearance, then those over
-            // the IOR for the materials whose IOR varies.
-            let mut iors: Vec<f64> = Vec::new();
-            for ior in glass_materials(model).filter_map(Material::one_ior) {
-                if !iors.contains(&ior) {
-                    iors.push(ior);
+            // The glass tables at each distinct IOR and a coat's reflection at each distinct
+            // coat IOR, in order of first appearance; then the glass tables over the IOR for
+            // the materials whose IOR varies.
+            for (effect, quantities) in [
+                (Effect::Transmission, &DIELECTRIC_QUANTITIES[..]),
+                (Effect::Coat, &COAT_QUANTITIES[..]),
+            ] {
+                let mut iors: Vec<f64> = Vec::new();
+                for m in self.materials.iter().filter(|m| m.model() == model) {
+                    if let Some(ior) = m.one_ior_for(effect)
+                        && !iors.contains(&ior)
+                    {
+                        iors.push(ior);
+                    }
+                }
+                for ior in iors {
+                    let at_ior = crate::BakeOptions {
+                        quantities: quantities.to_vec(),
+                        size: ONE_IOR_SIZE,
+                        fresnel: Some(Fresnel::Dielectric { eta: ior }),
+                        ..base.clone()
+                    };
+                    needs.push((at_ior, Some(effect), model));
                 }
             }
-            for ior in iors {
-                let glass = crate::BakeOptions {
-                    quantities: DIELECTRIC_QUANTITIES.to_vec(),
-                    size: ONE_IOR_SIZE,
-                    fresnel: Some(Fresnel::Dielectric { eta: ior }),
-                    ..base.clone()
-                };
-                needs.push((glass, Some(Effect::Transmission), model));
-            }
-            // A coat's reflection at each distinct coat IOR.
-            let mut coats: Vec<f64> = Vec::new();
-            for m in self.materials.iter().filter(|m| m.model() == model) {
-                if let Some(coat) = m.coat
-                    && !coats.contains(&coat.ior)
-                {
-                    coats.push(coat.ior);
-                }
-            }
-            for ior in coats {
-                let coat = crate::BakeOptions {
-                    quantities: COAT_QUANTITIES.to_vec(),
-                    size: ONE_IOR_SIZE,
-                    fresnel: Some(Fresnel::Dielectric { eta: ior }),
-                    ..base.clone()
-                };
-                needs.push((coat, Some(Effect::Coat), model));
-            }
-            if glass_materials(model).any(|m| m.ior_varies) {
+            if self
+                .materials
+                .iter()
+                .any(|m| m.transmission && m.ior_varies && m.model() == model)
+            {
                 let glass = crate::BakeOptions {
                     quantities: DIELECTRIC_QUANTITIES.to_vec(),
                     size: DIELECTRIC_SIZE,
@@ -745,28 +745,19 @@ impl Scene {
                     .collect(),
             };
             let materials = match effect {
-                // A glass bake serves the materials of its IOR, or those whose IOR varies.
-                Some(Effect::Transmission) if self.preset().is_none() => self
-                    .materials
-                    .iter()
-                    .filter(|m| m.transmission && m.model() == model)
-                    .filter(|m| match options.fresnel {
-                        Some(Fresnel::Dielectric { eta }) => m.one_ior() == Some(eta),
-                        _ => m.ior_varies,
-                    })
-                    .map(|m| m.name.clone())
-                    .collect(),
-                // A coat bake serves the materials of its coat's IOR.
-                Some(Effect::Coat) => self
-                    .materials
-                    .iter()
-                    .filter(|m| m.model() == model)
-                    .filter(|m| match (m.coat, options.fresnel) {
-                        (Some(coat), Some(Fresnel::Dielectric { eta })) => coat.ior == eta,
-                        _ => false,
-                    })
-                    .map(|m| m.name.clone())
-                    .collect(),
+                // A bake at one IOR serves the materials of that IOR (a glass's or a coat's); the
+                // glass tables over the IOR those whose IOR varies.
+                Some(effect @ (Effect::Transmission | Effect::Coat)) if self.preset().is_none() => {
+                    self.materials
+                        .iter()
+                        .filter(|m| m.asks(effect) && m.model() == model)
+                        .filter(|m| match options.fresnel {
+                            Some(Fresnel::Dielectric { eta }) => m.one_ior_for(effect) == Some(eta),
+                            _ => m.ior_varies,
+                        })
+                        .map(|m| m.name.clone())
+                        .collect()
+                }
                 Some(effect) => self.asking(Some(model), &[effect]),
                 None => self.asking(Some(model), &engine_effects),
             };
@@ -1022,32 +1013,28 @@ impl Scene {
                     "f_avg": m.f_avg,
                     "e_avg_table": average.map(|t| t.spec.id()),
                 });
-                if material.transmission && self.preset().is_none() {
-                    // The glass tables this material reads: at its IOR, or over the IOR.
-                    let glass: serde_json::Map<String, serde_json::Value> = tables
+                // The tables of `quantities` this material reads at `ior` (over the IOR: None),
+                // by quantity.
+                let read = |quantities: &[Quantity], ior: Option<f64>| {
+                    tables
                         .iter()
                         .filter(|t| {
-                            DIELECTRIC_QUANTITIES.contains(&t.spec.quantity)
+                            quantities.contains(&t.spec.quantity)
                                 && t.spec.model == material.model()
-                                && t.spec.fixed_ior() == material.one_ior()
+                                && t.spec.fixed_ior() == ior
                         })
                         .map(|t| (t.spec.quantity.symbol().to_string(), t.spec.id().into()))
-                        .collect();
-                    object["glass_tables"] = glass.into();
+                        .collect::<serde_json::Map<String, serde_json::Value>>()
+                };
+                if material.transmission && self.preset().is_none() {
+                    // At its IOR, or over the IOR.
+                    object["glass_tables"] =
+                        read(&DIELECTRIC_QUANTITIES, material.one_ior()).into();
                     object["ior_varies"] = material.ior_varies.into();
                 }
                 if let Some(coat) = material.coat {
-                    let tables: serde_json::Map<String, serde_json::Value> = tables
-                        .iter()
-                        .filter(|t| {
-                            COAT_QUANTITIES.contains(&t.spec.quantity)
-                                && t.spec.model == material.model()
-                                && t.spec.fixed_ior() == Some(coat.ior)
-                        })
-                        .map(|t| (t.spec.quantity.symbol().to_string(), t.spec.id().into()))
-                        .collect();
                     object["coat_ior"] = coat.ior.into();
-                    object["coat_tables"] = tables.into();
+                    object["coat_tables"] = read(&COAT_QUANTITIES, Some(coat.ior)).into();
                 }
                 if let (Some(table), [lo, hi]) = (average, m.roughness)
                     && lo == hi

@@ -111,14 +111,9 @@ fn the_fitted_32x32_lookup_meets_2_5e_4_through_the_generated_code() {
     let hlsl = std::fs::read_to_string(dir.path().join(format!("{id}.hlsl"))).unwrap();
     // The coordinate and sampling functions (Turquin's helper needs float3 arithmetic).
     let hlsl = &hlsl[..hlsl.find("float3 ").unwrap_or(hlsl.len())];
-    let texels: Vec<String> = table
-        .value
-        .iter()
-        .zip(&table.one_minus_value)
-        .flat_map(|(v, w)| [format!("{:?}f", *v as f32), format!("{:?}f", *w as f32)])
-        .collect();
+    let texels = cxx::texels_rg(&table);
     let mut source = format!("{HLSL_2D_PRELUDE}{hlsl}\nint main() {{\n");
-    let _ = writeln!(source, "  Tex2 tex{{32, 32, {{{}}}}};", texels.join(", "));
+    let _ = writeln!(source, "  Tex2 tex{{32, 32, {{{texels}}}}};");
     for &(mu, r) in &points {
         let _ = writeln!(
             source,

@@ -178,19 +178,11 @@ fn generated_hlsl_lookup_runs_and_matches_the_library() {
             std::fs::read_to_string(dir.path().join(format!("{}.hlsl", table.spec.id()))).unwrap();
         source += &format!("namespace t{n} {{\n{hlsl}\n}}\n");
         let shape = table.spec.shape();
-        let texels: Vec<String> = table
-            .value
-            .iter()
-            .zip(&table.one_minus_value)
-            .flat_map(|(v, w)| [format!("{:?}f", *v as f32), format!("{:?}f", *w as f32)])
-            .collect();
+        let texels = cxx::texels_rg(table);
         let _ = writeln!(
             main,
             "  Tex3 tex{n}{{{}, {}, {}, {{{}}}}};",
-            shape[2],
-            shape[1],
-            shape[0],
-            texels.join(", ")
+            shape[2], shape[1], shape[0], texels
         );
         for &(mu, r, eta) in &points {
             for eta in [eta, 1.0 / eta] {

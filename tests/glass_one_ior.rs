@@ -152,15 +152,10 @@ fn generated_lookups_read_the_one_ior_layout() {
             let stem = kiln::format::shader::name(table);
             let hlsl = std::fs::read_to_string(dir.path().join(format!("{id}.hlsl"))).unwrap();
             let hlsl = &hlsl[..hlsl.find("float3 ").unwrap_or(hlsl.len())];
-            let texels: Vec<String> = table
-                .value
-                .iter()
-                .zip(&table.one_minus_value)
-                .flat_map(|(v, w)| [format!("{:?}f", *v as f32), format!("{:?}f", *w as f32)])
-                .collect();
+            let texels = cxx::texels_rg(table);
             let prelude = crate::balanced_layout::HLSL_2D_PRELUDE;
             let mut source = format!("{prelude}{hlsl}\nint main() {{\n");
-            let _ = writeln!(source, "  Tex2 tex{{8, 8, {{{}}}}};", texels.join(", "));
+            let _ = writeln!(source, "  Tex2 tex{{8, 8, {{{texels}}}}};");
             for &(mu, r) in &points {
                 let _ = writeln!(
                     source,

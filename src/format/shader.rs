@@ -113,19 +113,8 @@ fn coordinate(language: Language, axis: &Axis) -> String {
                 );
                 language.select("mu <= 0.0", "0.0", &t)
             }
-            MuMapping::Balanced => {
-                // `balanced_k` and `balanced_eps` come from the preamble.
-                let p = literal(BalancedLayout::KILN.power);
-                let u = language.select(
-                    "mu <= 0.0",
-                    "0.0",
-                    "min(mu * (1.0 + balanced_k) / max(mu + balanced_k, 1e-30), 1.0)",
-                );
-                format!(
-                    "(pow({u} + balanced_eps, {p}) - pow(balanced_eps, {p})) / (pow(1.0 + \
-                     balanced_eps, {p}) - pow(balanced_eps, {p}))"
-                )
-            }
+            // `balanced_k` and `balanced_eps` come from the preamble.
+            MuMapping::Balanced => balanced_coordinate(language, BalancedLayout::KILN),
             MuMapping::SplitSum => {
                 let l = SplitSumLayout::KILN;
                 format!(
@@ -144,16 +133,7 @@ fn coordinate(language: Language, axis: &Axis) -> String {
             MuMapping::OneIor => {
                 // `balanced_k`, `balanced_eps`, `critical_share`, `critical_mu` and
                 // `critical_s` come from the preamble.
-                let p = literal(OneIorLayout::KILN.base().power);
-                let u = language.select(
-                    "mu <= 0.0",
-                    "0.0",
-                    "min(mu * (1.0 + balanced_k) / max(mu + balanced_k, 1e-30), 1.0)",
-                );
-                let base = format!(
-                    "(pow({u} + balanced_eps, {p}) - pow(balanced_eps, {p})) / (pow(1.0 + \
-                     balanced_eps, {p}) - pow(balanced_eps, {p}))"
-                );
+                let base = balanced_coordinate(language, OneIorLayout::KILN.base());
                 let at = |x: &str| format!("atan(({x} - critical_mu) / critical_s)");
                 let step = format!(
                     "min(max(({} - {}) / ({} - {}), 0.0), 1.0)",
@@ -342,23 +322,7 @@ fn preamble(language: Language, table: &Table) -> String {
     }) = spec.mu
     {
         // The balanced layout's scale and grazing offset (BalancedLayout::scale_at, offset_at).
-        let l = BalancedLayout::KILN;
-        out += &language.local(
-            "balanced_k",
-            &format!(
-                "{} * alpha * (1.0 + {} * alpha)",
-                literal(l.scale),
-                literal(l.scale_growth)
-            ),
-        );
-        out += &language.local(
-            "balanced_eps",
-            &format!(
-                "{} * exp(-{} * alpha)",
-                literal(l.offset_at(0.0, size)),
-                literal(l.offset_decay)
-            ),
-        );
+        out += &balanced_locals(language, BalancedLayout::KILN, size);
     }
     if let (
         Some(ior),
@@ -374,22 +338,7 @@ fn preamble(language: Language, table: &Table) -> String {
         let l = OneIorLayout::KILN;
         let b = l.base();
         let eta = spec.relative_eta(ior);
-        out += &language.local(
-            "balanced_k",
-            &format!(
-                "{} * alpha * (1.0 + {} * alpha)",
-                literal(b.scale),
-                literal(b.scale_growth)
-            ),
-        );
-        out += &language.local(
-            "balanced_eps",
-            &format!(
-                "{} * exp(-{} * alpha)",
-                literal(b.offset_at(0.0, size)),
-                literal(b.offset_decay)
-            ),
-        );
+        out += &balanced_locals(language, b, size);
         out += &language.local("critical_share", &literal(l.critical_share_at(eta)));
         out += &language.local(
             "critical_mu",
@@ -427,6 +376,42 @@ fn preamble(language: Language, table: &Table) -> String {
         out += &language.local("layer_share", &share);
     }
     out
+}
+
+/// The balanced coordinate of `mu` for `layout` (`BalancedLayout::mu_coordinate`), from the
+/// locals of [`balanced_locals`].
+fn balanced_coordinate(language: Language, layout: BalancedLayout) -> String {
+    let p = literal(layout.power);
+    let u = language.select(
+        "mu <= 0.0",
+        "0.0",
+        "min(mu * (1.0 + balanced_k) / max(mu + balanced_k, 1e-30), 1.0)",
+    );
+    format!(
+        "(pow({u} + balanced_eps, {p}) - pow(balanced_eps, {p})) / (pow(1.0 + balanced_eps, \
+         {p}) - pow(balanced_eps, {p}))"
+    )
+}
+
+/// The balanced coordinate's scale and grazing offset at the lookup's `alpha`
+/// (`BalancedLayout::scale_at`, `offset_at`) as the locals `balanced_k` and `balanced_eps`, for
+/// `layout` on an axis of `size` samples.
+fn balanced_locals(language: Language, layout: BalancedLayout, size: usize) -> String {
+    language.local(
+        "balanced_k",
+        &format!(
+            "{} * alpha * (1.0 + {} * alpha)",
+            literal(layout.scale),
+            literal(layout.scale_growth)
+        ),
+    ) + &language.local(
+        "balanced_eps",
+        &format!(
+            "{} * exp(-{} * alpha)",
+            literal(layout.offset_at(0.0, size)),
+            literal(layout.offset_decay)
+        ),
+    )
 }
 
 /// The function name stem: `ggx_height_correlated_e`.

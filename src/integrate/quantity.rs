@@ -216,19 +216,11 @@ impl Quantity {
         self != Quantity::FAvg
     }
 
-    /// Whether the table has an index-of-refraction axis (the dielectric tables and `F_avg`).
+    /// Whether the table has an index-of-refraction axis (the dielectric tables and `F_avg`;
+    /// a dielectric table at one IOR has none, [`crate::table::TableSpec::fixed_ior`]).
     #[must_use]
     pub fn has_ior(self) -> bool {
-        matches!(
-            self,
-            Quantity::EDielectric
-                | Quantity::EDielectricInside
-                | Quantity::EAvgDielectric
-                | Quantity::EAvgDielectricInside
-                | Quantity::EReflection
-                | Quantity::EAvgReflection
-                | Quantity::FAvg
-        )
+        self.is_dielectric() || self == Quantity::FAvg
     }
 
     /// Whether the quantity is the reflection alone of a rough dielectric interface, a coat's

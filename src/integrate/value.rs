@@ -164,12 +164,11 @@ impl Integral {
             (self.quantity, eta.or(self.fixed_eta()), mu)
         {
             // A coat's reflection: the Fresnel-weighted albedo's estimator.
-            let fresnel = Fresnel::Dielectric { eta };
-            return weighted_albedo(
+            return fresnel_weighted_qmc(
                 self.model,
+                Fresnel::Dielectric { eta },
                 alpha,
                 mu,
-                move |c| fresnel.reflectance(c)[0],
                 settings,
             );
         }
@@ -197,13 +196,7 @@ impl Integral {
         }
         if let Some(fresnel) = self.fresnel {
             let mu = mu.expect("E_F has a mu axis");
-            return weighted_albedo(
-                self.model,
-                alpha,
-                mu,
-                move |c| fresnel.reflectance(c)[0],
-                settings,
-            );
+            return fresnel_weighted_qmc(self.model, fresnel, alpha, mu, settings);
         }
         match (mu, self.quantity.weight()) {
             (Some(mu), None) => albedo(self.model, alpha, mu, settings),
@@ -211,6 +204,23 @@ impl Integral {
             (None, _) => average_albedo(self.model, alpha, settings),
         }
     }
+}
+
+/// The QMC Fresnel-weighted albedo `E_F(mu)` of channel 0 of `fresnel`.
+fn fresnel_weighted_qmc(
+    model: Model,
+    fresnel: Fresnel,
+    alpha: f64,
+    mu: f64,
+    settings: &QmcSettings,
+) -> Estimate {
+    weighted_albedo(
+        model,
+        alpha,
+        mu,
+        move |c| fresnel.reflectance(c)[0],
+        settings,
+    )
 }
 
 /// The reflected part `R` of a dielectric reference, as a value (`one_minus_value` is `1 - R`).

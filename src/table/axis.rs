@@ -294,18 +294,12 @@ impl MuMapping {
             MuMapping::Balanced => {
                 let l = super::balanced_layout::BalancedLayout::KILN;
                 format!(
-                    "lookup coordinate t = ((u + eps)^{p} - eps^{p}) / ((1 + eps)^{p} - eps^{p}) \
-                     with u = mu (1 + k) / (mu + k), k = {c} alpha (1 + {e} alpha), eps = ({z} / \
-                     32) (32 / N)^{w} exp(-{y} alpha), N the axis size (t = 0 at mu = 0; t = 1 \
-                     at alpha = 0, mu > 0); mu = u k / (1 + k - u) with u = (t ((1 + eps)^{p} - \
-                     eps^{p}) + eps^{p})^(1/{p}) - eps; the row at alpha = 0 holds the limit \
-                     alpha -> 0+ (computed at alpha = 1e-7)",
+                    "lookup coordinate t = {} (t = 0 at mu = 0; t = 1 at alpha = 0, mu > 0); mu = \
+                     u k / (1 + k - u) with u = (t ((1 + eps)^{p} - eps^{p}) + eps^{p})^(1/{p}) - \
+                     eps; the row at alpha = 0 holds the limit alpha -> 0+ (computed at alpha = \
+                     1e-7)",
+                    balanced_formula(l),
                     p = l.power,
-                    c = l.scale,
-                    e = l.scale_growth,
-                    z = l.offset,
-                    w = l.offset_size_power,
-                    y = l.offset_decay,
                 )
             }
             MuMapping::SplitSum => {
@@ -327,19 +321,12 @@ impl MuMapping {
                 format!(
                     "lookup coordinate t = w_c C(mu) + (1 - w_c) B(mu), eta the table's relative \
                      index (its IOR from outside, 1 / IOR from inside); B the balanced \
-                     coordinate with a tenth of its offset: B = ((u + eps)^{p} - eps^{p}) / ((1 \
-                     + eps)^{p} - eps^{p}), u = mu (1 + k) / (mu + k), k = {c} alpha (1 + {e} \
-                     alpha), eps = ({z} / 32) (32 / N)^{w} exp(-{y} alpha); from inside (eta < \
-                     1) w_c = {wc} and C(mu) = (atan((mu - mu_c) / s) - atan(-mu_c / s)) / \
-                     (atan((1 - mu_c) / s) - atan(-mu_c / s)), mu_c = sqrt(1 - eta^2), s = {cc} \
-                     alpha + {s0}; from outside w_c = 0; mu at t by bisection; the row at alpha \
-                     = 0 holds the limit alpha -> 0+ (computed at alpha = 1e-7)",
-                    p = b.power,
-                    c = b.scale,
-                    e = b.scale_growth,
-                    z = b.offset,
-                    w = b.offset_size_power,
-                    y = b.offset_decay,
+                     coordinate with a tenth of its offset: B = {}; from inside (eta < 1) w_c = \
+                     {wc} and C(mu) = (atan((mu - mu_c) / s) - atan(-mu_c / s)) / (atan((1 - \
+                     mu_c) / s) - atan(-mu_c / s)), mu_c = sqrt(1 - eta^2), s = {cc} alpha + \
+                     {s0}; from outside w_c = 0; mu at t by bisection; the row at alpha = 0 \
+                     holds the limit alpha -> 0+ (computed at alpha = 1e-7)",
+                    balanced_formula(b),
                     wc = l.critical_share,
                     cc = l.critical_scale,
                     s0 = l.critical_floor,
@@ -347,6 +334,22 @@ impl MuMapping {
             }
         }
     }
+}
+
+/// The balanced coordinate of `layout` as a formula: `((u + eps)^p - eps^p) / ((1 + eps)^p -
+/// eps^p)` with its constants (`table::balanced_layout`).
+fn balanced_formula(l: super::balanced_layout::BalancedLayout) -> String {
+    format!(
+        "((u + eps)^{p} - eps^{p}) / ((1 + eps)^{p} - eps^{p}) with u = mu (1 + k) / (mu + k), k = \
+         {c} alpha (1 + {e} alpha), eps = ({z} / 32) (32 / N)^{w} exp(-{y} alpha), N the axis \
+         size",
+        p = l.power,
+        c = l.scale,
+        e = l.scale_growth,
+        z = l.offset,
+        w = l.offset_size_power,
+        y = l.offset_decay,
+    )
 }
 
 /// How the samples of a roughness axis are spaced along its convention's value (`r` or

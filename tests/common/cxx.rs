@@ -53,3 +53,16 @@ pub fn compile_and_run(dir: &std::path::Path, name: &str, source: &str) -> Vec<f
         .map(|l| l.parse().unwrap())
         .collect()
 }
+
+/// A table's two channels (value, `1 - value`) as interleaved single-precision C++ literals, in
+/// storage order: the texels of the tests' C++ stand-ins for a GPU texture.
+#[allow(dead_code)] // not every test that includes this file samples a texture
+pub fn texels_rg(table: &kiln::Table) -> String {
+    let texels: Vec<String> = table
+        .value
+        .iter()
+        .zip(&table.one_minus_value)
+        .flat_map(|(v, w)| [format!("{:?}f", *v as f32), format!("{:?}f", *w as f32)])
+        .collect();
+    texels.join(", ")
+}
