@@ -141,7 +141,8 @@ fn coordinate_code(axis: &Axis) -> String {
                 )
             }
             MuMapping::OneIor => {
-                // `critical_share` and `critical_mu` come from the lookup (its one IOR).
+                // `critical_share`, `critical_mu` and `top_share` come from the lookup (its one
+                // IOR; both shares 0 from outside).
                 let l = OneIorLayout::KILN;
                 let b = l.base();
                 format!(
@@ -153,13 +154,17 @@ fn coordinate_code(axis: &Axis) -> String {
                      let s = {:?} * alpha + {:?};\n        \
                      let at = |x: f32| ((x - critical_mu) / s).atan();\n        \
                      let step = ((at(mu.clamp(0.0, 1.0)) - at(0.0)) / (at(1.0) - at(0.0))).clamp(0.0, 1.0);\n        \
-                     (1.0 - critical_share) * base + critical_share * step\n    }}",
+                     let w_t = top_share * alpha.min(1.0) * alpha.min(1.0);\n        \
+                     let top_at = |x: f32| ((x - 1.0) / {:?}).atan();\n        \
+                     let top = ((top_at(mu.clamp(0.0, 1.0)) - top_at(0.0)) / (top_at(1.0) - top_at(0.0))).clamp(0.0, 1.0);\n        \
+                     (1.0 - critical_share - w_t) * base + critical_share * step + w_t * top\n    }}",
                     b.scale as f32,
                     b.scale_growth as f32,
                     b.offset_at(0.0, size) as f32,
                     b.offset_decay as f32,
                     l.critical_scale as f32,
                     l.critical_floor as f32,
+                    l.top_width as f32,
                     p = b.power as f32,
                 )
             }
@@ -353,9 +358,10 @@ fn write_lookup(out: &mut String, table: &Table, prefix: &str, ty: &str) {
                 let l = OneIorLayout::KILN;
                 let _ = writeln!(
                     out,
-                    "    let (critical_share, critical_mu) = ({:?}_f32, {:?}_f32);",
+                    "    let (critical_share, critical_mu, top_share) = ({:?}_f32, {:?}_f32, {:?}_f32);",
                     l.critical_share_at(eta) as f32,
-                    OneIorLayout::critical_mu(eta.min(1.0)) as f32
+                    OneIorLayout::critical_mu(eta.min(1.0)) as f32,
+                    if eta < 1.0 { l.top_share as f32 } else { 0.0 }
                 );
             }
             let _ = writeln!(out, "    let t_mu = {};", coordinate_code(&mu_axis));

@@ -131,8 +131,8 @@ fn coordinate(language: Language, axis: &Axis) -> String {
                 )
             }
             MuMapping::OneIor => {
-                // `balanced_k`, `balanced_eps`, `critical_share`, `critical_mu` and
-                // `critical_s` come from the preamble.
+                // `balanced_k`, `balanced_eps`, `critical_share`, `critical_mu`, `critical_s`
+                // and `top_share` come from the preamble.
                 let base = balanced_coordinate(language, OneIorLayout::KILN.base());
                 let at = |x: &str| format!("atan(({x} - critical_mu) / critical_s)");
                 let step = format!(
@@ -142,7 +142,24 @@ fn coordinate(language: Language, axis: &Axis) -> String {
                     at("1.0"),
                     at("0.0")
                 );
-                format!("(1.0 - critical_share) * ({base}) + critical_share * {step}")
+                // The step at normal incidence, its share `top_share` (from the preamble).
+                let top_at = |x: &str| {
+                    format!(
+                        "atan(({x} - 1.0) / {})",
+                        literal(OneIorLayout::KILN.top_width)
+                    )
+                };
+                let top = format!(
+                    "min(max(({} - {}) / ({} - {}), 0.0), 1.0)",
+                    top_at("min(max(mu, 0.0), 1.0)"),
+                    top_at("0.0"),
+                    top_at("1.0"),
+                    top_at("0.0")
+                );
+                format!(
+                    "(1.0 - critical_share - top_share) * ({base}) + critical_share * {step} + \
+                     top_share * {top}"
+                )
             }
             MuMapping::Glass => {
                 // `layer_share` and `kappa` come from the preamble.
@@ -340,6 +357,11 @@ fn preamble(language: Language, table: &Table) -> String {
         let eta = spec.relative_eta(ior);
         out += &balanced_locals(language, b, size);
         out += &language.local("critical_share", &literal(l.critical_share_at(eta)));
+        let top_share = if eta < 1.0 { l.top_share } else { 0.0 };
+        out += &language.local(
+            "top_share",
+            &format!("{} * min(alpha, 1.0) * min(alpha, 1.0)", literal(top_share)),
+        );
         out += &language.local(
             "critical_mu",
             &literal(OneIorLayout::critical_mu(eta.min(1.0))),

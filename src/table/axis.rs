@@ -319,14 +319,19 @@ impl MuMapping {
                 let l = super::one_ior_layout::OneIorLayout::KILN;
                 let b = l.base();
                 format!(
-                    "lookup coordinate t = w_c C(mu) + (1 - w_c) B(mu), eta the table's relative \
+                    "lookup coordinate t = w_c C(mu) + w_t T(mu) + (1 - w_c - w_t) B(mu), eta the table's relative \
                      index (its IOR from outside, 1 / IOR from inside); B the balanced \
                      coordinate with a tenth of its offset: B = {}; from inside (eta < 1) w_c = \
                      {wc} and C(mu) = (atan((mu - mu_c) / s) - atan(-mu_c / s)) / (atan((1 - \
                      mu_c) / s) - atan(-mu_c / s)), mu_c = sqrt(1 - eta^2), s = {cc} alpha + \
-                     {s0}; from outside w_c = 0; mu at t by bisection; the row at alpha = 0 \
-                     holds the limit alpha -> 0+ (computed at alpha = 1e-7)",
+                     {s0}, and a share w_t = {wt} min(alpha, 1)^2 more of the coordinate is T(mu) \
+                     = (atan((mu - 1) / {st}) - atan(-1 / {st})) / -atan(-1 / {st}) (t = w_c \
+                     C + w_t T + (1 - w_c - w_t) B); from outside w_c = w_t = 0; mu at t by \
+                     bisection; the row at alpha = 0 holds the limit alpha -> 0+ (computed at \
+                     alpha = 1e-7)",
                     balanced_formula(b),
+                    wt = l.top_share,
+                    st = l.top_width,
                     wc = l.critical_share,
                     cc = l.critical_scale,
                     s0 = l.critical_floor,
