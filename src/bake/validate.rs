@@ -91,11 +91,8 @@ impl BakeOptions {
                 }
             )));
         }
-        let one_ior = self
-            .quantities
-            .iter()
-            .any(|&q| self.fixed_ior_for(q).is_some());
-        if let Some(ior) = self.quantities.iter().find_map(|&q| self.fixed_ior_for(q)) {
+        let one_ior = self.quantities.iter().find_map(|&q| self.fixed_ior_for(q));
+        if let Some(ior) = one_ior {
             crate::table::check::check_fixed_ior(ior)?;
         }
         match (self.quantities.contains(&Quantity::EF), self.fresnel) {
@@ -114,7 +111,7 @@ impl BakeOptions {
                         .into(),
                 ));
             }
-            (false, Some(_)) if one_ior => {}
+            (false, Some(_)) if one_ior.is_some() => {}
             (false, Some(_)) => {
                 return Err(Error::InvalidInput(
                     "a Fresnel model applies to the Fresnel-weighted table (add --quantity e-f) \

@@ -361,7 +361,7 @@ fn write_lookup(out: &mut String, table: &Table, prefix: &str, ty: &str) {
                     "    let (critical_share, critical_mu, top_share) = ({:?}_f32, {:?}_f32, {:?}_f32);",
                     l.critical_share_at(eta) as f32,
                     OneIorLayout::critical_mu(eta.min(1.0)) as f32,
-                    if eta < 1.0 { l.top_share as f32 } else { 0.0 }
+                    l.top_share_for(eta) as f32
                 );
             }
             let _ = writeln!(out, "    let t_mu = {};", coordinate_code(&mu_axis));

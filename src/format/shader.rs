@@ -357,10 +357,12 @@ fn preamble(language: Language, table: &Table) -> String {
         let eta = spec.relative_eta(ior);
         out += &balanced_locals(language, b, size);
         out += &language.local("critical_share", &literal(l.critical_share_at(eta)));
-        let top_share = if eta < 1.0 { l.top_share } else { 0.0 };
         out += &language.local(
             "top_share",
-            &format!("{} * min(alpha, 1.0) * min(alpha, 1.0)", literal(top_share)),
+            &format!(
+                "{} * min(alpha, 1.0) * min(alpha, 1.0)",
+                literal(l.top_share_for(eta))
+            ),
         );
         out += &language.local(
             "critical_mu",

@@ -160,9 +160,8 @@ impl Integral {
     #[must_use]
     pub fn qmc(&self, at: Point, settings: &QmcSettings) -> Estimate {
         let Point { alpha, mu, eta } = at;
-        if let (Quantity::EReflection, Some(eta), Some(mu)) =
-            (self.quantity, eta.or(self.fixed_eta()), mu)
-        {
+        let eta = eta.or(self.fixed_eta());
+        if let (Quantity::EReflection, Some(eta), Some(mu)) = (self.quantity, eta, mu) {
             // A coat's reflection: the Fresnel-weighted albedo's estimator.
             return fresnel_weighted_qmc(
                 self.model,
@@ -183,7 +182,7 @@ impl Integral {
                 samples: r.evaluations,
             };
         }
-        if let Some(eta) = eta.or(self.fixed_eta()) {
+        if let Some(eta) = eta {
             let convention = self.transmission;
             return match mu {
                 Some(mu) => {

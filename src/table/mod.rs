@@ -556,10 +556,8 @@ impl TableSpec {
     #[must_use]
     pub fn point_at(&self, t_roughness: f64, t_mu: f64, eta_up: f64) -> (f64, Option<f64>) {
         debug_assert!(self.roughness.is_some(), "F_avg has no roughness axis");
-        // A glass table at one IOR is laid out at that index, whatever the caller's.
-        let eta_up = self
-            .fixed_ior()
-            .map_or(eta_up, |ior| self.relative_eta(ior));
+        // A glass table at one IOR is laid out at its own index, whatever the caller's.
+        let eta_up = self.mapping_eta(eta_up);
         let alpha = self.roughness_axis().alpha_at_coordinate(t_roughness);
         match self.mu {
             Some(Axis::Mu { mapping, size, .. }) => {

@@ -110,6 +110,13 @@ impl OneIorLayout {
         ((at(mu.clamp(0.0, 1.0)) - low) / (high - low)).clamp(0.0, 1.0)
     }
 
+    /// The step at normal incidence's factor `w_t` at relative index `eta`: `w_t` from inside,
+    /// 0 from outside (its share at `alpha` is this times `min(alpha, 1)^2`).
+    #[must_use]
+    pub fn top_share_for(&self, eta: f64) -> f64 {
+        if eta < 1.0 { self.top_share } else { 0.0 }
+    }
+
     /// The share of the step at normal incidence at `alpha`, from inside: `w_t min(alpha, 1)^2`.
     #[must_use]
     pub fn top_share_at(&self, alpha: f64) -> f64 {
